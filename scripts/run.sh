@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# Installs what is missing, builds, and runs the main job: a headless replay of an
+# example stroke into out/replay.png (with its stats in out/replay-stats.json).
+set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+wb_install_deps
+wb_build
+mkdir -p "$WB_ROOT/out"
+"$WB_BUILD/bin/wetbrush" devices
+"$WB_BUILD/bin/wetbrush" replay "$WB_ROOT/examples/press-and-drag.json" \
+  -o "$WB_ROOT/out/replay.png" --stats "$WB_ROOT/out/replay-stats.json" "$@"
+echo "wetbrush: wrote $WB_ROOT/out/replay.png and $WB_ROOT/out/replay-stats.json"

@@ -1,0 +1,81 @@
+// Gather and scatter between the sparse tiles and the dense active window (DESIGN
+// step 3). Compiled once per backend; one launch per operation.
+#pragma once
+#include "core/canvas/tile_store.h"
+#include "core/exec/atomics.h"
+#include "core/exec/parallel_for.h"
+
+namespace wb::WB_BACKEND_NS {
+
+namespace detail {
+struct CanvasCellRef {
+  int64_t at = -1;  ///< offset into the pool, -1 when unallocated or off-canvas
+};
+WB_HD WB_INLINE CanvasCellRef locate(const TileStoreView& t, int cx, int cy, int cz) {
+  CanvasCellRef r;
+  if (!t.inside(cx, cy, cz)) return r;
+  const int tile = (cy / kTileSize) * t.tiles_x + cx / kTileSize;
+  const int32_t slot = t.slot_of_tile[tile];
+  if (slot < 0) return r;
+  r.at = int64_t(slot) * t.tile_cells() + t.cell_offset(cx % kTileSize, cy % kTileSize, cz);
+  return r;
+}
+WB_HD WB_INLINE void decompose(const PaintWindowView& w, int64_t i, int& x, int& y, int& z) {
+  x = int(i % w.nx);
+  y = int((i / w.nx) % w.ny);
+  z = int(i / (int64_t(w.nx) * w.ny));
+}
+}  // namespace detail
+
+void gather_window(TileStoreView t, PaintWindowView w) {
+  parallel_for(w.size(), [=] WB_HD(int64_t i) {
+    int x, y, z;
+    detail::decompose(w, i, x, y, z);
+    const auto c = detail::locate(t, x + w.ox, y + w.oy, z + w.oz);
+    if (c.at < 0) {
+      w.density[i] = w.pigment_r[i] = w.pigment_y[i] = w.pigment_b[i] = w.oil[i] = w.dryness[i] = 0.f;
+      return;
+    }
+    w.density[i] = t.density[c.at];
+    w.pigment_r[i] = decode_unorm16(t.pigment_r[c.at]);
+    w.pigment_y[i] = decode_unorm16(t.pigment_y[c.at]);
+    w.pigment_b[i] = decode_unorm16(t.pigment_b[c.at]);
+    w.oil[i] = decode_unorm16(t.oil[c.at]);
+    w.dryness[i] = decode_unorm16(t.dryness[c.at]);
+  });
+}
+
+void mark_painted_tiles(TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* flags) {
+  parallel_for(w.size(), [=] WB_HD(int64_t i) {
+    if (w.density[i] == 0.f) return;
+    int x, y, z;
+    detail::decompose(w, i, x, y, z);
+    const int cx = x + w.ox, cy = y + w.oy, cz = z + w.oz;
+    if (!t.inside(cx, cy, cz)) return;
+    const int f = (cy / kTileSize - ty0) * ntx + (cx / kTileSize - tx0);
+    if (flags[f] == 0) atomic_or(&flags[f], 1);
+  });
+}
+
+void scatter_window(TileStoreView t, PaintWindowView w) {
+  parallel_for(w.size(), [=] WB_HD(int64_t i) {
+    int x, y, z;
+    detail::decompose(w, i, x, y, z);
+    const auto c = detail::locate(t, x + w.ox, y + w.oy, z + w.oz);
+    if (c.at < 0) return;  // off-canvas, or an unallocated tile that received no paint
+    t.density[c.at] = w.density[i];
+    t.pigment_r[c.at] = encode_unorm16(w.pigment_r[i]);
+    t.pigment_y[c.at] = encode_unorm16(w.pigment_y[i]);
+    t.pigment_b[c.at] = encode_unorm16(w.pigment_b[i]);
+    t.oil[c.at] = encode_unorm16(w.oil[i]);
+    t.dryness[c.at] = encode_unorm16(w.dryness[i]);
+  });
+}
+
+void dry_all(TileStoreView t, int64_t cells) {
+  parallel_for(cells, [=] WB_HD(int64_t i) {
+    if (t.density[i] > 0.f) t.dryness[i] = 65535;
+  });
+}
+
+}  // namespace wb::WB_BACKEND_NS

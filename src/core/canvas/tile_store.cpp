@@ -1,0 +1,188 @@
+#include "core/canvas/tile_store.h"
+
+#include <algorithm>
+
+#include "core/exec/algorithms.h"
+#include "core/exec/dispatch.h"
+
+namespace wb {
+
+namespace {
+void gather_dispatch(const Device& d, TileStoreView t, PaintWindowView w) { WB_DISPATCH(d, gather_window(t, w)); }
+void mark_dispatch(const Device& d, TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* f) {
+  WB_DISPATCH(d, mark_painted_tiles(t, w, tx0, ty0, ntx, f));
+}
+void scatter_dispatch(const Device& d, TileStoreView t, PaintWindowView w) { WB_DISPATCH(d, scatter_window(t, w)); }
+void dry_dispatch(const Device& d, TileStoreView t, int64_t cells) { WB_DISPATCH(d, dry_all(t, cells)); }
+}  // namespace
+
+TileStore::TileStore(const Device& device, CanvasDims dims) : device_(device), dims_(dims) {
+  WB_REQUIRE(dims.width > 0 && dims.height > 0 && dims.depth > 0, "canvas dimensions must be positive");
+  WB_REQUIRE(dims.width <= 65536 && dims.height <= 65536 && dims.depth <= 1024,
+             "canvas dimensions too large (at most 65536 x 65536 x 1024 cells)");
+  tiles_x_ = (dims.width + kTileSize - 1) / kTileSize;
+  tiles_y_ = (dims.height + kTileSize - 1) / kTileSize;
+  host_slot_.assign(size_t(tiles_x_) * tiles_y_, -1);
+  slot_of_tile_.set_device(device);
+  slot_of_tile_.copy_from_host(host_slot_);
+  for (auto* b : {&pigment_r_, &pigment_y_, &pigment_b_, &oil_, &dryness_}) b->set_device(device);
+  density_.set_device(device);
+  tile_flags_.set_device(device);
+}
+
+TileStoreView TileStore::view() {
+  TileStoreView v{};
+  v.slot_of_tile = slot_of_tile_.data();
+  v.density = density_.data();
+  v.pigment_r = pigment_r_.data();
+  v.pigment_y = pigment_y_.data();
+  v.pigment_b = pigment_b_.data();
+  v.oil = oil_.data();
+  v.dryness = dryness_.data();
+  v.width = dims_.width;
+  v.height = dims_.height;
+  v.depth = dims_.depth;
+  v.tiles_x = tiles_x_;
+  v.tiles_y = tiles_y_;
+  return v;
+}
+
+void TileStore::grow_pool(int32_t slots) {
+  if (slots <= slot_capacity_) return;
+  int32_t cap = std::max<int32_t>(slot_capacity_, 8);
+  while (cap < slots) cap += cap / 2;
+  const size_t cells = size_t(cap) * size_t(tile_cells());
+  const size_t used = size_t(slot_capacity_) * size_t(tile_cells());
+  density_.grow_keep(cells);
+  for (auto* b : {&pigment_r_, &pigment_y_, &pigment_b_, &oil_, &dryness_}) b->grow_keep(cells);
+  // New slots start empty.
+  mem::fill_zero(device_, density_.data() + used, (cells - used) * sizeof(float));
+  for (auto* b : {&pigment_r_, &pigment_y_, &pigment_b_, &oil_, &dryness_})
+    mem::fill_zero(device_, b->data() + used, (cells - used) * sizeof(uint16_t));
+  slot_capacity_ = cap;
+}
+
+int32_t TileStore::ensure_slot(int tile_id) {
+  int32_t& s = host_slot_[size_t(tile_id)];
+  if (s >= 0) return s;
+  grow_pool(slots_used_ + 1);
+  s = slots_used_++;
+  tile_of_slot_.push_back(tile_id);
+  slot_of_tile_.copy_range_from_host(&s, size_t(tile_id), 1);
+  return s;
+}
+
+void TileStore::gather(PaintWindow& window) {
+  WB_REQUIRE(window.device() == device_, "gather: window and canvas live on different devices");
+  gather_dispatch(device_, view(), window.view());
+}
+
+void TileStore::scatter(PaintWindow& window) {
+  WB_REQUIRE(window.device() == device_, "scatter: window and canvas live on different devices");
+  const Int3 o = window.origin(), n = window.dims();
+  const int x0 = std::max(o.x, 0), y0 = std::max(o.y, 0);
+  const int x1 = std::min(o.x + n.x, dims_.width) - 1, y1 = std::min(o.y + n.y, dims_.height) - 1;
+  if (x1 < x0 || y1 < y0 || o.z >= dims_.depth || o.z + n.z <= 0) return;  // window entirely off-canvas
+  const int tx0 = x0 / kTileSize, ty0 = y0 / kTileSize;
+  const int ntx = x1 / kTileSize - tx0 + 1, nty = y1 / kTileSize - ty0 + 1;
+  // Allocate the tiles that receive paint, then write every on-canvas cell of the window.
+  tile_flags_.resize(size_t(ntx) * nty);
+  tile_flags_.fill_zero();
+  mark_dispatch(device_, view(), window.view(), tx0, ty0, ntx, tile_flags_.data());
+  host_flags_.resize(tile_flags_.size());
+  tile_flags_.copy_to_host(host_flags_.data(), host_flags_.size());
+  for (int j = 0; j < nty; ++j)
+    for (int i = 0; i < ntx; ++i)
+      if (host_flags_[size_t(j) * ntx + i]) ensure_slot((ty0 + j) * tiles_x_ + tx0 + i);
+  scatter_dispatch(device_, view(), window.view());
+}
+
+void TileStore::dry_all() {
+  if (slots_used_ == 0) return;
+  dry_dispatch(device_, view(), int64_t(slots_used_) * tile_cells());
+}
+
+void TileStore::clear() {
+  for (int32_t t : tile_of_slot_) host_slot_[size_t(t)] = -1;
+  tile_of_slot_.clear();
+  slots_used_ = 0;
+  slot_of_tile_.copy_from_host(host_slot_);
+  if (slot_capacity_ > 0) {
+    density_.fill_zero();
+    for (auto* b : {&pigment_r_, &pigment_y_, &pigment_b_, &oil_, &dryness_}) b->fill_zero();
+  }
+}
+
+size_t TileStore::memory_bytes() const {
+  size_t b = host_slot_.size() * sizeof(int32_t) * 2 + tile_of_slot_.capacity() * sizeof(int32_t);
+  b += density_.bytes() + pigment_r_.bytes() + pigment_y_.bytes() + pigment_b_.bytes() + oil_.bytes() +
+       dryness_.bytes();
+  return b;
+}
+
+double TileStore::total_density(Workspace& ws) const {
+  if (slots_used_ == 0) return 0.0;
+  return reduce_sum(device_, density_.data(), int64_t(slots_used_) * tile_cells(), ws);
+}
+
+PaintCell TileStore::read_cell(int x, int y, int z) const {
+  PaintCell c;
+  if (x < 0 || y < 0 || z < 0 || x >= dims_.width || y >= dims_.height || z >= dims_.depth) return c;
+  const int32_t slot = host_slot_[size_t(y / kTileSize) * tiles_x_ + x / kTileSize];
+  if (slot < 0) return c;
+  const size_t at = size_t(slot) * tile_cells() + size_t((z * kTileSize + y % kTileSize) * kTileSize + x % kTileSize);
+  density_.copy_range_to_host(&c.density, at, 1);
+  uint16_t q[5];
+  pigment_r_.copy_range_to_host(&q[0], at, 1);
+  pigment_y_.copy_range_to_host(&q[1], at, 1);
+  pigment_b_.copy_range_to_host(&q[2], at, 1);
+  oil_.copy_range_to_host(&q[3], at, 1);
+  dryness_.copy_range_to_host(&q[4], at, 1);
+  c.pigment_r = decode_unorm16(q[0]);
+  c.pigment_y = decode_unorm16(q[1]);
+  c.pigment_b = decode_unorm16(q[2]);
+  c.oil = decode_unorm16(q[3]);
+  c.dryness = decode_unorm16(q[4]);
+  return c;
+}
+
+std::vector<int> TileStore::allocated_tile_ids() const { return {tile_of_slot_.begin(), tile_of_slot_.end()}; }
+
+TileData TileStore::read_tile(int tile_id) const {
+  WB_REQUIRE(tile_id >= 0 && size_t(tile_id) < host_slot_.size(), "read_tile: tile id out of range");
+  TileData d;
+  d.tile_x = tile_id % tiles_x_;
+  d.tile_y = tile_id / tiles_x_;
+  const size_t n = size_t(tile_cells());
+  d.density.assign(n, 0.f);
+  for (auto* v : {&d.pigment_r, &d.pigment_y, &d.pigment_b, &d.oil, &d.dryness}) v->assign(n, 0);
+  const int32_t slot = host_slot_[size_t(tile_id)];
+  if (slot < 0) return d;
+  const size_t at = size_t(slot) * n;
+  density_.copy_range_to_host(d.density.data(), at, n);
+  pigment_r_.copy_range_to_host(d.pigment_r.data(), at, n);
+  pigment_y_.copy_range_to_host(d.pigment_y.data(), at, n);
+  pigment_b_.copy_range_to_host(d.pigment_b.data(), at, n);
+  oil_.copy_range_to_host(d.oil.data(), at, n);
+  dryness_.copy_range_to_host(d.dryness.data(), at, n);
+  return d;
+}
+
+void TileStore::write_tile(const TileData& d) {
+  WB_REQUIRE(d.tile_x >= 0 && d.tile_y >= 0 && d.tile_x < tiles_x_ && d.tile_y < tiles_y_,
+             "write_tile: tile position outside the canvas");
+  const size_t n = size_t(tile_cells());
+  WB_REQUIRE(d.density.size() == n && d.pigment_r.size() == n && d.pigment_y.size() == n &&
+                 d.pigment_b.size() == n && d.oil.size() == n && d.dryness.size() == n,
+             "write_tile: field sizes do not match the canvas depth");
+  const int32_t slot = ensure_slot(d.tile_y * tiles_x_ + d.tile_x);
+  const size_t at = size_t(slot) * n;
+  density_.copy_range_from_host(d.density.data(), at, n);
+  pigment_r_.copy_range_from_host(d.pigment_r.data(), at, n);
+  pigment_y_.copy_range_from_host(d.pigment_y.data(), at, n);
+  pigment_b_.copy_range_from_host(d.pigment_b.data(), at, n);
+  oil_.copy_range_from_host(d.oil.data(), at, n);
+  dryness_.copy_range_from_host(d.dryness.data(), at, n);
+}
+
+}  // namespace wb

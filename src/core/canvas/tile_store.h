@@ -1,0 +1,125 @@
+// The sparse canvas: width x height x depth cells stored as columns of 16 x 16 x depth
+// cells ("tiles"), allocated on first write from a pool that grows geometrically.
+// An empty canvas costs only the tile index. Storage per cell (14 bytes):
+//   density  float32  -- mass must survive any number of window moves exactly
+//   R, Y, B  unorm16   -- pigment mixes in small steps; 8 bits would band and drift
+//   oil      unorm16
+//   dryness  unorm16   -- 1/65535 resolution; drying rates are far coarser per step
+// See docs/ARCHITECTURE.md ("The sparse canvas") for the reasoning.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "core/canvas/paint_fields.h"
+#include "core/canvas/window.h"
+#include "core/exec/buffer.h"
+#include "core/exec/workspace.h"
+
+namespace wb {
+
+inline constexpr int kTileSize = 16;
+
+struct CanvasDims {
+  int width = 4096;
+  int height = 4096;
+  int depth = 64;
+  bool operator==(const CanvasDims& o) const { return width == o.width && height == o.height && depth == o.depth; }
+};
+
+WB_HD WB_INLINE uint16_t encode_unorm16(float v) {
+  v = v < 0.f ? 0.f : (v > 1.f ? 1.f : v);
+  return uint16_t(v * 65535.f + 0.5f);
+}
+WB_HD WB_INLINE float decode_unorm16(uint16_t q) { return float(q) * (1.f / 65535.f); }
+
+/// POD view of the tile pool, passed by value to kernels.
+struct TileStoreView {
+  const int32_t* slot_of_tile;  ///< tiles_x * tiles_y entries, -1 = not allocated
+  float* density;               ///< slot * tile_cells + cell
+  uint16_t* pigment_r;
+  uint16_t* pigment_y;
+  uint16_t* pigment_b;
+  uint16_t* oil;
+  uint16_t* dryness;
+  int width, height, depth;
+  int tiles_x, tiles_y;
+  WB_HD int64_t tile_cells() const { return int64_t(kTileSize) * kTileSize * depth; }
+  WB_HD int64_t cell_offset(int lx, int ly, int z) const { return (int64_t(z) * kTileSize + ly) * kTileSize + lx; }
+  WB_HD bool inside(int x, int y, int z) const {
+    return x >= 0 && y >= 0 && z >= 0 && x < width && y < height && z < depth;
+  }
+};
+
+/// The host copy of one tile, as stored.
+struct TileData {
+  int tile_x = 0, tile_y = 0;
+  std::vector<float> density;
+  std::vector<uint16_t> pigment_r, pigment_y, pigment_b, oil, dryness;
+};
+
+class TileStore {
+ public:
+  TileStore(const Device& device, CanvasDims dims);
+
+  const Device& device() const { return device_; }
+  CanvasDims dims() const { return dims_; }
+  int tiles_x() const { return tiles_x_; }
+  int tiles_y() const { return tiles_y_; }
+  int64_t tile_cells() const { return int64_t(kTileSize) * kTileSize * dims_.depth; }
+
+  /// Fills the window from the tiles at the window's origin (empty where unallocated or off-canvas).
+  void gather(PaintWindow& window);
+  /// Writes the window back; allocates the tiles that receive paint. Off-canvas cells are dropped.
+  void scatter(PaintWindow& window);
+  /// "Let it dry": every cell holding paint becomes fully dry (solid).
+  void dry_all();
+  /// Empties the canvas (keeps the pool's memory).
+  void clear();
+
+  int allocated_tiles() const { return slots_used_; }
+  /// Bytes held now: tile index (host and device) plus the pool's capacity.
+  size_t memory_bytes() const;
+  /// Sum of density over all cells (in cell units), in double.
+  double total_density(Workspace& ws) const;
+
+  PaintCell read_cell(int x, int y, int z) const;
+  /// Ids (ty * tiles_x + tx) of the allocated tiles, in slot order.
+  std::vector<int> allocated_tile_ids() const;
+  TileData read_tile(int tile_id) const;
+  /// Writes a whole tile (allocating it); sizes must be tile_cells().
+  void write_tile(const TileData& data);
+
+  TileStoreView view();
+
+ private:
+  int32_t ensure_slot(int tile_id);
+  void grow_pool(int32_t slots);
+
+  Device device_;
+  CanvasDims dims_;
+  int tiles_x_ = 0, tiles_y_ = 0;
+  std::vector<int32_t> host_slot_;  ///< mirror of slot_of_tile_
+  std::vector<int32_t> tile_of_slot_;
+  int32_t slots_used_ = 0;
+  int32_t slot_capacity_ = 0;
+  DeviceBuffer<int32_t> slot_of_tile_;
+  DeviceBuffer<float> density_;
+  DeviceBuffer<uint16_t> pigment_r_, pigment_y_, pigment_b_, oil_, dryness_;
+  DeviceBuffer<int32_t> tile_flags_;  ///< scratch of scatter: which window tiles hold paint
+  std::vector<int32_t> host_flags_;
+};
+
+namespace cpu {
+void gather_window(TileStoreView t, PaintWindowView w);
+void mark_painted_tiles(TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* flags);
+void scatter_window(TileStoreView t, PaintWindowView w);
+void dry_all(TileStoreView t, int64_t cells);
+}  // namespace cpu
+namespace cuda {
+void gather_window(TileStoreView t, PaintWindowView w);
+void mark_painted_tiles(TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* flags);
+void scatter_window(TileStoreView t, PaintWindowView w);
+void dry_all(TileStoreView t, int64_t cells);
+}  // namespace cuda
+
+}  // namespace wb

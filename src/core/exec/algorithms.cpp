@@ -1,0 +1,39 @@
+// The one runtime dispatcher of the primitives: validates, then picks the backend.
+#include "core/exec/algorithms.h"
+
+#include "core/exec/dispatch.h"
+
+namespace wb {
+namespace {
+void check_ws(const Device& d, const Workspace& ws) {
+  WB_REQUIRE(ws.device() == d, "algorithm workspace lives on " + ws.device().to_string() + ", not " + d.to_string());
+}
+}  // namespace
+
+void sort_by_key(const Device& d, uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Workspace& ws) {
+  WB_REQUIRE(n >= 0 && key_bits > 0 && key_bits <= 32, "sort_by_key: bad size or key bit count");
+  check_ws(d, ws);
+  WB_DISPATCH(d, sort_by_key(keys, values, n, key_bits, ws));
+}
+uint32_t exclusive_scan(const Device& d, const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws) {
+  check_ws(d, ws);
+  WB_DISPATCH(d, exclusive_scan(in, out, n, ws));
+}
+double reduce_sum(const Device& d, const float* in, int64_t n, Workspace& ws) {
+  check_ws(d, ws);
+  WB_DISPATCH(d, reduce_sum(in, n, ws));
+}
+float reduce_max(const Device& d, const float* in, int64_t n, Workspace& ws) {
+  check_ws(d, ws);
+  WB_DISPATCH(d, reduce_max(in, n, ws));
+}
+float reduce_min(const Device& d, const float* in, int64_t n, Workspace& ws) {
+  check_ws(d, ws);
+  WB_DISPATCH(d, reduce_min(in, n, ws));
+}
+int64_t count_nonfinite(const Device& d, const float* in, int64_t n, Workspace& ws) {
+  check_ws(d, ws);
+  WB_DISPATCH(d, count_nonfinite(in, n, ws));
+}
+
+}  // namespace wb

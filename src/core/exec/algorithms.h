@@ -1,0 +1,40 @@
+// Device-wide primitives the stages need: radix sort of key/value pairs, exclusive
+// scan, reductions and a finiteness count. One dispatcher (algorithms.cpp) picks
+// the OpenMP implementation or the CUB one; all pointers are device pointers.
+#pragma once
+#include <cstdint>
+
+#include "core/exec/device.h"
+#include "core/exec/workspace.h"
+
+namespace wb {
+
+/// Sorts (key, value) pairs by the low `key_bits` bits of the key, stable, in place.
+void sort_by_key(const Device& device, uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Workspace& ws);
+/// out[i] = sum of in[0..i), out may alias in; returns the total.
+uint32_t exclusive_scan(const Device& device, const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);
+/// Sum in double precision (mass books need more than float accumulation).
+double reduce_sum(const Device& device, const float* in, int64_t n, Workspace& ws);
+float reduce_max(const Device& device, const float* in, int64_t n, Workspace& ws);
+float reduce_min(const Device& device, const float* in, int64_t n, Workspace& ws);
+/// Number of NaN or infinite values.
+int64_t count_nonfinite(const Device& device, const float* in, int64_t n, Workspace& ws);
+
+namespace cpu {
+void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Workspace& ws);
+uint32_t exclusive_scan(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);
+double reduce_sum(const float* in, int64_t n, Workspace& ws);
+float reduce_max(const float* in, int64_t n, Workspace& ws);
+float reduce_min(const float* in, int64_t n, Workspace& ws);
+int64_t count_nonfinite(const float* in, int64_t n, Workspace& ws);
+}  // namespace cpu
+namespace cuda {
+void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Workspace& ws);
+uint32_t exclusive_scan(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);
+double reduce_sum(const float* in, int64_t n, Workspace& ws);
+float reduce_max(const float* in, int64_t n, Workspace& ws);
+float reduce_min(const float* in, int64_t n, Workspace& ws);
+int64_t count_nonfinite(const float* in, int64_t n, Workspace& ws);
+}  // namespace cuda
+
+}  // namespace wb

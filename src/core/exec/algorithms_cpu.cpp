@@ -1,0 +1,81 @@
+// CPU (OpenMP) implementations of the device-wide primitives.
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <vector>
+
+#include "core/exec/algorithms.h"
+
+namespace wb::cpu {
+
+// LSD radix sort, 8 bits a pass, only as many passes as key_bits needs. A generic
+// comparison sort over OpenMP is an order of magnitude slower on the per-step path.
+void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Workspace& ws) {
+  if (n <= 1) return;
+  const int passes = std::max(1, (std::min(key_bits, 32) + 7) / 8);
+  auto* scratch = static_cast<uint32_t*>(ws.get(size_t(n) * 2 * sizeof(uint32_t)));
+  uint32_t* k_src = keys;
+  uint32_t* v_src = values;
+  uint32_t* k_dst = scratch;
+  uint32_t* v_dst = scratch + n;
+  for (int pass = 0; pass < passes; ++pass) {
+    const int shift = pass * 8;
+    size_t count[257] = {};
+    for (int64_t i = 0; i < n; ++i) ++count[((k_src[i] >> shift) & 0xFFu) + 1];
+    for (int b = 0; b < 256; ++b) count[b + 1] += count[b];
+    for (int64_t i = 0; i < n; ++i) {
+      const size_t dst = count[(k_src[i] >> shift) & 0xFFu]++;
+      k_dst[dst] = k_src[i];
+      v_dst[dst] = v_src[i];
+    }
+    std::swap(k_src, k_dst);
+    std::swap(v_src, v_dst);
+  }
+  if (k_src != keys) {
+    std::memcpy(keys, k_src, size_t(n) * sizeof(uint32_t));
+    std::memcpy(values, v_src, size_t(n) * sizeof(uint32_t));
+  }
+}
+
+uint32_t exclusive_scan(const uint32_t* in, uint32_t* out, int64_t n, Workspace&) {
+  uint32_t running = 0;
+  for (int64_t i = 0; i < n; ++i) {
+    const uint32_t v = in[i];
+    out[i] = running;
+    running += v;
+  }
+  return running;
+}
+
+double reduce_sum(const float* in, int64_t n, Workspace&) {
+  double s = 0.0;
+#pragma omp parallel for reduction(+ : s) schedule(static) if (n > 65536)
+  for (int64_t i = 0; i < n; ++i) s += double(in[i]);
+  return s;
+}
+
+float reduce_max(const float* in, int64_t n, Workspace&) {
+  float m = -std::numeric_limits<float>::infinity();
+#pragma omp parallel for reduction(max : m) schedule(static) if (n > 65536)
+  for (int64_t i = 0; i < n; ++i) m = std::max(m, in[i]);
+  return m;
+}
+
+float reduce_min(const float* in, int64_t n, Workspace&) {
+  float m = std::numeric_limits<float>::infinity();
+#pragma omp parallel for reduction(min : m) schedule(static) if (n > 65536)
+  for (int64_t i = 0; i < n; ++i) m = std::min(m, in[i]);
+  return m;
+}
+
+int64_t count_nonfinite(const float* in, int64_t n, Workspace&) {
+  int64_t c = 0;
+#pragma omp parallel for reduction(+ : c) schedule(static) if (n > 65536)
+  for (int64_t i = 0; i < n; ++i) c += std::isfinite(in[i]) ? 0 : 1;
+  return c;
+}
+
+}  // namespace wb::cpu

@@ -1,0 +1,102 @@
+// CUDA implementations of the device-wide primitives, on CUB with scratch from the
+// caller's Workspace (no allocation once warm). Results come back with one sync.
+#include <cub/device/device_radix_sort.cuh>
+#include <cub/device/device_reduce.cuh>
+#include <cub/device/device_scan.cuh>
+#include <thrust/iterator/transform_iterator.h>
+
+#include <cuda/std/limits>
+
+#include "core/exec/algorithms.h"
+#include "core/exec/cuda_check.h"
+#include "core/exec/stream.h"
+
+namespace wb::cuda {
+namespace {
+
+struct ToDouble {
+  __host__ __device__ double operator()(float v) const { return double(v); }
+};
+struct NonFinite {
+  __host__ __device__ long long operator()(float v) const { return isfinite(v) ? 0 : 1; }
+};
+struct MaxOp {
+  __host__ __device__ float operator()(float a, float b) const { return a > b ? a : b; }
+};
+struct MinOp {
+  __host__ __device__ float operator()(float a, float b) const { return a < b ? a : b; }
+};
+
+// Layout of the workspace: [result slot 256 B][CUB temp storage][extra].
+template <typename T>
+T fetch_result(void* slot) {
+  T host{};
+  WB_CUDA_CHECK(cudaMemcpyAsync(&host, slot, sizeof(T), cudaMemcpyDeviceToHost, wb::cuda_stream()));
+  WB_CUDA_CHECK(cudaStreamSynchronize(wb::cuda_stream()));
+  return host;
+}
+
+template <typename InputIt, typename T, typename Op>
+T reduce(InputIt in, int64_t n, Op op, T init, Workspace& ws) {
+  size_t temp = 0;
+  WB_CUDA_CHECK(cub::DeviceReduce::Reduce(nullptr, temp, in, static_cast<T*>(nullptr), n, op, init, wb::cuda_stream()));
+  auto* base = static_cast<unsigned char*>(ws.get(256 + temp));
+  T* out = reinterpret_cast<T*>(base);
+  WB_CUDA_CHECK(cub::DeviceReduce::Reduce(base + 256, temp, in, out, n, op, init, wb::cuda_stream()));
+  return fetch_result<T>(out);
+}
+
+}  // namespace
+
+void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Workspace& ws) {
+  if (n <= 1) return;
+  const int end_bit = key_bits < 1 ? 1 : (key_bits > 32 ? 32 : key_bits);
+  const size_t pair_bytes = size_t(n) * sizeof(uint32_t);
+  const size_t aligned = (pair_bytes + 255) & ~size_t(255);
+  size_t temp = 0;
+  cub::DoubleBuffer<uint32_t> k(keys, nullptr), v(values, nullptr);
+  WB_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, temp, k, v, n, 0, end_bit, wb::cuda_stream()));
+  auto* base = static_cast<unsigned char*>(ws.get(2 * aligned + temp));
+  k = cub::DoubleBuffer<uint32_t>(keys, reinterpret_cast<uint32_t*>(base));
+  v = cub::DoubleBuffer<uint32_t>(values, reinterpret_cast<uint32_t*>(base + aligned));
+  WB_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(base + 2 * aligned, temp, k, v, n, 0, end_bit, wb::cuda_stream()));
+  if (k.Current() != keys) {
+    WB_CUDA_CHECK(cudaMemcpyAsync(keys, k.Current(), pair_bytes, cudaMemcpyDeviceToDevice, wb::cuda_stream()));
+    WB_CUDA_CHECK(cudaMemcpyAsync(values, v.Current(), pair_bytes, cudaMemcpyDeviceToDevice, wb::cuda_stream()));
+  }
+}
+
+uint32_t exclusive_scan(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws) {
+  if (n <= 0) return 0;
+  // The last input is read before the scan so that out may alias in.
+  uint32_t last_in = 0;
+  WB_CUDA_CHECK(cudaMemcpyAsync(&last_in, in + n - 1, sizeof(uint32_t), cudaMemcpyDeviceToHost, wb::cuda_stream()));
+  size_t temp = 0;
+  WB_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, temp, in, out, n, wb::cuda_stream()));
+  void* base = ws.get(temp);
+  WB_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(base, temp, in, out, n, wb::cuda_stream()));
+  uint32_t last_out = 0;
+  WB_CUDA_CHECK(cudaMemcpyAsync(&last_out, out + n - 1, sizeof(uint32_t), cudaMemcpyDeviceToHost, wb::cuda_stream()));
+  WB_CUDA_CHECK(cudaStreamSynchronize(wb::cuda_stream()));
+  return last_out + last_in;
+}
+
+double reduce_sum(const float* in, int64_t n, Workspace& ws) {
+  if (n <= 0) return 0.0;
+  return reduce(thrust::make_transform_iterator(in, ToDouble{}), n, ::cuda::std::plus<double>{}, 0.0, ws);
+}
+
+float reduce_max(const float* in, int64_t n, Workspace& ws) {
+  return reduce(in, n, MaxOp{}, -::cuda::std::numeric_limits<float>::infinity(), ws);
+}
+
+float reduce_min(const float* in, int64_t n, Workspace& ws) {
+  return reduce(in, n, MinOp{}, ::cuda::std::numeric_limits<float>::infinity(), ws);
+}
+
+int64_t count_nonfinite(const float* in, int64_t n, Workspace& ws) {
+  if (n <= 0) return 0;
+  return reduce(thrust::make_transform_iterator(in, NonFinite{}), n, ::cuda::std::plus<long long>{}, 0LL, ws);
+}
+
+}  // namespace wb::cuda

@@ -1,0 +1,89 @@
+// Float and integer atomics usable from WB_HD code on both backends. Used only where
+// the paper accumulates (rasterisation of particles and samples, transfer budgets).
+#pragma once
+#include <cstdint>
+
+#include "core/exec/hd.h"
+#if !defined(__CUDA_ARCH__)
+#include <atomic>
+#endif
+
+namespace wb {
+
+WB_HD WB_INLINE float atomic_add(float* addr, float v) {
+#if defined(__CUDA_ARCH__)
+  return atomicAdd(addr, v);
+#else
+  return std::atomic_ref<float>(*addr).fetch_add(v, std::memory_order_relaxed);
+#endif
+}
+
+WB_HD WB_INLINE int32_t atomic_add(int32_t* addr, int32_t v) {
+#if defined(__CUDA_ARCH__)
+  return atomicAdd(reinterpret_cast<int*>(addr), v);
+#else
+  return std::atomic_ref<int32_t>(*addr).fetch_add(v, std::memory_order_relaxed);
+#endif
+}
+
+WB_HD WB_INLINE uint32_t atomic_add(uint32_t* addr, uint32_t v) {
+#if defined(__CUDA_ARCH__)
+  return atomicAdd(reinterpret_cast<unsigned*>(addr), v);
+#else
+  return std::atomic_ref<uint32_t>(*addr).fetch_add(v, std::memory_order_relaxed);
+#endif
+}
+
+WB_HD WB_INLINE int32_t atomic_max(int32_t* addr, int32_t v) {
+#if defined(__CUDA_ARCH__)
+  return atomicMax(reinterpret_cast<int*>(addr), v);
+#else
+  std::atomic_ref<int32_t> a(*addr);
+  int32_t cur = a.load(std::memory_order_relaxed);
+  while (cur < v && !a.compare_exchange_weak(cur, v, std::memory_order_relaxed)) {
+  }
+  return cur;
+#endif
+}
+
+WB_HD WB_INLINE int32_t atomic_min(int32_t* addr, int32_t v) {
+#if defined(__CUDA_ARCH__)
+  return atomicMin(reinterpret_cast<int*>(addr), v);
+#else
+  std::atomic_ref<int32_t> a(*addr);
+  int32_t cur = a.load(std::memory_order_relaxed);
+  while (cur > v && !a.compare_exchange_weak(cur, v, std::memory_order_relaxed)) {
+  }
+  return cur;
+#endif
+}
+
+/// Float max by compare-and-swap on the bit pattern (any sign).
+WB_HD WB_INLINE float atomic_max(float* addr, float v) {
+#if defined(__CUDA_ARCH__)
+  int* ia = reinterpret_cast<int*>(addr);
+  int old = *ia;
+  while (__int_as_float(old) < v) {
+    const int assumed = old;
+    old = atomicCAS(ia, assumed, __float_as_int(v));
+    if (old == assumed) break;
+  }
+  return __int_as_float(old);
+#else
+  std::atomic_ref<float> a(*addr);
+  float cur = a.load(std::memory_order_relaxed);
+  while (cur < v && !a.compare_exchange_weak(cur, v, std::memory_order_relaxed)) {
+  }
+  return cur;
+#endif
+}
+
+WB_HD WB_INLINE int32_t atomic_or(int32_t* addr, int32_t v) {
+#if defined(__CUDA_ARCH__)
+  return atomicOr(reinterpret_cast<int*>(addr), v);
+#else
+  return std::atomic_ref<int32_t>(*addr).fetch_or(v, std::memory_order_relaxed);
+#endif
+}
+
+}  // namespace wb

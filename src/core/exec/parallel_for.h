@@ -1,0 +1,53 @@
+// parallel_for(n, fn): the one loop construct of every stage driver. Under nvcc it is a
+// grid-stride kernel on the simulator's stream (checked after launch); under g++ an
+// OpenMP static loop, serial below a size where threading costs more than it saves.
+#pragma once
+#include <cstdint>
+
+#include "core/exec/hd.h"
+
+#if defined(__CUDACC__)
+#include "core/exec/cuda_check.h"
+#include "core/exec/stream.h"
+#endif
+
+namespace wb {
+
+/// Below this many elements the CPU backend runs serially.
+inline constexpr int64_t kMinParallelSize = 2048;
+
+#if defined(__CUDACC__)
+namespace detail {
+template <typename F>
+__global__ void parallel_for_kernel(int64_t n, F fn) {
+  const int64_t stride = int64_t(blockDim.x) * gridDim.x;
+  for (int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x; i < n; i += stride) fn(i);
+}
+}  // namespace detail
+#endif
+
+namespace WB_BACKEND_NS {
+
+template <typename F>
+void parallel_for(int64_t n, F fn) {
+  if (n <= 0) return;
+#if defined(__CUDACC__)
+  static_assert(__nv_is_extended_host_device_lambda_closure_type(F) || !__nv_is_extended_device_lambda_closure_type(F),
+                "parallel_for takes __host__ __device__ (WB_HD) lambdas or functors");
+  constexpr int kBlock = 256;
+  int64_t blocks = (n + kBlock - 1) / kBlock;
+  if (blocks > (int64_t(1) << 20)) blocks = int64_t(1) << 20;
+  detail::parallel_for_kernel<<<unsigned(blocks), kBlock, 0, ::wb::cuda_stream()>>>(n, fn);
+  WB_CUDA_CHECK_LAUNCH();
+#else
+  if (n < kMinParallelSize) {
+    for (int64_t i = 0; i < n; ++i) fn(i);
+    return;
+  }
+#pragma omp parallel for schedule(static)
+  for (int64_t i = 0; i < n; ++i) fn(i);
+#endif
+}
+
+}  // namespace WB_BACKEND_NS
+}  // namespace wb

@@ -1,0 +1,1 @@
+#include "core/exec/selftest_impl.h"

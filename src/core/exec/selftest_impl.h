@@ -1,0 +1,20 @@
+#pragma once
+#include "core/exec/atomics.h"
+#include "core/exec/parallel_for.h"
+#include "core/exec/selftest.h"
+
+namespace wb::WB_BACKEND_NS {
+
+void selftest_atomic_contention(float* acc4, int32_t* iacc2, int64_t n) {
+  parallel_for(n, [=] WB_HD(int64_t i) {
+    atomic_add(&acc4[i % 4], 1.0f);
+    atomic_add(&iacc2[0], int32_t(1));
+    atomic_max(&iacc2[1], int32_t(i));
+  });
+}
+
+void selftest_count_visits(int32_t* hits, int64_t n) {
+  parallel_for(n, [=] WB_HD(int64_t i) { hits[i] += 1; });
+}
+
+}  // namespace wb::WB_BACKEND_NS

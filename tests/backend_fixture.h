@@ -1,0 +1,27 @@
+// BackendTest: every kernel test runs on the device named by WB_DEVICE
+// (cpu by default; WB_DEVICE=cuda runs the same suite on the GPU).
+#pragma once
+#include <gtest/gtest.h>
+
+#include "core/exec/device.h"
+#include "core/exec/workspace.h"
+
+namespace wb::test {
+
+inline Device test_device() {
+  static const Device d = Device::from_env();
+  return d;
+}
+
+class BackendTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    device_ = test_device();
+    device_.activate();
+    ws_ = Workspace(device_);
+  }
+  Device device_;
+  Workspace ws_;
+};
+
+}  // namespace wb::test

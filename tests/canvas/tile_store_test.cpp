@@ -1,0 +1,136 @@
+// The sparse canvas: empty cost, gather/scatter round trips at any position,
+// windows over the canvas edges, unallocated tiles, memory growing with paint.
+#include <random>
+
+#include "backend_fixture.h"
+#include "core/canvas/tile_store.h"
+
+namespace wb::test {
+
+class TileStoreTest : public BackendTest {
+ protected:
+  // Random paint in a window: each value already on the unorm16 lattice so that a
+  // round trip must be bit-exact.
+  std::vector<std::vector<float>> random_fields(int64_t n, unsigned seed, float fill = 0.5f) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(0.f, 1.f);
+    std::vector<std::vector<float>> f(kPaintFieldCount, std::vector<float>(size_t(n), 0.f));
+    for (int64_t i = 0; i < n; ++i) {
+      if (u(rng) > fill) continue;
+      f[0][i] = u(rng) * 1.5f;
+      for (int k = 1; k < kPaintFieldCount; ++k) f[k][i] = decode_unorm16(encode_unorm16(u(rng)));
+    }
+    return f;
+  }
+};
+
+TEST_F(TileStoreTest, EmptyDefaultCanvasIsSmall) {
+  TileStore canvas(device_, CanvasDims{});
+  EXPECT_EQ(canvas.allocated_tiles(), 0);
+  EXPECT_LT(canvas.memory_bytes(), size_t(64) << 20);
+  EXPECT_EQ(canvas.total_density(ws_), 0.0);
+}
+
+TEST_F(TileStoreTest, GatherFromEmptyIsZero) {
+  TileStore canvas(device_, CanvasDims{512, 512, 64});
+  PaintWindow w(device_, Int3{64, 64, 32});
+  w.set_origin({100, 37, 0});
+  auto f = random_fields(w.cell_count(), 1, 1.f);
+  w.from_host(f);
+  canvas.gather(w);
+  for (auto& field : w.to_host())
+    for (float v : field) ASSERT_EQ(v, 0.f);
+}
+
+TEST_F(TileStoreTest, ScatterGatherRoundTripIsExact) {
+  TileStore canvas(device_, CanvasDims{512, 384, 48});
+  PaintWindow w(device_, Int3{40, 56, 20});
+  for (Int3 origin : {Int3{0, 0, 0}, Int3{123, 77, 5}, Int3{497, 370, 30}, Int3{-20, -33, -4}}) {
+    canvas.clear();
+    w.set_origin(origin);
+    auto f = random_fields(w.cell_count(), unsigned(origin.x + 1000));
+    w.from_host(f);
+    canvas.scatter(w);
+    PaintWindow back(device_, w.dims());
+    back.set_origin(origin);
+    canvas.gather(back);
+    auto g = back.to_host();
+    const Int3 n = w.dims();
+    for (int z = 0; z < n.z; ++z)
+      for (int y = 0; y < n.y; ++y)
+        for (int x = 0; x < n.x; ++x) {
+          const int cx = x + origin.x, cy = y + origin.y, cz = z + origin.z;
+          const bool inside = cx >= 0 && cy >= 0 && cz >= 0 && cx < 512 && cy < 384 && cz < 48;
+          const size_t i = (size_t(z) * n.y + y) * n.x + x;
+          for (int k = 0; k < kPaintFieldCount; ++k) {
+            // Fields without paint are not kept in unallocated tiles: compare where paint is.
+            const float expect = inside && f[0][i] != 0.f ? f[k][i] : 0.f;
+            ASSERT_EQ(g[k][i], expect) << "field " << k << " at " << cx << "," << cy << "," << cz;
+          }
+        }
+  }
+}
+
+TEST_F(TileStoreTest, MovingWindowKeepsMassExactly) {
+  TileStore canvas(device_, CanvasDims{1024, 1024, 32});
+  PaintWindow w(device_, Int3{64, 64, 32});
+  w.set_origin({300, 300, 0});
+  w.from_host(random_fields(w.cell_count(), 7, 0.3f));
+  const double m0 = w.total_density(ws_);
+  canvas.scatter(w);
+  EXPECT_DOUBLE_EQ(canvas.total_density(ws_), m0);
+  // Walk the window around, overlapping its old place, across the edge and back.
+  std::mt19937 rng(11);
+  for (int step = 0; step < 40; ++step) {
+    const Int3 o{int(rng() % 1100) - 40, int(rng() % 1100) - 40, 0};
+    w.set_origin(o);
+    canvas.gather(w);
+    canvas.scatter(w);
+  }
+  EXPECT_DOUBLE_EQ(canvas.total_density(ws_), m0);
+}
+
+TEST_F(TileStoreTest, MemoryGrowsWithPaintedArea) {
+  TileStore canvas(device_, CanvasDims{});
+  PaintWindow w(device_, Int3{32, 32, 8});
+  const size_t empty = canvas.memory_bytes();
+  std::vector<std::vector<float>> f(kPaintFieldCount, std::vector<float>(size_t(w.cell_count()), 0.f));
+  f[0][0] = 1.f;  // one painted cell allocates exactly one tile
+  w.from_host(f);
+  w.set_origin({16 * 5, 16 * 9, 0});
+  canvas.scatter(w);
+  EXPECT_EQ(canvas.allocated_tiles(), 1);
+  EXPECT_GT(canvas.memory_bytes(), empty);
+  EXPECT_FLOAT_EQ(canvas.read_cell(80, 144, 0).density, 1.f);
+  EXPECT_EQ(canvas.read_cell(81, 144, 0).density, 0.f);
+}
+
+TEST_F(TileStoreTest, DryAllSolidifiesPaintOnly) {
+  TileStore canvas(device_, CanvasDims{64, 64, 16});
+  PaintWindow w(device_, Int3{64, 64, 16});
+  auto f = random_fields(w.cell_count(), 5, 0.5f);
+  w.from_host(f);
+  canvas.scatter(w);
+  canvas.dry_all();
+  canvas.gather(w);
+  auto g = w.to_host();
+  for (size_t i = 0; i < g[0].size(); ++i) EXPECT_EQ(g[5][i], g[0][i] > 0.f ? 1.f : 0.f);
+}
+
+TEST_F(TileStoreTest, TileReadWriteRoundTrip) {
+  TileStore a(device_, CanvasDims{256, 256, 16}), b(device_, CanvasDims{256, 256, 16});
+  PaintWindow w(device_, Int3{100, 60, 16});
+  w.set_origin({30, 40, 0});
+  w.from_host(random_fields(w.cell_count(), 9));
+  a.scatter(w);
+  for (int id : a.allocated_tile_ids()) b.write_tile(a.read_tile(id));
+  EXPECT_EQ(a.allocated_tiles(), b.allocated_tiles());
+  EXPECT_DOUBLE_EQ(a.total_density(ws_), b.total_density(ws_));
+  PaintWindow wa(device_, Int3{256, 256, 16}), wb(device_, Int3{256, 256, 16});
+  a.gather(wa);
+  b.gather(wb);
+  EXPECT_EQ(wa.to_host(), wb.to_host());
+  EXPECT_THROW(b.write_tile(TileData{}), Error);
+}
+
+}  // namespace wb::test

@@ -1,0 +1,127 @@
+// The execution primitives on the backend under test: sort, scan, reductions,
+// atomics under contention, parallel_for coverage.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <random>
+
+#include "backend_fixture.h"
+#include "core/exec/algorithms.h"
+#include "core/exec/buffer.h"
+#include "core/exec/selftest.h"
+
+namespace wb::test {
+
+class AlgorithmsTest : public BackendTest {};
+
+TEST_F(AlgorithmsTest, SortByKeyMatchesStableSort) {
+  for (int64_t n : {0, 1, 7, 1000, 210000}) {
+    std::mt19937 rng(unsigned(n) + 1);
+    std::vector<uint32_t> keys(n), vals(n);
+    for (int64_t i = 0; i < n; ++i) {
+      keys[i] = rng() % 50000u;  // many duplicates, 16 key bits
+      vals[i] = uint32_t(i);
+    }
+    DeviceBuffer<uint32_t> dk(device_, n), dv(device_, n);
+    dk.copy_from_host(keys);
+    dv.copy_from_host(vals);
+    sort_by_key(device_, dk.data(), dv.data(), n, 16, ws_);
+    std::vector<uint32_t> idx(n);
+    std::iota(idx.begin(), idx.end(), 0u);
+    std::stable_sort(idx.begin(), idx.end(), [&](uint32_t a, uint32_t b) { return keys[a] < keys[b]; });
+    auto gk = dk.to_host(), gv = dv.to_host();
+    for (int64_t i = 0; i < n; ++i) {
+      ASSERT_EQ(gk[i], keys[idx[i]]) << "n=" << n << " i=" << i;
+      ASSERT_EQ(gv[i], idx[i]) << "stability, n=" << n << " i=" << i;
+    }
+  }
+}
+
+TEST_F(AlgorithmsTest, SortFullWidthKeys) {
+  const int64_t n = 5000;
+  std::mt19937 rng(3);
+  std::vector<uint32_t> keys(n), vals(n);
+  for (int64_t i = 0; i < n; ++i) keys[i] = rng(), vals[i] = uint32_t(i);
+  DeviceBuffer<uint32_t> dk(device_, n), dv(device_, n);
+  dk.copy_from_host(keys);
+  dv.copy_from_host(vals);
+  sort_by_key(device_, dk.data(), dv.data(), n, 32, ws_);
+  auto gk = dk.to_host(), gv = dv.to_host();
+  EXPECT_TRUE(std::is_sorted(gk.begin(), gk.end()));
+  for (int64_t i = 0; i < n; ++i) EXPECT_EQ(keys[gv[i]], gk[i]);
+}
+
+TEST_F(AlgorithmsTest, ExclusiveScanInPlaceAndTotal) {
+  for (int64_t n : {1, 5, 100000}) {
+    std::vector<uint32_t> in(n);
+    for (int64_t i = 0; i < n; ++i) in[i] = uint32_t(i % 7);
+    DeviceBuffer<uint32_t> d(device_, n);
+    d.copy_from_host(in);
+    const uint32_t total = exclusive_scan(device_, d.data(), d.data(), n, ws_);
+    auto out = d.to_host();
+    uint32_t run = 0;
+    for (int64_t i = 0; i < n; ++i) {
+      ASSERT_EQ(out[i], run);
+      run += in[i];
+    }
+    EXPECT_EQ(total, run);
+  }
+}
+
+TEST_F(AlgorithmsTest, ReductionsAndNonFinite) {
+  const int64_t n = 300001;
+  std::vector<float> v(n);
+  double expect = 0.0;
+  for (int64_t i = 0; i < n; ++i) {
+    v[i] = float((i * 37) % 1001) * 1e-3f - 0.5f;
+    expect += double(v[i]);
+  }
+  DeviceBuffer<float> d(device_, n);
+  d.copy_from_host(v);
+  EXPECT_NEAR(reduce_sum(device_, d.data(), n, ws_), expect, 1e-6 * n);
+  EXPECT_FLOAT_EQ(reduce_max(device_, d.data(), n, ws_), *std::max_element(v.begin(), v.end()));
+  EXPECT_FLOAT_EQ(reduce_min(device_, d.data(), n, ws_), *std::min_element(v.begin(), v.end()));
+  EXPECT_EQ(count_nonfinite(device_, d.data(), n, ws_), 0);
+  v[10] = std::numeric_limits<float>::quiet_NaN();
+  v[n - 1] = std::numeric_limits<float>::infinity();
+  d.copy_from_host(v);
+  EXPECT_EQ(count_nonfinite(device_, d.data(), n, ws_), 2);
+}
+
+TEST_F(AlgorithmsTest, FloatAtomicsUnderContention) {
+  // 1M increments onto 4 addresses: every one must land.
+  const int64_t n = 1 << 20;
+  DeviceBuffer<float> acc(device_, 4);
+  DeviceBuffer<int32_t> iacc(device_, 2);
+  acc.fill_zero();
+  iacc.fill_zero();
+  selftest_atomic_contention(device_, acc.data(), iacc.data(), n);
+  auto a = acc.to_host();
+  auto ia = iacc.to_host();
+  for (int k = 0; k < 4; ++k) EXPECT_FLOAT_EQ(a[k], float(n / 4));  // exact: integers below 2^24
+  EXPECT_EQ(ia[0], n);
+  EXPECT_EQ(ia[1], n - 1);  // atomic max of the indices
+}
+
+TEST_F(AlgorithmsTest, ParallelForVisitsEachIndexOnce) {
+  const int64_t n = 100003;
+  DeviceBuffer<int32_t> hits(device_, n);
+  hits.fill_zero();
+  selftest_count_visits(device_, hits.data(), n);
+  auto h = hits.to_host();
+  for (int64_t i = 0; i < n; ++i) ASSERT_EQ(h[i], 1) << i;
+}
+
+TEST(DeviceTest, ParseAndPrint) {
+  EXPECT_EQ(Device::parse("cpu").to_string(), "cpu");
+  EXPECT_TRUE(Device::parse("cpu") == Device(DeviceType::CPU));
+  EXPECT_THROW(Device::parse("gpu"), Error);
+  EXPECT_THROW(Device::parse("cuda:x"), Error);
+  if (cuda_device_count() == 0) EXPECT_THROW(Device::parse("cuda"), Error);
+  const Device a = Device::parse("auto");
+  EXPECT_EQ(a.is_cuda(), cuda_compiled() && cuda_device_count() > 0);
+  EXPECT_GE(list_devices().size(), 1u);
+}
+
+}  // namespace wb::test
