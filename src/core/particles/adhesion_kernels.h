@@ -1,0 +1,137 @@
+// Particle stage, per-particle physics (paper §4.3, Eq. 8-10): friction near the
+// solid surface, the two-step adhesion update (local sample frame, Eq. 9, and
+// canvas frame), and their blend by the distance to the bristles (Eq. 10).
+// Plain WB_HD functions of values: no allocation, no backend.
+#pragma once
+#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
+#include <cstdint>
+
+#include "core/brush/bristle_fields.h"
+#include "core/exec/hd.h"
+#include "core/math/vec.h"
+
+namespace wb {
+
+/// The solid the particles rest on: the canvas floor, optionally raised by a height map
+/// of dried paint over a window of columns (absolute z of the dried top, canvas cells).
+struct SolidView {
+  float floor_z = 0.f;
+  const float* height = nullptr;  ///< nx * ny columns, index j * nx + i; nullptr: floor only
+  int nx = 0, ny = 0;
+  int ox = 0, oy = 0;  ///< canvas cell of column (0, 0)
+};
+
+/// Height of the solid surface under p, canvas cells.
+WB_HD WB_INLINE float solid_surface_z(const SolidView& s, Vec3 p) {
+  float z = s.floor_z;
+  if (s.height) {
+    const int i = int(floorf(p.x)) - s.ox, j = int(floorf(p.y)) - s.oy;
+    if (i >= 0 && j >= 0 && i < s.nx && j < s.ny) z = maxf(z, s.height[int64_t(j) * s.nx + i]);
+  }
+  return z;
+}
+
+/// d_k of Eq. 8: distance from p to the solid surface below it (vertical: the solid is a
+/// height field), cells, >= 0.
+WB_HD WB_INLINE float solid_distance(const SolidView& s, Vec3 p) { return maxf(p.z - solid_surface_z(s, p), 0.f); }
+
+/// Eq. 8 weight w = max(1 - delta d, 0)^2. The paper prints max((1 - delta d)^2, 0), which is
+/// never clipped and would grow again beyond 1/delta; the range reading is the intended one.
+WB_HD WB_INLINE float friction_weight(float d, float delta) {
+  const float s = maxf(1.f - delta * d, 0.f);
+  return s * s;
+}
+
+/// Eq. 8: f = -max(1 - delta d, 0)^2 v, read as the velocity change of one step (so the
+/// acceleration is f / dt): at the surface the particle stops (no slip), beyond 1/delta it slips.
+WB_HD WB_INLINE Vec3 friction_accel(Vec3 v, float d, float delta, float dt) {
+  return v * (-friction_weight(d, delta) / dt);
+}
+
+/// Eq. 10 weight of the local-frame result: max(1 - d_B / D1, 0).
+WB_HD WB_INLINE float adhesion_weight(float d_B, float D1) { return D1 > 0.f ? maxf(1.f - d_B / D1, 0.f) : 0.f; }
+
+/// Eq. 10: p_new = p'' + max(1 - d_B/D1, 0) (p' - p'').
+WB_HD WB_INLINE Vec3 adhesion_blend(Vec3 p_local, Vec3 p_canvas, float d_B, float D1) {
+  return p_canvas + (p_local - p_canvas) * adhesion_weight(d_B, D1);
+}
+
+/// One bristle sample's frame and motion, canvas frame (see bristle_fields.h).
+struct SampleFrame {
+  Vec3 x, t, n, b, v, omega, a, alpha;
+};
+
+WB_HD WB_INLINE SampleFrame load_sample(const SampleView& s, int64_t j) {
+  return SampleFrame{s.x[j], s.t[j], s.n[j], s.b[j], s.v[j], s.omega[j], s.a[j], s.alpha[j]};
+}
+
+/// R v with R's rows t, n, b: canvas -> local coordinates.
+WB_HD WB_INLINE Vec3 to_local(Vec3 t, Vec3 n, Vec3 b, Vec3 v) { return Vec3(dot(t, v), dot(n, v), dot(b, v)); }
+/// R^T v: local -> canvas coordinates.
+WB_HD WB_INLINE Vec3 to_canvas(Vec3 t, Vec3 n, Vec3 b, Vec3 v) { return t * v.x + n * v.y + b * v.z; }
+
+/// The canvas-frame update without adhesion (symplectic Euler): p'' = p + dt (v + dt a_k).
+WB_HD WB_INLINE Vec3 canvas_frame_step(Vec3 p, Vec3 v, Vec3 a_k, float dt) { return p + (v + a_k * dt) * dt; }
+
+/// Eq. 9, the local-frame update; returns p' in the canvas frame.
+/// The sample holds its state at the end of the brush step (t + dt), with velocities from
+/// position differences (v = dx/dt, a = dv/dt, rotation over the step = omega dt, as
+/// position-based dynamics produces them). The frame at t is therefore x - v dt, axes
+/// rotated by -omega dt, velocity v - a dt, angular velocity omega - alpha dt. In it:
+///   p^l = R_L (p - x_j),  v^l = R_L (v_k - v_j - omega_j x (p - x_j)),
+///   dv^l/dt = R_L a_k - beta_L (R_L a_j + w x (w x p^l) + R_L alpha_j x p^l + 2 w x v^l),  w = R_L omega_j,
+/// integrated by symplectic Euler, and p^l mapped back with the frame at t + dt.
+/// With beta_L = 0 and a_k = 0 a particle moving with the sample stays rigidly attached.
+WB_HD WB_INLINE Vec3 local_frame_step(Vec3 p, Vec3 v, Vec3 a_k, const SampleFrame& s, float beta_L, float dt) {
+  // The frame at the start of the step.
+  const Vec3 x0 = s.x - s.v * dt;
+  const Vec3 v0 = s.v - s.a * dt;
+  const Vec3 w0 = s.omega - s.alpha * dt;
+  Vec3 t0 = s.t, n0 = s.n, b0 = s.b;
+  const float wl = length(s.omega);
+  if (wl * dt > 1e-7f) {
+    const Vec3 axis = s.omega / wl;
+    t0 = rotate_axis_angle(s.t, axis, -wl * dt);
+    n0 = rotate_axis_angle(s.n, axis, -wl * dt);
+    b0 = rotate_axis_angle(s.b, axis, -wl * dt);
+  }
+  const Vec3 r = p - x0;
+  Vec3 pl = to_local(t0, n0, b0, r);
+  Vec3 vl = to_local(t0, n0, b0, v - v0 - cross(w0, r));
+  const Vec3 W = to_local(t0, n0, b0, w0);
+  const Vec3 Wdot = to_local(t0, n0, b0, s.alpha);
+  const Vec3 A = to_local(t0, n0, b0, s.a);
+  const Vec3 inertial = A + cross(W, cross(W, pl)) + cross(Wdot, pl) + cross(W, vl) * 2.f;
+  const Vec3 acc = to_local(t0, n0, b0, a_k) - inertial * beta_L;
+  vl += acc * dt;
+  pl += vl * dt;
+  return s.x + to_canvas(s.t, s.n, s.b, pl);
+}
+
+/// One particle's two-step update (§4.3): external acceleration a_k = g + friction (Eq. 8);
+/// p' from the nearest sample's frame (Eq. 9, only when d_B < D1), p'' in the canvas frame;
+/// blend (Eq. 10); keep it above the solid; velocity corrected from the positions,
+/// v = (p_new - p) / dt. `sample` may be null when no sample is near.
+WB_HD WB_INLINE void adhesion_update(Vec3& p, Vec3& v, const SampleFrame* sample, float d_B, const SolidView& solid,
+                                     Vec3 gravity, float delta, float beta_L, float D1, float dt) {
+  const Vec3 a_k = gravity + friction_accel(v, solid_distance(solid, p), delta, dt);
+  const Vec3 p_canvas = canvas_frame_step(p, v, a_k, dt);
+  Vec3 p_new = p_canvas;
+  const float w = adhesion_weight(d_B, D1);
+  if (sample && w > 0.f) p_new = p_canvas + (local_frame_step(p, v, a_k, *sample, beta_L, dt) - p_canvas) * w;
+  // The particle cannot enter the solid; the projection only sees the solid on the grid.
+  const float zs = solid_surface_z(solid, p_new);
+  if (p_new.z < zs) p_new.z = zs;
+  v = (p_new - p) / dt;
+  p = p_new;
+}
+
+/// Fig. 8(a) baseline, not used by the simulator: adhesion as an explicit spring toward the
+/// nearest sample's position at the start of the step, a = a_ext + k (x_j - p), symplectic
+/// Euler. Stable only for k dt^2 < 4; it must be that stiff to hold a particle at speed.
+WB_HD WB_INLINE void spring_adhesion_step(Vec3& p, Vec3& v, Vec3 target, Vec3 a_ext, float k, float dt) {
+  v += (a_ext + (target - p) * k) * dt;
+  p += v * dt;
+}
+
+}  // namespace wb

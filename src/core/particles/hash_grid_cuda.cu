@@ -1,0 +1,1 @@
+#include "core/particles/hash_grid_impl.h"

@@ -1,0 +1,88 @@
+// Neighbour search between liquid particles and bristle samples (paper §4.3, §6: the
+// sorted hash list of Green 2010). Samples are hashed into a uniform grid of cells;
+// after a radix sort by bucket each bucket is a contiguous range [start, end). A
+// particle finds its nearest sample by visiting shells of cells outwards.
+#pragma once
+#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
+#include <cstdint>
+
+#include "core/exec/hd.h"
+#include "core/math/vec.h"
+
+namespace wb {
+
+/// The built grid, by value: sorted sample indices and positions, bucket ranges.
+struct HashGridView {
+  const uint32_t* cell_start;  ///< first sorted slot of each bucket (start == end: empty)
+  const uint32_t* cell_end;    ///< one past the last sorted slot of each bucket
+  const uint32_t* sorted_index;  ///< sample index of each sorted slot
+  const Vec3* sorted_x;        ///< sample position of each sorted slot (coherent reads)
+  int64_t count;               ///< number of samples
+  float h;                     ///< cell size, canvas cells
+  uint32_t mask;               ///< bucket count - 1 (a power of two)
+};
+
+/// Integer cell of p for cell size h.
+WB_HD WB_INLINE void hash_cell_of(Vec3 p, float inv_h, int& ix, int& iy, int& iz) {
+  ix = int(floorf(p.x * inv_h));
+  iy = int(floorf(p.y * inv_h));
+  iz = int(floorf(p.z * inv_h));
+}
+
+/// Bucket of cell (ix, iy, iz): the spatial hash of Teschner et al. 2003, masked. Distinct
+/// cells may share a bucket; queries then see extra samples, never miss one.
+WB_HD WB_INLINE uint32_t hash_bucket(int ix, int iy, int iz, uint32_t mask) {
+  return ((uint32_t(ix) * 73856093u) ^ (uint32_t(iy) * 19349663u) ^ (uint32_t(iz) * 83492791u)) & mask;
+}
+
+/// Result of a nearest-sample query.
+struct NearestSample {
+  int32_t index;  ///< sample index, -1 when none lies within the range
+  float dist;     ///< distance to it, or the range when none
+};
+
+/// Scans one bucket, keeping the nearest sample (ties: the lower sample index).
+WB_HD WB_INLINE void scan_bucket(const HashGridView& g, uint32_t bucket, Vec3 p, float& best_d2, int32_t& best) {
+  const uint32_t end = g.cell_end[bucket];
+  for (uint32_t s = g.cell_start[bucket]; s < end; ++s) {
+    const float d2 = length2(g.sorted_x[s] - p);
+    const int32_t idx = int32_t(g.sorted_index[s]);
+    if (d2 < best_d2 || (d2 == best_d2 && idx < best)) {
+      best_d2 = d2;
+      best = idx;
+    }
+  }
+}
+
+/// Nearest sample to p within max_range. Shells of cells at Chebyshev ring R = 0, 1, ...
+/// around p's cell are visited in order; after ring R every unvisited sample is farther
+/// than R h, so the search stops once the best distance is below R h, or R h >= max_range.
+WB_HD WB_INLINE NearestSample nearest_sample(const HashGridView& g, Vec3 p, float max_range) {
+  NearestSample out{-1, max_range};
+  if (g.count == 0) return out;
+  const float inv_h = 1.f / g.h;
+  int cx, cy, cz;
+  hash_cell_of(p, inv_h, cx, cy, cz);
+  float best_d2 = max_range * max_range;
+  int32_t best = -1;
+  // Cells of ring R hold points at distance <= max_range only while (R - 1) h < max_range.
+  const int r_max = int(ceilf(max_range * inv_h)) + 1;
+  for (int R = 0; R <= r_max; ++R) {
+    for (int dz = -R; dz <= R; ++dz)
+      for (int dy = -R; dy <= R; ++dy) {
+        const bool face = (dz == -R || dz == R || dy == -R || dy == R);
+        const int step = face ? 1 : 2 * R;  // inner rows: only the two end cells are on the shell
+        for (int dx = -R; dx <= R; dx += (step > 0 ? step : 1))
+          scan_bucket(g, hash_bucket(cx + dx, cy + dy, cz + dz, g.mask), p, best_d2, best);
+      }
+    const float reach = float(R) * g.h;
+    if ((best >= 0 && best_d2 < reach * reach) || reach >= max_range) break;
+  }
+  if (best >= 0 && best_d2 < max_range * max_range) {
+    out.index = best;
+    out.dist = sqrtf(best_d2);
+  }
+  return out;
+}
+
+}  // namespace wb

@@ -1,0 +1,42 @@
+// Liquid particles near the brush (paper §4.3, §5): the per-particle state, listed
+// once. The lists generate the owning buffers of ParticleStore, the POD view kernels
+// take, host copies and compaction. Units: 1 cell = 0.2 mm, time in s, mass in kg.
+#pragma once
+#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
+#include <cstdint>
+
+#include "core/math/vec.h"
+
+// X(type, name, description). State carried from step to step.
+#define WB_PARTICLE_STATE_FIELDS(X)                                          \
+  X(Vec3, x, "position, canvas cells")                                     \
+  X(Vec3, v, "velocity, cells/s, canvas frame")                            \
+  X(float, m, "mass, kg")                                                  \
+  X(float, pigment_r, "RYB pigment, red component in [0, 1]")              \
+  X(float, pigment_y, "RYB pigment, yellow component in [0, 1]")           \
+  X(float, pigment_b, "RYB pigment, blue component in [0, 1]")             \
+  X(float, oil, "oil density in [0, 1] (viscosity, transparency)")         \
+  X(float, dryness, "dryness in [0, 1]; solid at the drying threshold")
+
+// Per-step scratch, recomputed every step (never serialised).
+#define WB_PARTICLE_SCRATCH_FIELDS(X)                                                        \
+  X(int32_t, nearest, "index of the nearest bristle sample within the query range, -1: none") \
+  X(float, d_B, "distance to the nearest bristle sample, cells, capped at the query range")   \
+  X(uint32_t, key, "hash bucket of the particle's cell in the sample hash grid")             \
+  X(uint32_t, dead, "1: remove at the next compaction (absorbed, moved to the grid)")
+
+#define WB_PARTICLE_FIELDS(X) \
+  WB_PARTICLE_STATE_FIELDS(X) \
+  WB_PARTICLE_SCRATCH_FIELDS(X)
+
+namespace wb {
+
+/// POD view of all particles: device pointers plus the live count. Passed by value.
+struct ParticleView {
+#define WB_X(type, name, doc) type* name;
+  WB_PARTICLE_FIELDS(WB_X)
+#undef WB_X
+  int64_t count;
+};
+
+}  // namespace wb

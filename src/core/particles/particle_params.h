@@ -1,0 +1,34 @@
+// Parameters of the particle stage (paper §4.3 Eq. 8-11, Table 1). One POD, passed
+// by value to the stage drivers. Units: lengths in canvas cells (1 cell = 0.2 mm),
+// velocities in cells/s, time in s. Table 1 distances converted with that cell size.
+#pragma once
+#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
+#include <cstdint>
+
+#include "core/math/vec.h"
+
+namespace wb {
+
+struct ParticleParams {
+  /// Inertial weight of the local-frame update. Default 0.1, range [0, 0.2]. Table 1, Eq. 9.
+  float beta_L = 0.1f;
+  /// Adhesion range: blend weight max(1 - d_B/D1, 0). Default 15 cells (0.3 cm), range [0, 100]. Table 1, Eq. 10.
+  float D1 = 15.f;
+  /// Particle range around the bristles (grid <-> particle conversion, §5.2); also the cap of d_B.
+  /// Default 50 cells (1 cm), range [D1, 200]. Table 1.
+  float D0 = 50.f;
+  /// Friction range delta: friction vanishes beyond 1/delta. Default 0.1 / cell (1/0.2 cm), range [0.01, 1]. Table 1, Eq. 8.
+  float delta = 0.1f;
+  /// PIC weight of the velocity update (FLIP weight 1 - gamma). Default 0.8, range [0, 1]. Table 1, Eq. 11.
+  float gamma = 0.8f;
+  /// Gravity, cells/s^2, canvas frame (z up). Default 9.81 m/s^2 = 49050 cells/s^2 down, range |g| in [0, 49050]. Eq. 9.
+  Vec3 gravity = Vec3(0.f, 0.f, -49050.f);
+  /// Height of the canvas surface (solid floor), cells. Default 0. Eq. 8 (d_k).
+  float floor_z = 0.f;
+  /// Cell size of the sample hash grid, cells. Default 4, range [0.5, D1]. Green 2010, §6.
+  float hash_cell = 4.f;
+  /// Most particles the store may hold. Default 2M, range [1, 2^31). §7 ("as many as 2M particles").
+  int64_t max_particles = 2000000;
+};
+
+}  // namespace wb

@@ -1,0 +1,124 @@
+// Particle storage: growth, batch append, flag-and-compact removal (paper §4.3, §5).
+#include "core/particles/particle_store.h"
+
+#include <algorithm>
+#include <string>
+
+#include "core/exec/algorithms.h"
+#include "core/exec/error.h"
+#include "core/particles/particles.h"
+
+namespace wb {
+namespace {
+template <typename T>
+void compact_one(const Device& d, DeviceBuffer<T>& field, DeviceBuffer<Vec3>& scratch, const uint32_t* dead,
+                 const uint32_t* pos, int64_t n, int64_t kept) {
+  static_assert(sizeof(T) <= sizeof(Vec3), "the compaction scratch holds the widest field");
+  auto* tmp = reinterpret_cast<T*>(scratch.data());
+  particles_compact_field(d, field.data(), tmp, dead, pos, n);
+  mem::copy_on_device(d, field.data(), tmp, size_t(kept) * sizeof(T));
+}
+}  // namespace
+
+void ParticleHost::resize(size_t n) {
+#define WB_X(type, name, doc) name.resize(n);
+  WB_PARTICLE_STATE_FIELDS(WB_X)
+#undef WB_X
+}
+
+ParticleStore::ParticleStore(const Device& device, int64_t limit) : device_(device) {
+#define WB_X(type, name, doc) name.set_device(device);
+  WB_PARTICLE_FIELDS(WB_X)
+#undef WB_X
+  scan_.set_device(device);
+  scratch_.set_device(device);
+  set_limit(limit);
+}
+
+void ParticleStore::set_limit(int64_t limit) {
+  WB_REQUIRE(limit > 0 && limit < (int64_t(1) << 31),
+             "ParticleStore: the particle limit must lie in [1, 2^31), got " + std::to_string(limit));
+  WB_REQUIRE(limit >= count_, "ParticleStore: limit " + std::to_string(limit) + " is below the " +
+                                  std::to_string(count_) + " particles held");
+  limit_ = limit;
+}
+
+void ParticleStore::reserve(int64_t n) {
+  WB_REQUIRE(n >= 0, "ParticleStore::reserve: negative count");
+  WB_REQUIRE(n <= limit_, "ParticleStore: " + std::to_string(n) + " particles exceed the limit of " +
+                              std::to_string(limit_));
+  if (n <= capacity_) return;
+  // Doubling, so that a growing particle count costs O(log n) reallocations in all.
+  int64_t cap = std::max<int64_t>(capacity_, 1024);
+  while (cap < n) cap *= 2;
+  cap = std::min(cap, limit_);
+#define WB_X(type, name, doc) name.grow_keep(size_t(cap));
+  WB_PARTICLE_FIELDS(WB_X)
+#undef WB_X
+  capacity_ = cap;
+}
+
+int64_t ParticleStore::append_uninitialised(int64_t n) {
+  WB_REQUIRE(n >= 0, "ParticleStore::append: negative count");
+  const int64_t first = count_;
+  reserve(count_ + n);
+  count_ += n;
+  particles_init_scratch(device_, view(), first, n);
+  return first;
+}
+
+int64_t ParticleStore::append(const ParticleHost& b) {
+  const size_t n = b.size();
+#define WB_X(type, name, doc)                                                                                    \
+  WB_REQUIRE(b.name.size() == n, "ParticleStore::append: field '" #name "' has " + std::to_string(b.name.size()) + \
+                                     " entries, position has " + std::to_string(n));
+  WB_PARTICLE_STATE_FIELDS(WB_X)
+#undef WB_X
+  const int64_t first = append_uninitialised(int64_t(n));
+#define WB_X(type, name, doc) name.copy_range_from_host(b.name.data(), size_t(first), n);
+  WB_PARTICLE_STATE_FIELDS(WB_X)
+#undef WB_X
+  return first;
+}
+
+int64_t ParticleStore::compact(Workspace& ws) {
+  const int64_t n = count_;
+  if (n == 0) return 0;
+  if (scan_.size() < size_t(n)) scan_.grow_keep(size_t(n));
+  if (scratch_.size() < size_t(n)) scratch_.grow_keep(size_t(n));
+  particles_keep_flags(device_, dead.data(), scan_.data(), n);
+  const int64_t kept = int64_t(exclusive_scan(device_, scan_.data(), scan_.data(), n, ws));
+  if (kept == n) return 0;
+  // Every field goes through the one scratch buffer (sized for the widest field) and back,
+  // which needs a single spare array instead of a second copy of the whole store. The dead
+  // flags go last: the scatters read them.
+#define WB_X(type, name, doc) \
+  if (static_cast<const void*>(&name) != static_cast<const void*>(&dead)) compact_one(device_, name, scratch_, dead.data(), scan_.data(), n, kept);
+  WB_PARTICLE_FIELDS(WB_X)
+#undef WB_X
+  dead.fill_zero();
+  count_ = kept;
+  return n - kept;
+}
+
+ParticleView ParticleStore::view() {
+  ParticleView out;
+#define WB_X(type, name, doc) out.name = name.data();
+  WB_PARTICLE_FIELDS(WB_X)
+#undef WB_X
+  out.count = count_;
+  return out;
+}
+
+ParticleHost ParticleStore::to_host() const {
+  ParticleHost h;
+  h.resize(size_t(count_));
+#define WB_X(type, name, doc) name.copy_range_to_host(h.name.data(), 0, size_t(count_));
+  WB_PARTICLE_STATE_FIELDS(WB_X)
+#undef WB_X
+  return h;
+}
+
+double ParticleStore::total_mass(Workspace& ws) const { return reduce_sum(device_, m.data(), count_, ws); }
+
+}  // namespace wb

@@ -1,0 +1,70 @@
+// Particle stage (paper §4.3, Eq. 8-11; DESIGN steps 4, 5 and 7): the per-step drivers a
+// simulator step calls, in order:
+//   SampleHashGrid::build -> query_nearest -> particles_adhesion_step -> particles_rasterise
+//   -> (grid projection) -> particles_flip_pic.
+// Each validates its input and dispatches to wb::cpu or wb::cuda (particles_impl.h).
+#pragma once
+#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
+#include <cstdint>
+
+#include "core/brush/bristle_fields.h"
+#include "core/exec/device.h"
+#include "core/particles/adhesion_kernels.h"
+#include "core/particles/flip_kernels.h"
+#include "core/particles/mac_sample.h"
+#include "core/particles/particle_fields.h"
+#include "core/particles/particle_params.h"
+
+namespace wb {
+
+/// Two-step adhesion update of every particle (Eq. 8-10) over dt seconds. Needs the
+/// particles' nearest / d_B from SampleHashGrid::query_nearest with a range >= prm.D1 on
+/// the same samples. Positions and velocities are updated in place.
+void particles_adhesion_step(const Device& d, const ParticleView& p, const SampleView& s, const SolidView& solid,
+                             const ParticleParams& prm, float dt);
+/// Adds the particles' mass (cell centres) and momentum and mass weight (MAC faces) into g,
+/// trilinearly (flip_kernels.h). Particles outside the window are skipped.
+void particles_rasterise(const Device& d, const ParticleView& p, const ParticleRasterView& g);
+/// vel[c][f] = mom / weight on faces with weight > 0, else `empty` (e.g. 0).
+void particles_face_velocity(const Device& d, const ParticleRasterView& g, float* const vel[3], float empty);
+/// Eq. 11 for every particle: before = joint field u before projection, after = u_bar.
+void particles_flip_pic(const Device& d, const ParticleView& p, const MacView& before, const MacView& after,
+                        float gamma);
+
+/// Particles whose dead flag is clear; used by ParticleStore::compact.
+void particles_keep_flags(const Device& d, const uint32_t* dead, uint32_t* keep, int64_t n);
+/// dst[pos[i]] = src[i] for every i with !dead[i]; pos is the exclusive scan of the keep flags.
+void particles_compact_field(const Device& d, const float* src, float* dst, const uint32_t* dead, const uint32_t* pos,
+                             int64_t n);
+void particles_compact_field(const Device& d, const Vec3* src, Vec3* dst, const uint32_t* dead, const uint32_t* pos,
+                             int64_t n);
+void particles_compact_field(const Device& d, const int32_t* src, int32_t* dst, const uint32_t* dead,
+                             const uint32_t* pos, int64_t n);
+void particles_compact_field(const Device& d, const uint32_t* src, uint32_t* dst, const uint32_t* dead,
+                             const uint32_t* pos, int64_t n);
+/// Scratch of particles [first, first + n): nearest = -1, d_B = 0, key = 0, dead = 0.
+void particles_init_scratch(const Device& d, const ParticleView& p, int64_t first, int64_t n);
+
+#define WB_PARTICLES_BACKEND_DECLS                                                                                 \
+  void particles_adhesion_step(ParticleView p, SampleView s, SolidView solid, ParticleParams prm, float dt);      \
+  void particles_rasterise(ParticleView p, ParticleRasterView g);                                                \
+  void particles_face_velocity(ParticleRasterView g, float* u, float* v, float* w, float empty);                 \
+  void particles_flip_pic(ParticleView p, MacView before, MacView after, float gamma);                           \
+  void particles_keep_flags(const uint32_t* dead, uint32_t* keep, int64_t n);                                    \
+  void particles_compact_field(const float* src, float* dst, const uint32_t* dead, const uint32_t* pos, int64_t n); \
+  void particles_compact_field(const Vec3* src, Vec3* dst, const uint32_t* dead, const uint32_t* pos, int64_t n);   \
+  void particles_compact_field(const int32_t* src, int32_t* dst, const uint32_t* dead, const uint32_t* pos,         \
+                               int64_t n);                                                                         \
+  void particles_compact_field(const uint32_t* src, uint32_t* dst, const uint32_t* dead, const uint32_t* pos,       \
+                               int64_t n);                                                                         \
+  void particles_init_scratch(ParticleView p, int64_t first, int64_t n);
+
+namespace cpu {
+WB_PARTICLES_BACKEND_DECLS
+}  // namespace cpu
+namespace cuda {
+WB_PARTICLES_BACKEND_DECLS
+}  // namespace cuda
+#undef WB_PARTICLES_BACKEND_DECLS
+
+}  // namespace wb

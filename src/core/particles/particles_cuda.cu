@@ -1,0 +1,1 @@
+#include "core/particles/particles_impl.h"

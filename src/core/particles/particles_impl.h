@@ -1,0 +1,80 @@
+// Particle stage drivers (paper §4.3, Eq. 8-11), compiled once per backend: one
+// parallel_for per stage over the particles (or faces), physics in the *_kernels.h.
+#pragma once
+#include "core/exec/parallel_for.h"
+#include "core/particles/particles.h"
+
+namespace wb::WB_BACKEND_NS {
+
+void particles_adhesion_step(ParticleView p, SampleView s, SolidView solid, ParticleParams prm, float dt) {
+  const Vec3 g = prm.gravity;
+  const float delta = prm.delta, beta_L = prm.beta_L, D1 = prm.D1;
+  const int64_t n_samples = s.count();
+  parallel_for(p.count, [=] WB_HD(int64_t k) {
+    Vec3 x = p.x[k], v = p.v[k];
+    const int32_t j = p.nearest[k];
+    if (j >= 0 && j < n_samples) {
+      const SampleFrame f = load_sample(s, j);
+      adhesion_update(x, v, &f, p.d_B[k], solid, g, delta, beta_L, D1, dt);
+    } else {
+      adhesion_update(x, v, nullptr, p.d_B[k], solid, g, delta, beta_L, D1, dt);
+    }
+    p.x[k] = x;
+    p.v[k] = v;
+  });
+}
+
+void particles_rasterise(ParticleView p, ParticleRasterView g) {
+  parallel_for(p.count, [=] WB_HD(int64_t k) { rasterise_particle(g, p.x[k], p.v[k], p.m[k]); });
+}
+
+void particles_face_velocity(ParticleRasterView g, float* u, float* v, float* w, float empty) {
+  const int64_t nu = int64_t(g.nx + 1) * g.ny * g.nz, nv = int64_t(g.nx) * (g.ny + 1) * g.nz,
+                nw = int64_t(g.nx) * g.ny * (g.nz + 1);
+  parallel_for(nu, [=] WB_HD(int64_t f) { u[f] = face_velocity(g.mom[0][f], g.weight[0][f], empty); });
+  parallel_for(nv, [=] WB_HD(int64_t f) { v[f] = face_velocity(g.mom[1][f], g.weight[1][f], empty); });
+  parallel_for(nw, [=] WB_HD(int64_t f) { w[f] = face_velocity(g.mom[2][f], g.weight[2][f], empty); });
+}
+
+void particles_flip_pic(ParticleView p, MacView before, MacView after, float gamma) {
+  parallel_for(p.count, [=] WB_HD(int64_t k) {
+    const Vec3 x = p.x[k];
+    p.v[k] = flip_pic_velocity(p.v[k], before.sample(x), after.sample(x), gamma);
+  });
+}
+
+void particles_keep_flags(const uint32_t* dead, uint32_t* keep, int64_t n) {
+  parallel_for(n, [=] WB_HD(int64_t i) { keep[i] = dead[i] ? 0u : 1u; });
+}
+
+template <typename T>
+void compact_field(const T* src, T* dst, const uint32_t* dead, const uint32_t* pos, int64_t n) {
+  parallel_for(n, [=] WB_HD(int64_t i) {
+    if (!dead[i]) dst[pos[i]] = src[i];
+  });
+}
+void particles_compact_field(const float* src, float* dst, const uint32_t* dead, const uint32_t* pos, int64_t n) {
+  compact_field(src, dst, dead, pos, n);
+}
+void particles_compact_field(const Vec3* src, Vec3* dst, const uint32_t* dead, const uint32_t* pos, int64_t n) {
+  compact_field(src, dst, dead, pos, n);
+}
+void particles_compact_field(const int32_t* src, int32_t* dst, const uint32_t* dead, const uint32_t* pos, int64_t n) {
+  compact_field(src, dst, dead, pos, n);
+}
+void particles_compact_field(const uint32_t* src, uint32_t* dst, const uint32_t* dead, const uint32_t* pos,
+                             int64_t n) {
+  compact_field(src, dst, dead, pos, n);
+}
+
+void particles_init_scratch(ParticleView p, int64_t first, int64_t n) {
+  parallel_for(n, [=] WB_HD(int64_t i) {
+    const int64_t k = first + i;
+    p.nearest[k] = -1;
+    p.d_B[k] = 0.f;
+    p.key[k] = 0u;
+    p.dead[k] = 0u;
+  });
+}
+
+}  // namespace wb::WB_BACKEND_NS
