@@ -1,0 +1,87 @@
+#include "core/grid/active_window.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/exec/dispatch.h"
+#include "core/exec/profile.h"
+#include "core/grid/grid.h"
+
+namespace wb {
+
+namespace {
+void shift_dispatch(const Device& d, const float* src, float* dst, int ex, int ey, int ez, int dx, int dy, int dz) {
+  WB_DISPATCH(d, grid_shift_lattice(src, dst, ex, ey, ez, dx, dy, dz));
+}
+}  // namespace
+
+ActiveWindow::ActiveWindow(TileStore& canvas, Int3 dims, Int3 origin)
+    : canvas_(&canvas), paint_(canvas.device(), dims), ws_(canvas.device()) {
+  const GridDims d = grid_dims();
+  const size_t most = size_t(std::max({d.nu(), d.nv(), d.nw()}));
+  for (int c = 0; c < 3; ++c) {
+    vel_[c].set_device(device());
+    vel_[c].resize(most);  // equal capacities: the shift swaps buffers between components
+    vel_[c].resize(size_t(d.faces(c)));
+    vel_[c].fill_zero();
+  }
+  shift_tmp_.set_device(device());
+  shift_tmp_.resize(most);
+  paint_.set_origin(origin);
+  canvas_->gather(paint_);
+  gathered_mass_ = paint_.total_density(ws_);
+}
+
+void ActiveWindow::shift_faces(int c, int dx, int dy, int dz) {
+  const GridDims d = grid_dims();
+  int ex, ey, ez;
+  d.face_extent(c, ex, ey, ez);
+  shift_tmp_.resize(size_t(d.faces(c)));
+  shift_dispatch(device(), vel_[c].data(), shift_tmp_.data(), ex, ey, ez, dx, dy, dz);
+  vel_[c].swap(shift_tmp_);
+}
+
+void ActiveWindow::move_to(Int3 new_origin) {
+  const Int3 o = origin();
+  if (new_origin == o) return;
+  WB_PROFILE_SCOPE("grid.window_move");
+  canvas_->scatter(paint_);
+  for (int c = 0; c < 3; ++c) shift_faces(c, new_origin.x - o.x, new_origin.y - o.y, new_origin.z - o.z);
+  paint_.set_origin(new_origin);
+  canvas_->gather(paint_);
+  gathered_mass_ = paint_.total_density(ws_);
+}
+
+Int3 ActiveWindow::origin_for(Vec3 brush, int snap) const {
+  snap = std::max(snap, 1);
+  const Int3 n = dims();
+  auto snapped = [&](float centre, int extent) {
+    const float start = centre - 0.5f * float(extent);
+    return int(std::lround(start / float(snap))) * snap;
+  };
+  return Int3{snapped(brush.x, n.x), snapped(brush.y, n.y), origin().z};
+}
+
+bool ActiveWindow::recentre_on(Vec3 brush, int snap) {
+  const Int3 target = origin_for(brush, snap);
+  if (target == origin()) return false;
+  move_to(target);
+  return true;
+}
+
+void ActiveWindow::flush() {
+  WB_PROFILE_SCOPE("grid.window_flush");
+  canvas_->scatter(paint_);
+  gathered_mass_ = paint_.total_density(ws_);
+}
+
+void ActiveWindow::reload() {
+  canvas_->gather(paint_);
+  gathered_mass_ = paint_.total_density(ws_);
+}
+
+double ActiveWindow::total_mass(Workspace& ws) const {
+  return canvas_->total_density(ws) - gathered_mass_ + paint_.total_density(ws);
+}
+
+}  // namespace wb

@@ -1,0 +1,381 @@
+// Grid stage dispatcher and step (paper §4.2, Algorithm 1): validates, then runs the
+// backend drivers of grid_impl.h through WB_DISPATCH. The step reads like §4.2.
+#include "core/grid/grid.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/exec/algorithms.h"
+#include "core/exec/dispatch.h"
+#include "core/exec/memory.h"
+#include "core/exec/profile.h"
+#include "core/grid/project_kernels.h"
+
+namespace wb {
+
+namespace {
+// One wrapper per backend driver: the only place that switches on the device.
+void classify_d(const Device& d, GridView g, PaintWindowView pw, BristleField br, CanvasDims cd, float lt, float dt) {
+  WB_DISPATCH(d, grid_classify(g, pw, br, cd.width, cd.height, cd.depth, lt, dt));
+}
+void advect_paint_d(const Device& d, GridView g, const float* u, const float* v, const float* w, PaintWindowView s,
+                    PaintWindowView t, float dt) {
+  WB_DISPATCH(d, grid_advect_paint(g, u, v, w, s, t, dt));
+}
+void touched_d(const Device& d, const float* a, const float* b, const uint8_t* cls, float* out, int64_t n) {
+  WB_DISPATCH(d, grid_touched_density(a, b, cls, out, n));
+}
+void scale_touched_d(const Device& d, float* a, const float* b, const uint8_t* cls, float s, int64_t n) {
+  WB_DISPATCH(d, grid_scale_touched(a, b, cls, s, n));
+}
+void advect_vel_d(const Device& d, GridView g, const float* u, const float* v, const float* w, float dt) {
+  WB_DISPATCH(d, grid_advect_velocity(g, u, v, w, dt));
+}
+void gravity_d(const Device& d, GridView g, const float* oil, float* ph, float g_dt, float yield) {
+  WB_DISPATCH(d, grid_gravity(g, oil, ph, g_dt, yield));
+}
+void visc_d(const Device& d, GridView g, const float* oil, float* const cur[3], float* const old[3], float* const out[3],
+            float nt, float nn, float dt) {
+  WB_DISPATCH(d, grid_viscosity_sweep(g, oil, cur[0], cur[1], cur[2], old[0], old[1], old[2], out[0], out[1], out[2],
+                                      nt, nn, dt));
+}
+void rhs_d(const Device& d, GridView g, float* b) { WB_DISPATCH(d, grid_rhs(g, b)); }
+void jacobi_d(const Device& d, PoissonView s, const float* b, const float* x, float* out, float omega) {
+  WB_DISPATCH(d, poisson_jacobi(s, b, x, out, omega));
+}
+void residual_d(const Device& d, PoissonView s, const float* b, const float* x, float* r) {
+  WB_DISPATCH(d, poisson_residual(s, b, x, r));
+}
+void cheb_d(const Device& d, PoissonView s, const float* b, const float* x, const float* xp, float* out, float w) {
+  WB_DISPATCH(d, poisson_chebyshev(s, b, x, xp, out, w));
+}
+void fp_first_d(const Device& d, PoissonView s, const float* r, const float* y, float* out, float alpha) {
+  WB_DISPATCH(d, poisson_fixed_point_first(s, r, y, out, alpha));
+}
+void fp_second_d(const Device& d, PoissonView s, const float* r, const float* z, float* y, float* x) {
+  WB_DISPATCH(d, poisson_fixed_point_second(s, r, z, y, x));
+}
+void apply_all_d(const Device& d, PoissonView s, const float* x, float* out) {
+  WB_DISPATCH(d, poisson_apply_all(s, x, out));
+}
+void apply_pressure_d(const Device& d, GridView g, const float* p) { WB_DISPATCH(d, grid_apply_pressure(g, p)); }
+void extrapolate_d(const Device& d, GridView g) { WB_DISPATCH(d, grid_extrapolate(g)); }
+void dry_d(const Device& d, PaintWindowView pw, float amount) { WB_DISPATCH(d, grid_dry(pw, amount)); }
+void max_speed_d(const Device& d, GridView g, float* out) { WB_DISPATCH(d, grid_max_abs_fluid_velocity(g, out)); }
+void square_d(const Device& d, const float* x, float* out, int64_t n) { WB_DISPATCH(d, grid_square(x, out, n)); }
+void scale_d(const Device& d, float* x, float s, int64_t n) { WB_DISPATCH(d, grid_scale(x, s, n)); }
+void hash_d(const Device& d, float* x, const uint8_t* cls, int64_t n, uint32_t seed) {
+  WB_DISPATCH(d, grid_fill_hash(x, cls, n, seed));
+}
+
+void check_params(const GridParams& p) {
+  WB_REQUIRE(p.dt > 0.f && p.dt <= 0.1f, "grid: dt must be in (0, 0.1] s");
+  WB_REQUIRE(p.jacobi_L >= 0 && p.jacobi_L <= 1000, "grid: jacobi_L must be in [0, 1000]");
+  WB_REQUIRE(p.alpha >= 0.f && p.alpha <= 1.f, "grid: alpha must be in [0, 1]");
+  WB_REQUIRE(p.solver_sweeps >= 0 && p.solver_sweeps <= 10000, "grid: solver_sweeps must be in [0, 10000]");
+  WB_REQUIRE(p.jacobi_omega > 0.f && p.jacobi_omega <= 1.f, "grid: jacobi_omega must be in (0, 1]");
+  WB_REQUIRE(p.chebyshev_rho >= 0.f && p.chebyshev_rho < 1.f, "grid: chebyshev_rho must be in [0, 1)");
+  WB_REQUIRE(p.chebyshev_power_iterations >= 1 && p.chebyshev_power_iterations <= 1000,
+             "grid: chebyshev_power_iterations must be in [1, 1000]");
+  WB_REQUIRE(p.nu_thick >= 0.f && p.nu_thin >= 0.f && p.nu_thick <= 1e7f && p.nu_thin <= 1e7f,
+             "grid: viscosities must be in [0, 1e7] cells^2/s");
+  WB_REQUIRE(p.viscosity_iterations >= 0 && p.viscosity_iterations <= 100,
+             "grid: viscosity_iterations must be in [0, 100]");
+  WB_REQUIRE(p.gravity >= 0.f && p.gravity <= 1e6f, "grid: gravity must be in [0, 1e6] cells/s^2");
+  WB_REQUIRE(p.yield_height >= 0.f && p.yield_height <= 1e4f, "grid: yield_height must be in [0, 1e4] cells");
+  WB_REQUIRE(p.liquid_threshold > 0.f && p.liquid_threshold <= 1.f, "grid: liquid_threshold must be in (0, 1]");
+  WB_REQUIRE(p.dry_rate >= 0.f && p.dry_rate <= 1000.f, "grid: dry_rate must be in [0, 1000] /s");
+  WB_REQUIRE(p.dry_threshold > 0.f && p.dry_threshold <= 1.f, "grid: dry_threshold must be in (0, 1]");
+  WB_REQUIRE(p.window_snap >= 1 && p.window_snap <= 64, "grid: window_snap must be in [1, 64]");
+}
+}  // namespace
+
+void SolverScratch::reserve(const Device& d, int64_t cells) {
+  for (auto* b : {&y, &z, &r, &prev, &tmp}) {
+    b->set_device(d);
+    b->resize(size_t(cells));
+  }
+}
+
+void poisson_apply(const Device& device, PoissonView s, const float* x, float* out) { apply_all_d(device, s, x, out); }
+
+double norm2(const Device& device, const float* v, int64_t n, SolverScratch& scratch, Workspace& ws) {
+  scratch.tmp.resize(size_t(n));
+  square_d(device, v, scratch.tmp.data(), n);
+  return std::sqrt(std::max(0.0, reduce_sum(device, scratch.tmp.data(), n, ws)));
+}
+
+void solve_pressure(const Device& device, PoissonView s, const float* b, float* x, const SolverConfig& cfg,
+                    SolverScratch& sc, const std::function<void(int, const float*)>& observe) {
+  const int64_t n = s.d.cells();
+  WB_REQUIRE(cfg.sweeps >= 0, "solve_pressure: negative sweep count");
+  sc.reserve(device, n);
+  mem::fill_zero(device, x, size_t(n) * sizeof(float));
+  switch (cfg.kind) {
+    case PressureSolver::FixedPoint: {
+      // Algorithm 1 in pressure space (Eq. 3): r = b - A x is minus the divergence of the
+      // already-corrected velocity; two Jacobi sweeps from alpha * y give the next correction y.
+      sc.y.fill_zero();
+      const int L = cfg.sweeps / 2;
+      for (int l = 0; l < L; ++l) {
+        residual_d(device, s, b, x, sc.r.data());
+        fp_first_d(device, s, sc.r.data(), sc.y.data(), sc.z.data(), cfg.alpha);
+        fp_second_d(device, s, sc.r.data(), sc.z.data(), sc.y.data(), x);
+        if (observe) observe(2 * (l + 1), x);
+      }
+      break;
+    }
+    case PressureSolver::Jacobi:
+    case PressureSolver::WeightedJacobi: {
+      const float omega = cfg.kind == PressureSolver::Jacobi ? 1.f : cfg.omega;
+      float* cur = x;
+      float* nxt = sc.y.data();
+      for (int k = 0; k < cfg.sweeps; ++k) {
+        jacobi_d(device, s, b, cur, nxt, omega);
+        std::swap(cur, nxt);
+        if (observe) observe(k + 1, cur);
+      }
+      if (cur != x) mem::copy_on_device(device, x, cur, size_t(n) * sizeof(float));
+      break;
+    }
+    case PressureSolver::Chebyshev: {
+      WB_REQUIRE(cfg.rho > 0.f && cfg.rho < 1.f, "solve_pressure: Chebyshev needs rho in (0, 1)");
+      // x^{k+1} = omega_{k+1} (J x^k - x^{k-1}) + x^{k-1}  (Eq. 6 in iterate form).
+      float* prev = sc.prev.data();
+      float* cur = x;
+      float* nxt = sc.y.data();
+      sc.prev.fill_zero();
+      float omega = 1.f;
+      for (int k = 0; k < cfg.sweeps; ++k) {
+        omega = chebyshev_omega(k, cfg.rho, omega);
+        cheb_d(device, s, b, cur, prev, nxt, omega);
+        float* old_prev = prev;
+        prev = cur;
+        cur = nxt;
+        nxt = old_prev;
+        if (observe) observe(k + 1, cur);
+      }
+      if (cur != x) mem::copy_on_device(device, x, cur, size_t(n) * sizeof(float));
+      break;
+    }
+  }
+}
+
+float estimate_jacobi_rho(const Device& device, PoissonView s, int iters, SolverScratch& sc, Workspace& ws) {
+  const int64_t n = s.d.cells();
+  sc.reserve(device, n);
+  hash_d(device, sc.y.data(), s.cls, n, 12345u);
+  sc.r.fill_zero();  // b = 0: each sweep applies D^-1 R
+  double nrm = norm2(device, sc.y.data(), n, sc, ws);
+  if (nrm <= 0.0) return 0.f;
+  float* cur = sc.y.data();
+  float* nxt = sc.z.data();
+  double ratio = 0.0;
+  for (int k = 0; k < iters; ++k) {
+    scale_d(device, cur, float(1.0 / nrm), n);
+    jacobi_d(device, s, sc.r.data(), cur, nxt, 1.f);
+    std::swap(cur, nxt);
+    nrm = norm2(device, cur, n, sc, ws);
+    if (nrm <= 0.0) return 0.f;
+    ratio = nrm;
+  }
+  return float(std::min(ratio, 0.9999));
+}
+
+Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
+    : params_(params), window_(canvas, dims, origin), ws_(canvas.device()) {
+  check_params(params_);
+  const Device& d = device();
+  const GridDims g = window_.grid_dims();
+  for (int c = 0; c < 3; ++c) {
+    for (auto* b : {&theta_[c], &solid_vel_[c], &vel_pre_[c], &vel_tmp_[c]}) {
+      b->set_device(d);
+      b->resize(size_t(g.faces(c)));
+      b->fill_zero();
+    }
+  }
+  cls_.set_device(d);
+  cls_.resize(size_t(g.cells()));
+  cls_.fill_zero();
+  for (auto* b : {&pressure_, &rhs_, &cell_tmp_}) {
+    b->set_device(d);
+    b->resize(size_t(g.cells()));
+    b->fill_zero();
+  }
+  face_tmp_.set_device(d);
+  face_tmp_.resize(size_t(g.nu() + g.nv() + g.nw()));
+  paint_tmp_ = PaintWindow(d, dims);
+  scratch_.reserve(d, g.cells());
+  classify();
+}
+
+GridView Grid::view() {
+  GridView v{};
+  v.d = window_.grid_dims();
+  for (int c = 0; c < 3; ++c) {
+    v.vel[c] = window_.velocity(c).data();
+    v.theta[c] = theta_[c].data();
+    v.solid_vel[c] = solid_vel_[c].data();
+  }
+  v.cls = cls_.data();
+  v.pressure = pressure_.data();
+  return v;
+}
+
+bool Grid::move_window(Int3 new_origin) {
+  WB_PROFILE_SCOPE("grid.move_window");
+  const bool moved = !(new_origin == window_.origin());
+  window_.move_to(new_origin);
+  stats_.window_moved = moved;
+  return moved;
+}
+
+bool Grid::recentre_on(Vec3 brush) { return move_window(window_.origin_for(brush, params_.window_snap)); }
+
+void Grid::classify() {
+  WB_PROFILE_SCOPE("grid.classify");
+  classify_d(device(), view(), window_.paint().view(), bristles_, window_.canvas().dims(), params_.liquid_threshold,
+             params_.dry_threshold);
+}
+
+void Grid::advect(float dt) {
+  WB_PROFILE_SCOPE("grid.advect");
+  WB_REQUIRE(dt > 0.f && std::isfinite(dt), "Grid::advect: dt must be positive");
+  const Device& d = device();
+  const GridDims g = dims();
+  const int64_t n = g.cells();
+  PaintWindow& paint = window_.paint();
+  paint_tmp_.set_origin(paint.origin());
+  GridView v = view();
+  // Paint fields: departure points in the velocity of the last step, into the scratch window.
+  advect_paint_d(d, v, v.vel[0], v.vel[1], v.vel[2], paint.view(), paint_tmp_.view(), dt);
+  double before = 0, after = 0;
+  if (params_.track_mass || params_.mass_correction) {
+    before = reduce_sum(d, paint.density.data(), n, ws_);
+    after = reduce_sum(d, paint_tmp_.density.data(), n, ws_);
+  }
+  stats_.advect_change = after - before;
+  stats_.advect_correction = 0;
+  if (params_.mass_correction && after != before) {
+    // Conservative and local: rescale density only in the cells advection changed, in proportion
+    // to their density (no smearing into empty cells, no change to untouched paint).
+    touched_d(d, paint_tmp_.density.data(), paint.density.data(), v.cls, cell_tmp_.data(), n);
+    const double touched = reduce_sum(d, cell_tmp_.data(), n, ws_);
+    if (touched > 1e-9) {
+      const double scale = std::clamp(1.0 + (before - after) / touched, 0.5, 2.0);
+      scale_touched_d(d, paint_tmp_.density.data(), paint.density.data(), v.cls, float(scale), n);
+      stats_.advect_correction = (scale - 1.0) * touched;
+    }
+  }
+#define WB_X(name, doc) paint.name.swap(paint_tmp_.name);
+  WB_PAINT_FIELDS(WB_X)
+#undef WB_X
+  // Velocity: backtrace every open face through a copy of the field.
+  for (int c = 0; c < 3; ++c)
+    mem::copy_on_device(d, vel_tmp_[c].data(), v.vel[c], size_t(g.faces(c)) * sizeof(float));
+  v = view();
+  advect_vel_d(d, v, vel_tmp_[0].data(), vel_tmp_[1].data(), vel_tmp_[2].data(), dt);
+}
+
+void Grid::add_external_forces(float dt) {
+  WB_PROFILE_SCOPE("grid.forces");
+  if (params_.gravity <= 0.f) return;
+  gravity_d(device(), view(), window_.paint().oil.data(), cell_tmp_.data(), params_.gravity * dt,
+            params_.yield_height);
+}
+
+void Grid::apply_viscosity(float dt) {
+  WB_PROFILE_SCOPE("grid.viscosity");
+  if (params_.viscosity_iterations <= 0 || (params_.nu_thick <= 0.f && params_.nu_thin <= 0.f)) return;
+  const Device& d = device();
+  const GridDims g = dims();
+  GridView v = view();
+  // old = u before diffusion (kept in vel_pre_, overwritten again by project()); iterate
+  // between the window's velocity and vel_tmp_.
+  float* old[3];
+  float* a[3];
+  float* b[3];
+  for (int c = 0; c < 3; ++c) {
+    mem::copy_on_device(d, vel_pre_[c].data(), v.vel[c], size_t(g.faces(c)) * sizeof(float));
+    old[c] = vel_pre_[c].data();
+    a[c] = v.vel[c];
+    b[c] = vel_tmp_[c].data();
+  }
+  for (int it = 0; it < params_.viscosity_iterations; ++it) {
+    visc_d(d, v, window_.paint().oil.data(), a, old, b, params_.nu_thick, params_.nu_thin, dt);
+    std::swap(a[0], b[0]);
+    std::swap(a[1], b[1]);
+    std::swap(a[2], b[2]);
+  }
+  if (a[0] != v.vel[0])
+    for (int c = 0; c < 3; ++c) mem::copy_on_device(d, v.vel[c], a[c], size_t(g.faces(c)) * sizeof(float));
+}
+
+void Grid::compute_rhs() { rhs_d(device(), view(), rhs_.data()); }
+
+void Grid::project() {
+  WB_PROFILE_SCOPE("grid.project");
+  const Device& d = device();
+  const GridDims g = dims();
+  GridView v = view();
+  for (int c = 0; c < 3; ++c)
+    mem::copy_on_device(d, vel_pre_[c].data(), v.vel[c], size_t(g.faces(c)) * sizeof(float));
+  compute_rhs();
+  SolverConfig cfg;
+  cfg.kind = params_.solver;
+  cfg.alpha = params_.alpha;
+  cfg.omega = params_.jacobi_omega;
+  cfg.sweeps = params_.solver == PressureSolver::FixedPoint ? 2 * params_.jacobi_L : params_.solver_sweeps;
+  if (params_.solver == PressureSolver::Chebyshev) {
+    cfg.rho = params_.chebyshev_rho > 0.f
+                  ? params_.chebyshev_rho
+                  : estimate_jacobi_rho(d, v.poisson(), params_.chebyshev_power_iterations, scratch_, ws_);
+    if (!(cfg.rho > 0.f)) cfg.kind = PressureSolver::Jacobi;  // no liquid: plain sweeps on nothing
+    stats_.chebyshev_rho = cfg.rho;
+  }
+  solve_pressure(d, v.poisson(), rhs_.data(), pressure_.data(), cfg, scratch_);
+  if (params_.track_mass) {
+    stats_.rhs_norm = norm2(d, rhs_.data(), g.cells(), scratch_, ws_);
+    residual_d(d, v.poisson(), rhs_.data(), pressure_.data(), scratch_.r.data());
+    stats_.residual_norm = norm2(d, scratch_.r.data(), g.cells(), scratch_, ws_);
+  }
+  apply_pressure_d(d, v, pressure_.data());
+  extrapolate_d(d, v);
+}
+
+void Grid::dry(float dt) {
+  WB_PROFILE_SCOPE("grid.dry");
+  if (params_.dry_rate <= 0.f) return;
+  dry_d(device(), window_.paint().view(), params_.dry_rate * dt);
+}
+
+void Grid::step(float dt) {
+  WB_PROFILE_SCOPE("grid.step");
+  WB_REQUIRE(dt > 0.f && dt <= 0.1f, "Grid::step: dt must be in (0, 0.1] s");
+  check_params(params_);
+  classify();  // solids for the backtrace (dried paint is never moved)
+  advect(dt);
+  classify();  // liquid where the paint now is
+  add_external_forces(dt);
+  apply_viscosity(dt);
+  project();
+  dry(dt);
+  if (params_.track_mass) {
+    stats_.window_mass = window_.window_mass(ws_);
+    stats_.total_mass = window_.total_mass(ws_);
+    stats_.canvas_mass = stats_.total_mass - stats_.window_mass;
+  }
+}
+
+double Grid::divergence_norm() {
+  compute_rhs();
+  return norm2(device(), rhs_.data(), dims().cells(), scratch_, ws_);
+}
+
+float Grid::max_fluid_speed() {
+  max_speed_d(device(), view(), face_tmp_.data());
+  const GridDims g = dims();
+  return reduce_max(device(), face_tmp_.data(), g.nu() + g.nv() + g.nw(), ws_);
+}
+
+}  // namespace wb

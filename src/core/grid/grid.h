@@ -1,0 +1,160 @@
+// Grid-based liquid simulation (paper §4.2, Algorithm 1, Eq. 3-7; DESIGN steps 3 and 6).
+// Grid owns the active window (paint fields + MAC velocity, re-centred on the brush) and
+// runs the step as separate stages: move_window, advect, add_external_forces,
+// apply_viscosity, project, dry. Units: positions in window cells, velocity in cells/s,
+// dt in s. All buffers are sized once; no stage allocates.
+#pragma once
+#include <cstdint>
+#include <functional>
+
+#include "core/canvas/tile_store.h"
+#include "core/grid/active_window.h"
+#include "core/grid/grid_fields.h"
+#include "core/grid/grid_params.h"
+
+namespace wb {
+
+/// One step's books (mass in density-cells: sum of density; 1 = one full cell of paint).
+struct GridStats {
+  double canvas_mass = 0;       ///< canvas outside the window region (+ window region as last gathered)
+  double window_mass = 0;       ///< sum of density in the window after the step
+  double total_mass = 0;        ///< canvas + window without double counting (ActiveWindow::total_mass)
+  double advect_change = 0;     ///< window mass change made by semi-Lagrangian advection (before correction)
+  double advect_correction = 0; ///< mass the correction put back (0 when off)
+  double rhs_norm = 0;          ///< ||div||_2 over liquid cells before the projection
+  double residual_norm = 0;     ///< ||div||_2 over liquid cells after it
+  float chebyshev_rho = 0;      ///< rho used by the Chebyshev solver (estimated or given)
+  bool window_moved = false;
+};
+
+/// Which solver and how many sweeps, for solve_pressure().
+struct SolverConfig {
+  PressureSolver kind = PressureSolver::FixedPoint;
+  int sweeps = 6;       ///< Jacobi-type sweeps; the fixed-point method runs sweeps/2 iterations (L)
+  float alpha = 1.f;    ///< Algorithm 1
+  float omega = 0.8f;   ///< weighted Jacobi
+  float rho = 0.f;      ///< Chebyshev spectral-radius estimate (must be in (0,1) for Chebyshev)
+};
+
+/// Scratch of the solvers (sized to the cell count once).
+struct SolverScratch {
+  DeviceBuffer<float> y, z, r, prev, tmp;
+  void reserve(const Device& d, int64_t cells);
+};
+
+/// Solves A x = b approximately by cfg (x starts at 0). observe(sweeps_done, x) runs after each
+/// iteration when given (the solver study); it must not write x.
+void solve_pressure(const Device& device, PoissonView s, const float* b, float* x, const SolverConfig& cfg,
+                    SolverScratch& scratch, const std::function<void(int, const float*)>& observe = {});
+/// Spectral radius of D^-1 R on the liquid cells by power iteration (iters sweeps, b = 0).
+float estimate_jacobi_rho(const Device& device, PoissonView s, int iters, SolverScratch& scratch, Workspace& ws);
+/// ||v||_2 of a cell array, in double.
+double norm2(const Device& device, const float* v, int64_t n, SolverScratch& scratch, Workspace& ws);
+/// out = A x.
+void poisson_apply(const Device& device, PoissonView s, const float* x, float* out);
+
+class Grid {
+ public:
+  /// Gathers the window at `origin` (canvas cells; z is normally 0) from `canvas`.
+  Grid(TileStore& canvas, const GridParams& params = {}, Int3 dims = {128, 128, 32}, Int3 origin = {0, 0, 0});
+
+  GridParams& params() { return params_; }
+  const GridParams& params() const { return params_; }
+  ActiveWindow& window() { return window_; }
+  const Device& device() const { return window_.device(); }
+  GridDims dims() const { return window_.grid_dims(); }
+  GridView view();
+  PoissonView poisson() { return view().poisson(); }
+
+  /// Rasterised bristles for this step (cell-centred on the window; nullable = no brush).
+  /// The pointers must stay valid until the next call.
+  void set_bristles(const BristleField& b) { bristles_ = b; }
+
+  // --- stages (call in this order; step() does) ---
+  /// Window to `new_origin` (scatter, shift velocity, gather). Returns whether it moved.
+  bool move_window(Int3 new_origin);
+  /// Window centred on the brush (canvas cells), origin snapped to params().window_snap.
+  bool recentre_on(Vec3 brush_canvas_cells);
+  /// Cell classes and open face fractions from paint, dryness and bristles.
+  void classify();
+  /// Semi-Lagrangian advection (RK2 backtrace, trilinear) of the paint fields and the velocity.
+  void advect(float dt);
+  /// Gravity on faces touching liquid, hydrostatic part split off (docs/GRID.md).
+  void add_external_forces(float dt);
+  /// Implicit viscosity, nu from oil.
+  void apply_viscosity(float dt);
+  /// Keeps the pre-projection velocity, then projects with params().solver.
+  void project();
+  /// Dryness += dry_rate * dt in every cell holding paint.
+  void dry(float dt);
+  /// classify, advect, classify, add_external_forces, apply_viscosity, project, dry.
+  void step(float dt);
+
+  // --- for the particles (FLIP/PIC, Eq. 11) ---
+  /// MAC velocity before the last projection (component c = 0,1,2).
+  const DeviceBuffer<float>& velocity_before_projection(int c) const { return vel_pre_[c]; }
+  const DeviceBuffer<float>& pressure() const { return pressure_; }
+  /// Right-hand side b = -div of the last projection (liquid cells).
+  const DeviceBuffer<float>& rhs() const { return rhs_; }
+
+  // --- diagnostics ---
+  const GridStats& stats() const { return stats_; }
+  /// ||div||_2 of the current velocity over liquid cells (as the projection measures it).
+  double divergence_norm();
+  /// Largest |velocity| on faces touching liquid, cells/s.
+  float max_fluid_speed();
+  /// Recomputes the right-hand side b = -div u into rhs() (used by project and the study).
+  void compute_rhs();
+  Workspace& workspace() { return ws_; }
+  SolverScratch& solver_scratch() { return scratch_; }
+
+ private:
+  GridParams params_;
+  ActiveWindow window_;
+  BristleField bristles_{};
+  DeviceBuffer<float> theta_[3], solid_vel_[3], vel_pre_[3], vel_tmp_[3];
+  DeviceBuffer<uint8_t> cls_;
+  DeviceBuffer<float> pressure_, rhs_, cell_tmp_, face_tmp_;
+  PaintWindow paint_tmp_;
+  SolverScratch scratch_;
+  Workspace ws_;
+  GridStats stats_;
+};
+
+#define WB_GRID_BACKEND_DECLS                                                                                        \
+  void grid_classify(GridView g, PaintWindowView pw, BristleField br, int canvas_w, int canvas_h, int canvas_d,     \
+                     float liquid_threshold, float dry_threshold);                                                   \
+  void grid_advect_paint(GridView g, const float* u, const float* v, const float* w, PaintWindowView src,            \
+                         PaintWindowView dst, float dt);                                                             \
+  void grid_touched_density(const float* rho_new, const float* rho_old, const uint8_t* cls, float* out, int64_t n); \
+  void grid_scale_touched(float* rho_new, const float* rho_old, const uint8_t* cls, float scale, int64_t n);         \
+  void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt);                  \
+  void grid_gravity(GridView g, const float* oil, float* ph, float g_dt, float yield_height);                       \
+  void grid_viscosity_sweep(GridView g, const float* oil, const float* cur_u, const float* cur_v,                    \
+                            const float* cur_w, const float* old_u, const float* old_v, const float* old_w,         \
+                            float* out_u, float* out_v, float* out_w, float nu_thick, float nu_thin, float dt);     \
+  void grid_rhs(GridView g, float* b);                                                                               \
+  void poisson_jacobi(PoissonView s, const float* b, const float* x, float* out, float omega);                      \
+  void poisson_residual(PoissonView s, const float* b, const float* x, float* r);                                   \
+  void poisson_chebyshev(PoissonView s, const float* b, const float* x, const float* x_prev, float* out,            \
+                         float omega_k);                                                                             \
+  void poisson_fixed_point_first(PoissonView s, const float* r, const float* y, float* out, float alpha);           \
+  void poisson_fixed_point_second(PoissonView s, const float* r, const float* z, float* y_out, float* x);           \
+  void poisson_apply_all(PoissonView s, const float* x, float* out);                                                 \
+  void grid_apply_pressure(GridView g, const float* p);                                                              \
+  void grid_extrapolate(GridView g);                                                                                 \
+  void grid_dry(PaintWindowView pw, float amount);                                                                   \
+  void grid_shift_lattice(const float* src, float* dst, int ex, int ey, int ez, int dx, int dy, int dz);            \
+  void grid_max_abs_fluid_velocity(GridView g, float* out);                                                          \
+  void grid_square(const float* x, float* out, int64_t n);                                                          \
+  void grid_scale(float* x, float s, int64_t n);                                                                     \
+  void grid_fill_hash(float* x, const uint8_t* cls, int64_t n, uint32_t seed);
+
+namespace cpu {
+WB_GRID_BACKEND_DECLS
+}  // namespace cpu
+namespace cuda {
+WB_GRID_BACKEND_DECLS
+}  // namespace cuda
+
+}  // namespace wb

@@ -1,0 +1,2 @@
+// Grid stage drivers, CPU backend (OpenMP).
+#include "core/grid/grid_impl.h"

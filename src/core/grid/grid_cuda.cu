@@ -1,0 +1,2 @@
+// Grid stage drivers, CUDA backend.
+#include "core/grid/grid_impl.h"

@@ -1,0 +1,96 @@
+// Grid stage state (paper §4.2): the staggered (MAC) velocity on cell faces, cell
+// classes, open face fractions and the solid (bristle) face velocity, as POD views.
+// Units: positions in window cells (cell (i,j,k) spans [i,i+1) x [j,j+1) x [k,k+1)),
+// velocity in cells/s. The paint scalars live in PaintWindow (core/canvas/window.h).
+#pragma once
+#include <math.h>  // ::isfinite for core/math/vec.h under g++
+
+#include <cstdint>
+
+#include "core/canvas/window.h"
+#include "core/exec/hd.h"
+#include "core/math/vec.h"
+
+namespace wb {
+
+/// Cell classes of the projection.
+enum CellClass : uint8_t {
+  kCellAir = 0,     ///< p = 0 (free surface)
+  kCellLiquid = 1,  ///< unknown of the pressure system
+  kCellSolid = 2,   ///< dried paint, or off the canvas: never moved, closed faces
+};
+
+/// Rasterised bristles from the brush, cell-centred on the window grid (device pointers;
+/// psi == nullptr means no brush). psi is the bristle volume fraction (min(psi,1) is the
+/// solid fraction); vx, vy, vz the psi-weighted mean bristle velocity, cells/s.
+struct BristleField {
+  const float* psi = nullptr;
+  const float* vx = nullptr;
+  const float* vy = nullptr;
+  const float* vz = nullptr;
+};
+
+/// Index helpers of the MAC layout. u: (nx+1) x ny x nz, v: nx x (ny+1) x nz, w: nx x ny x (nz+1).
+struct GridDims {
+  int nx, ny, nz;
+  WB_HD int64_t cells() const { return int64_t(nx) * ny * nz; }
+  WB_HD int64_t nu() const { return int64_t(nx + 1) * ny * nz; }
+  WB_HD int64_t nv() const { return int64_t(nx) * (ny + 1) * nz; }
+  WB_HD int64_t nw() const { return int64_t(nx) * ny * (nz + 1); }
+  WB_HD int64_t cell(int i, int j, int k) const { return (int64_t(k) * ny + j) * nx + i; }
+  WB_HD int64_t uidx(int i, int j, int k) const { return (int64_t(k) * ny + j) * (nx + 1) + i; }
+  WB_HD int64_t vidx(int i, int j, int k) const { return (int64_t(k) * (ny + 1) + j) * nx + i; }
+  WB_HD int64_t widx(int i, int j, int k) const { return (int64_t(k) * ny + j) * nx + i; }
+  /// Face count and index of component c (0 = u, 1 = v, 2 = w).
+  WB_HD int64_t faces(int c) const { return c == 0 ? nu() : (c == 1 ? nv() : nw()); }
+  WB_HD int64_t fidx(int c, int i, int j, int k) const {
+    return c == 0 ? uidx(i, j, k) : (c == 1 ? vidx(i, j, k) : widx(i, j, k));
+  }
+  /// Face extent along each axis for component c.
+  WB_HD void face_extent(int c, int& ex, int& ey, int& ez) const {
+    ex = nx + (c == 0);
+    ey = ny + (c == 1);
+    ez = nz + (c == 2);
+  }
+  WB_HD void decompose_face(int c, int64_t f, int& i, int& j, int& k) const {
+    int ex, ey, ez;
+    face_extent(c, ex, ey, ez);
+    i = int(f % ex);
+    j = int((f / ex) % ey);
+    k = int(f / (int64_t(ex) * ey));
+  }
+  WB_HD void decompose_cell(int64_t c, int& i, int& j, int& k) const {
+    i = int(c % nx);
+    j = int((c / nx) % ny);
+    k = int(c / (int64_t(nx) * ny));
+  }
+};
+
+/// The pressure system A p = b on liquid cells (Batty et al. 2007 face fractions):
+/// (A p)_i = sum_f theta_f (p_i - p_nb(f)), p = 0 outside liquid, theta = open fraction.
+struct PoissonView {
+  GridDims d;
+  const uint8_t* cls;      ///< CellClass per cell
+  const float* theta[3];   ///< open face fractions per component (u, v, w)
+};
+
+/// Everything the grid kernels read and write, by value.
+struct GridView {
+  GridDims d;
+  float* vel[3];         ///< MAC velocity u, v, w (cells/s)
+  float* theta[3];       ///< open fraction of each face, 0 = closed (solid), 1 = open
+  float* solid_vel[3];   ///< velocity of the solid part of each face (bristles; 0 for dried paint)
+  uint8_t* cls;          ///< CellClass per cell
+  float* pressure;       ///< projected pressure (scaled so that u -= grad p), cells^2/s
+  WB_HD PoissonView poisson() const {
+    PoissonView p;
+    p.d = d;
+    p.cls = cls;
+    p.theta[0] = theta[0];
+    p.theta[1] = theta[1];
+    p.theta[2] = theta[2];
+    return p;
+  }
+};
+
+}  // namespace wb

@@ -1,0 +1,277 @@
+// Grid stage drivers (paper §4.2, Algorithm 1), compiled once per backend from this
+// source (grid_cpu.cpp, grid_cuda.cu). Each function is one or two launches over
+// cells or faces; the physics is in advect_/viscosity_/project_kernels.h.
+#pragma once
+#include "core/exec/parallel_for.h"
+#include "core/grid/advect_kernels.h"
+#include "core/grid/grid.h"
+#include "core/grid/project_kernels.h"
+#include "core/grid/viscosity_kernels.h"
+
+namespace wb::WB_BACKEND_NS {
+
+namespace detail {
+/// Face t of the concatenated u | v | w list: its component c and index f within it.
+WB_HD WB_INLINE void split_face(const GridDims& d, int64_t t, int& c, int64_t& f) {
+  const int64_t nu = d.nu(), nv = d.nv();
+  if (t < nu) {
+    c = 0;
+    f = t;
+  } else if (t < nu + nv) {
+    c = 1;
+    f = t - nu;
+  } else {
+    c = 2;
+    f = t - nu - nv;
+  }
+}
+WB_HD WB_INLINE int64_t all_faces(const GridDims& d) { return d.nu() + d.nv() + d.nw(); }
+}  // namespace detail
+
+void grid_classify(GridView g, PaintWindowView pw, BristleField br, int canvas_w, int canvas_h, int canvas_d,
+                   float liquid_threshold, float dry_threshold) {
+  const GridDims d = g.d;
+  parallel_for(d.cells(), [=] WB_HD(int64_t c) {
+    int i, j, k;
+    d.decompose_cell(c, i, j, k);
+    const int cx = i + pw.ox, cy = j + pw.oy, cz = k + pw.oz;
+    const bool on = cx >= 0 && cy >= 0 && cz >= 0 && cx < canvas_w && cy < canvas_h && cz < canvas_d;
+    g.cls[c] = classify_cell(pw.density[c], pw.dryness[c], on, liquid_threshold, dry_threshold);
+  });
+  parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
+    int c, i, j, k;
+    int64_t f;
+    detail::split_face(d, t, c, f);
+    d.decompose_face(c, f, i, j, k);
+    float theta, us;
+    face_fraction(d, g.cls, br, c, i, j, k, theta, us);
+    g.theta[c][f] = theta;
+    g.solid_vel[c][f] = us;
+  });
+}
+
+void grid_advect_paint(GridView g, const float* u, const float* v, const float* w, PaintWindowView src,
+                       PaintWindowView dst, float dt) {
+  const GridDims d = g.d;
+  parallel_for(d.cells(), [=] WB_HD(int64_t c) {
+    CellStencil s;
+    bool moved = false;
+    if (g.cls[c] != kCellSolid) {
+      int i, j, k;
+      d.decompose_cell(c, i, j, k);
+      const Vec3 x(float(i) + 0.5f, float(j) + 0.5f, float(k) + 0.5f);
+      moved = cell_stencil_fluid(d, g.cls, backtrace(u, v, w, d, x, dt), s);
+    }
+#define WB_X(name, doc) dst.name[c] = moved ? apply_stencil(s, src.name) : src.name[c];
+    WB_PAINT_FIELDS(WB_X)
+#undef WB_X
+  });
+}
+
+void grid_touched_density(const float* rho_new, const float* rho_old, const uint8_t* cls, float* out, int64_t n) {
+  parallel_for(n, [=] WB_HD(int64_t c) {
+    out[c] = (cls[c] != kCellSolid && rho_new[c] != rho_old[c]) ? rho_new[c] : 0.f;
+  });
+}
+
+void grid_scale_touched(float* rho_new, const float* rho_old, const uint8_t* cls, float scale, int64_t n) {
+  parallel_for(n, [=] WB_HD(int64_t c) {
+    if (cls[c] != kCellSolid && rho_new[c] != rho_old[c]) rho_new[c] *= scale;
+  });
+}
+
+void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt) {
+  const GridDims d = g.d;
+  parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
+    int c, i, j, k;
+    int64_t f;
+    detail::split_face(d, t, c, f);
+    if (g.theta[c][f] <= 0.f) {
+      g.vel[c][f] = g.solid_vel[c][f];
+      return;
+    }
+    d.decompose_face(c, f, i, j, k);
+    const Vec3 p = backtrace(u, v, w, d, face_position(c, i, j, k), dt);
+    g.vel[c][f] = sample_component(c == 0 ? u : (c == 1 ? v : w), d, c, p);
+  });
+}
+
+void grid_gravity(GridView g, const float* oil, float* ph, float g_dt, float yield_height) {
+  const GridDims d = g.d;
+  // Hydrostatic head of each liquid cell: contiguous liquid cells from it to the surface.
+  parallel_for(int64_t(d.nx) * d.ny, [=] WB_HD(int64_t col) {
+    const int i = int(col % d.nx), j = int(col / d.nx);
+    float head = 0.f;
+    for (int k = d.nz - 1; k >= 0; --k) {
+      const int64_t c = d.cell(i, j, k);
+      head = g.cls[c] == kCellLiquid ? head + g_dt : 0.f;
+      ph[c] = head;
+    }
+  });
+  parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
+    int c, i, j, k;
+    int64_t f;
+    detail::split_face(d, t, c, f);
+    if (g.theta[c][f] <= 0.f) return;
+    d.decompose_face(c, f, i, j, k);
+    int64_t a, b;
+    bool ha, hb;
+    face_cells(d, c, i, j, k, a, b, ha, hb);
+    const bool la = ha && g.cls[a] == kCellLiquid, lb = hb && g.cls[b] == kCellLiquid;
+    if (!la && !lb) return;
+    const float yield = g_dt * yield_height * (1.f - clampf(face_oil(d, oil, c, i, j, k), 0.f, 1.f));
+    g.vel[c][f] += gravity_face_impulse(c, la, lb, la ? ph[a] : 0.f, lb ? ph[b] : 0.f, g_dt, yield);
+  });
+}
+
+void grid_viscosity_sweep(GridView g, const float* oil, const float* cur_u, const float* cur_v, const float* cur_w,
+                          const float* old_u, const float* old_v, const float* old_w, float* out_u, float* out_v,
+                          float* out_w, float nu_thick, float nu_thin, float dt) {
+  const GridDims d = g.d;
+  parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
+    int c, i, j, k;
+    int64_t f;
+    detail::split_face(d, t, c, f);
+    const float* cur = c == 0 ? cur_u : (c == 1 ? cur_v : cur_w);
+    const float* old = c == 0 ? old_u : (c == 1 ? old_v : old_w);
+    float* out = c == 0 ? out_u : (c == 1 ? out_v : out_w);
+    d.decompose_face(c, f, i, j, k);
+    if (!face_is_fluid(d, g.cls, g.theta[c], c, i, j, k)) {
+      out[f] = cur[f];
+      return;
+    }
+    const float nu = viscosity_from_oil(face_oil(d, oil, c, i, j, k), nu_thick, nu_thin);
+    out[f] = viscosity_jacobi_face(g, cur, old, c, i, j, k, nu * dt);
+  });
+}
+
+void grid_rhs(GridView g, float* b) {
+  const GridDims d = g.d;
+  parallel_for(d.cells(), [=] WB_HD(int64_t c) {
+    if (g.cls[c] != kCellLiquid) {
+      b[c] = 0.f;
+      return;
+    }
+    int i, j, k;
+    d.decompose_cell(c, i, j, k);
+    b[c] = -cell_divergence(g, i, j, k);
+  });
+}
+
+void poisson_jacobi(PoissonView s, const float* b, const float* x, float* out, float omega) {
+  parallel_for(s.d.cells(), [=] WB_HD(int64_t c) { out[c] = jacobi_update(s, b, x, c, omega); });
+}
+
+void poisson_residual(PoissonView s, const float* b, const float* x, float* r) {
+  parallel_for(s.d.cells(), [=] WB_HD(int64_t c) {
+    r[c] = s.cls[c] == kCellLiquid ? b[c] - poisson_apply(s, x, c) : 0.f;
+  });
+}
+
+void poisson_chebyshev(PoissonView s, const float* b, const float* x, const float* x_prev, float* out, float omega_k) {
+  parallel_for(s.d.cells(), [=] WB_HD(int64_t c) {
+    const float xj = jacobi_update(s, b, x, c, 1.f);
+    out[c] = s.cls[c] == kCellLiquid ? omega_k * (xj - x_prev[c]) + x_prev[c] : 0.f;
+  });
+}
+
+void poisson_fixed_point_first(PoissonView s, const float* r, const float* y, float* out, float alpha) {
+  // One Jacobi sweep on the residual r started from alpha * y (Eq. 3, inner term).
+  parallel_for(s.d.cells(), [=] WB_HD(int64_t c) {
+    if (s.cls[c] != kCellLiquid) {
+      out[c] = 0.f;
+      return;
+    }
+    int i, j, k;
+    s.d.decompose_cell(c, i, j, k);
+    float diag, off;
+    poisson_row(s, y, i, j, k, diag, off);
+    out[c] = diag > 1e-6f ? (r[c] + alpha * off) / diag : 0.f;
+  });
+}
+
+void poisson_fixed_point_second(PoissonView s, const float* r, const float* z, float* y_out, float* x) {
+  // Second Jacobi sweep, then x += y (the pressure applied is the sum of the corrections).
+  parallel_for(s.d.cells(), [=] WB_HD(int64_t c) {
+    const float y = jacobi_update(s, r, z, c, 1.f);
+    y_out[c] = y;
+    x[c] += y;
+  });
+}
+
+void poisson_apply_all(PoissonView s, const float* x, float* out) {
+  parallel_for(s.d.cells(), [=] WB_HD(int64_t c) { out[c] = poisson_apply(s, x, c); });
+}
+
+void grid_apply_pressure(GridView g, const float* p) {
+  const GridDims d = g.d;
+  parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
+    int c, i, j, k;
+    int64_t f;
+    detail::split_face(d, t, c, f);
+    d.decompose_face(c, f, i, j, k);
+    g.vel[c][f] = projected_face_velocity(g, p, c, i, j, k);
+  });
+}
+
+void grid_extrapolate(GridView g) {
+  const GridDims d = g.d;
+  // Writes only faces that touch no liquid, reads only faces that do: safe in place.
+  parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
+    int c, i, j, k;
+    int64_t f;
+    detail::split_face(d, t, c, f);
+    if (g.theta[c][f] <= 0.f) {
+      g.vel[c][f] = g.solid_vel[c][f];
+      return;
+    }
+    d.decompose_face(c, f, i, j, k);
+    if (face_is_fluid(d, g.cls, g.theta[c], c, i, j, k)) return;
+    g.vel[c][f] = extrapolated_face_velocity(g, c, i, j, k);
+  });
+}
+
+void grid_dry(PaintWindowView pw, float amount) {
+  parallel_for(pw.size(), [=] WB_HD(int64_t c) {
+    if (pw.density[c] > 0.f) pw.dryness[c] = minf(pw.dryness[c] + amount, 1.f);
+  });
+}
+
+void grid_shift_lattice(const float* src, float* dst, int ex, int ey, int ez, int dx, int dy, int dz) {
+  parallel_for(int64_t(ex) * ey * ez, [=] WB_HD(int64_t t) {
+    const int i = int(t % ex), j = int((t / ex) % ey), k = int(t / (int64_t(ex) * ey));
+    const int si = i + dx, sj = j + dy, sk = k + dz;
+    const bool in = si >= 0 && sj >= 0 && sk >= 0 && si < ex && sj < ey && sk < ez;
+    dst[t] = in ? src[(int64_t(sk) * ey + sj) * ex + si] : 0.f;
+  });
+}
+
+void grid_max_abs_fluid_velocity(GridView g, float* out) {
+  const GridDims d = g.d;
+  parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
+    int c, i, j, k;
+    int64_t f;
+    detail::split_face(d, t, c, f);
+    d.decompose_face(c, f, i, j, k);
+    out[t] = face_is_fluid(d, g.cls, g.theta[c], c, i, j, k) ? fabsf(g.vel[c][f]) : 0.f;
+  });
+}
+
+void grid_square(const float* x, float* out, int64_t n) {
+  parallel_for(n, [=] WB_HD(int64_t c) { out[c] = x[c] * x[c]; });
+}
+
+void grid_scale(float* x, float s, int64_t n) {
+  parallel_for(n, [=] WB_HD(int64_t c) { x[c] *= s; });
+}
+
+void grid_fill_hash(float* x, const uint8_t* cls, int64_t n, uint32_t seed) {
+  parallel_for(n, [=] WB_HD(int64_t c) {
+    uint32_t h = uint32_t(c) * 747796405u + seed * 2891336453u + 1u;
+    h = ((h >> ((h >> 28u) + 4u)) ^ h) * 277803737u;
+    h = (h >> 22u) ^ h;
+    x[c] = cls[c] == kCellLiquid ? float(h & 0xFFFFFFu) / float(0x1000000) - 0.5f : 0.f;
+  });
+}
+
+}  // namespace wb::WB_BACKEND_NS

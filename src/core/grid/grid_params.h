@@ -1,0 +1,82 @@
+// Parameters of the grid-based liquid stage (paper §4.2, Algorithm 1, Eq. 3-7).
+// One POD, passed by value to the stage drivers. Units: lengths in canvas cells
+// (1 cell = 0.2 mm), velocities in cells/s, time in s.
+#pragma once
+
+namespace wb {
+
+/// Pressure solver behind Grid::project(). All run a fixed number of Jacobi-type sweeps.
+enum class PressureSolver : int {
+  FixedPoint = 0,      ///< Algorithm 1 / Eq. 3: L iterations of two Jacobi sweeps restarted from alpha * y
+  Jacobi = 1,          ///< plain Jacobi (Eq. 7 with omega = 1)
+  WeightedJacobi = 2,  ///< Eq. 7 with omega = jacobi_omega
+  Chebyshev = 3,       ///< Chebyshev semi-iteration, Eq. 6 (Golub & Van Loan 1996 §10.1.5)
+};
+
+struct GridParams {
+  // --- time ---
+  /// Step length. Default 1/60 s, range (0, 0.1] s. DESIGN "Units and scale".
+  float dt = 1.f / 60.f;
+
+  // --- pressure projection (§4.2, Algorithm 1) ---
+  PressureSolver solver = PressureSolver::FixedPoint;
+  /// Fixed-point iterations L of Algorithm 1 (each = two Jacobi sweeps). Default 3, range [0, 1000]. Alg. 1.
+  int jacobi_L = 3;
+  /// Restart weight alpha of Algorithm 1 / Eq. 3-5. Default 1, range [0, 1]. §4.2 ("simply set to 1").
+  float alpha = 1.f;
+  /// Sweeps of the Jacobi / weighted Jacobi / Chebyshev solvers. Default 6 (= 2L), range [0, 10000].
+  int solver_sweeps = 6;
+  /// Weight of weighted Jacobi, Eq. 7. Default 0.8 (dimensionless), range (0, 1].
+  float jacobi_omega = 0.8f;
+  /// Spectral-radius estimate rho of D^-1 R for Chebyshev (Eq. 6); <= 0: estimated by power
+  /// iteration (chebyshev_power_iterations sweeps) at each projection. Default 0, range [0, 1).
+  float chebyshev_rho = 0.f;
+  /// Power-iteration sweeps of the rho estimate. Default 30, range [1, 1000].
+  int chebyshev_power_iterations = 30;
+
+  // --- viscosity from oil (§4.2 "viscosity", DESIGN step 6) ---
+  /// Kinematic viscosity of paint without oil (oil = 0), cells^2/s. Default 3000, range [0, 1e7].
+  float nu_thick = 3000.f;
+  /// Kinematic viscosity of pure oil (oil = 1), cells^2/s. Default 30, range [0, 1e7].
+  /// nu(oil) = nu_thick * (nu_thin / nu_thick)^oil: more oil, thinner paint.
+  float nu_thin = 30.f;
+  /// Jacobi sweeps of the implicit (backward Euler) viscosity solve. Default 4, range [0, 100].
+  /// Every sweep is a convex combination, so any count is stable at any nu*dt.
+  int viscosity_iterations = 4;
+
+  // --- external forces ---
+  /// Gravity magnitude along -z, cells/s^2. Default 49050 (9.81 m/s^2 at 0.2 mm cells), range [0, 1e6].
+  /// Applied with its hydrostatic pressure split off per column (docs/GRID.md), so resting paint
+  /// feels no net force whatever the solver's accuracy.
+  float gravity = 49050.f;
+  /// Yield head of paint without oil, cells: the unbalanced weight of a column of paint shorter
+  /// than yield_height * (1 - oil) does not move it (Bingham-like yield stress: tube paint holds
+  /// ridges and overhangs). Default 50 (about 100 Pa at rho0 = 1000 kg/m^3), range [0, 1e4].
+  float yield_height = 50.f;
+
+  // --- cell classes ---
+  /// Density (volume fraction) at and above which a cell is liquid in the projection.
+  /// Default 0.5, range (0, 1]. Below it the cell is air (p = 0, free surface).
+  float liquid_threshold = 0.5f;
+
+  // --- drying (§4.2 "we also increase the dryness of every grid cell") ---
+  /// Dryness added per second to every cell holding paint. Default 0.002 /s, range [0, 1000].
+  float dry_rate = 0.002f;
+  /// Dryness at and above which a cell holding paint is solid for brush, projection and
+  /// advection. Default 0.95, range (0, 1].
+  float dry_threshold = 0.95f;
+
+  // --- advection and mass ---
+  /// Rescale density in the cells advection touched so that advection conserves mass
+  /// (docs/GRID.md "Mass"). Default on.
+  bool mass_correction = true;
+  /// Compute the mass books (canvas, window, advection change) each step: 3 reductions. Default on.
+  bool track_mass = true;
+
+  // --- active window (§4.2 last paragraph) ---
+  /// Window origins snap to multiples of this many cells, so the window moves (a scatter and a
+  /// gather) only when the brush has moved about this far. Default 8, range [1, 64].
+  int window_snap = 8;
+};
+
+}  // namespace wb
