@@ -1,0 +1,354 @@
+// The brush stage's host side (paper §4.1): owns the device buffers, computes the
+// brush frame's motion from consecutive poses (Eq. 2), validates, and dispatches the
+// stage drivers of brush_impl.h in the order of one step.
+#include "core/brush/brush.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "core/brush/brush_kernels.h"
+#include "core/brush/brush_stages.h"
+#include "core/brush/samples_kernels.h"
+#include "core/exec/algorithms.h"
+#include "core/exec/dispatch.h"
+#include "core/exec/memory.h"
+#include "core/exec/profile.h"
+
+namespace wb {
+
+namespace {
+// The one runtime switch per driver.
+#define WB_BRUSH_CALL(name, params, args) \
+  void name##_on(const Device& d, WB_BRUSH_UNPAREN params) { WB_DISPATCH(d, name args); }
+#define WB_BRUSH_UNPAREN(...) __VA_ARGS__
+WB_BRUSH_CALL(brush_integrate, (BristleState s, BristleRest r, BrushFrame f, BrushForces e, float b, float dmp, float dt),
+              (s, r, f, e, b, dmp, dt))
+WB_BRUSH_CALL(brush_solve, (BristleState s, BristleRest r, BrushFrame f, SolidField so, int it, float mu),
+              (s, r, f, so, it, mu))
+WB_BRUSH_CALL(brush_grid_keys, (BristleState s, float h, uint32_t m, uint32_t* k, uint32_t* i), (s, h, m, k, i))
+WB_BRUSH_CALL(brush_grid_clear, (uint32_t * a, uint32_t* b, int64_t n), (a, b, n))
+WB_BRUSH_CALL(brush_grid_ranges, (const uint32_t* k, int64_t n, uint32_t* a, uint32_t* b), (k, n, a, b))
+WB_BRUSH_CALL(brush_density_lambda, (BristleState s, MinDensityGrid g, float* l), (s, g, l))
+WB_BRUSH_CALL(brush_density_delta, (BristleState s, MinDensityGrid g, const float* l), (s, g, l))
+WB_BRUSH_CALL(brush_density_apply, (BristleState s), (s))
+WB_BRUSH_CALL(brush_finalize, (BristleState s, BristleRest r, BrushFrame f, SolidField so, float dt), (s, r, f, so, dt))
+WB_BRUSH_CALL(brush_restore, (BristleState s, BrushFrame f), (s, f))
+WB_BRUSH_CALL(brush_place, (BristleState s, BristleRest r, BrushFrame f), (s, r, f))
+WB_BRUSH_CALL(brush_stretch_and_z, (BristleState s, BristleRest r, float* a, float* b), (s, r, a, b))
+WB_BRUSH_CALL(samples_spline, (BristleState s, SampleView sv, SamplePrev p, SolidField so), (s, sv, p, so))
+WB_BRUSH_CALL(samples_frames, (SampleView sv, BrushFrame f), (sv, f))
+WB_BRUSH_CALL(samples_motion, (SampleView sv, SamplePrev p, float dt, int h), (sv, p, dt, h))
+WB_BRUSH_CALL(samples_z, (SampleView sv, float* z), (sv, z))
+WB_BRUSH_CALL(samples_rasterize,
+              (SampleView sv, float r, Int3 o, Int3 n, float* psi, float* vx, float* vy, float* vz),
+              (sv, r, o, n, psi, vx, vy, vz))
+WB_BRUSH_CALL(samples_rasterize_finish, (int64_t n, float* psi, float* vx, float* vy, float* vz), (n, psi, vx, vy, vz))
+WB_BRUSH_CALL(samples_contact_keys,
+              (SampleView sv, SolidField so, float ch, int32_t* t, int tw, int th, int ox, int oy, uint32_t* k,
+               uint32_t* v),
+              (sv, so, ch, t, tw, th, ox, oy, k, v))
+WB_BRUSH_CALL(count_distinct_flags, (const uint32_t* k, int64_t n, uint32_t s, float* f), (k, n, s, f))
+#undef WB_BRUSH_CALL
+#undef WB_BRUSH_UNPAREN
+
+bool finite_pose(const BrushPose& p) {
+  bool ok = isfinite3(p.position);
+  for (const auto& r : p.rotation.r) ok = ok && isfinite3(r);
+  return ok;
+}
+
+/// max |R^T R - I|: a pose's rotation must be orthonormal (a shear would distort the brush).
+float orthonormality_error(const Mat3& R) {
+  const Mat3 m = transpose(R) * R;
+  float e = 0.f;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) e = std::max(e, std::fabs(m.r[i][j] - (i == j ? 1.f : 0.f)));
+  return e;
+}
+
+void check_pose(const BrushPose& p, const char* where) {
+  WB_REQUIRE(finite_pose(p), std::string(where) + ": brush pose is not finite");
+  const float e = orthonormality_error(p.rotation);
+  WB_REQUIRE(e < 1e-3f, std::string(where) + ": brush pose rotation is not orthonormal (|R^T R - I| = " +
+                            std::to_string(e) + ")");
+  WB_REQUIRE(std::fabs(p.position.x) < 1e8f && std::fabs(p.position.y) < 1e8f && std::fabs(p.position.z) < 1e8f,
+             std::string(where) + ": brush pose position out of range");
+}
+
+int bit_width(uint64_t v) {
+  int b = 0;
+  while (v) {
+    ++b;
+    v >>= 1;
+  }
+  return b;
+}
+}  // namespace
+
+Brush::Brush(const Device& device, const BrushSpec& spec, const BrushPose& pose, const BrushSolverParams& params)
+    : device_(device), spec_(spec), params_(params), layout_(build_bristle_layout(spec)), ws_(device) {
+  WB_REQUIRE(params.iterations >= 1 && params.iterations <= 100, "brush solver: iterations must be in 1..100");
+  WB_REQUIRE(params.density_iterations >= 0 && params.density_iterations <= 20,
+             "brush solver: density_iterations must be in 0..20");
+  WB_REQUIRE(params.damping >= 0.f && params.damping <= 1.f, "brush solver: damping must be in [0, 1]");
+  check_pose(pose, "Brush");
+  device_.activate();
+
+  const int64_t N = vertex_count(), S = sample_count();
+  const int V = spec.vertices_per_bristle, B = spec.bristles;
+  for (auto* b : {&xb_, &vb_, &x_, &v_, &xb_old_, &vb_old_, &x_old_, &v_old_, &delta_, &root_, &dir_, &prev_x_,
+                  &prev_t_, &prev_n_, &prev_v_, &prev_omega_})
+    b->set_device(device);
+  for (auto* b : {&xb_, &vb_, &x_, &v_, &xb_old_, &vb_old_, &x_old_, &v_old_, &delta_}) b->resize(size_t(N));
+#define WB_X(type, name, doc)   \
+  s_##name##_.set_device(device); \
+  s_##name##_.resize(size_t(S));  \
+  s_##name##_.fill_zero();
+  WB_SAMPLE_FIELDS(WB_X)
+#undef WB_X
+  for (auto* b : {&prev_x_, &prev_t_, &prev_n_, &prev_v_, &prev_omega_}) {
+    b->resize(size_t(S));
+    b->fill_zero();
+  }
+
+  // Rest description.
+  std::vector<float> seg(size_t(N), 0.f);
+  std::vector<float> bend(static_cast<size_t>(B));
+  const float it_ratio = float(brush::kReferenceIterations) / float(params.iterations);
+  for (int k = 0; k < B; ++k) {
+    for (int i = 1; i < V; ++i) seg[size_t(k) * V + i] = layout_.length[size_t(k)] / float(V - 1);
+    // Müller et al. 2007 §3.3: k' = 1 - (1 - k)^(n_ref / n) keeps the per-step effect of the
+    // stiffness independent of the iteration count.
+    bend[size_t(k)] = 1.f - std::pow(1.f - layout_.stiffness[size_t(k)], it_ratio);
+  }
+  seg_length_.set_device(device);
+  seg_length_.copy_from_host(seg);
+  bend_k_.set_device(device);
+  bend_k_.copy_from_host(bend);
+  root_.copy_from_host(layout_.root);
+  dir_.copy_from_host(layout_.dir);
+
+  // Minimum-density constraint: s_min = 2 r (bristles touching), never more than 0.9 of the
+  // closest rest spacing, so that the rest shape satisfies the constraint.
+  s_min_ = params.min_spacing > 0.f ? params.min_spacing : 2.f * spec.bristle_radius;
+  s_min_ = std::min(s_min_, 0.9f * layout_.min_rest_spacing);
+  uint32_t table = 1024;
+  while (table < uint32_t(2 * N)) table <<= 1;
+  grid_mask_ = table - 1;
+  grid_bits_ = bit_width(grid_mask_);
+  for (auto* b : {&grid_keys_, &grid_ids_, &cell_start_, &cell_end_, &contact_keys_, &contact_vals_}) b->set_device(device);
+  grid_keys_.resize(size_t(N));
+  grid_ids_.resize(size_t(N));
+  cell_start_.resize(table);
+  cell_end_.resize(table);
+  lambda_.set_device(device);
+  lambda_.resize(size_t(N));
+  contact_keys_.resize(size_t(S));
+  contact_vals_.resize(size_t(S));
+  scratch_a_.set_device(device);
+  scratch_b_.set_device(device);
+  scratch_a_.resize(size_t(std::max(N, S)));
+  scratch_b_.resize(size_t(std::max(N, S)));
+  // Reserve the sort's scratch now so that the first step does not allocate.
+  ws_.get(size_t(std::max(N, S)) * 2 * sizeof(uint32_t) + 4096);
+
+  reset(pose);
+}
+
+BristleState Brush::state_view() {
+  return BristleState{xb_.data(),     vb_.data(),    x_.data(),     v_.data(),       xb_old_.data(),
+                      vb_old_.data(), x_old_.data(), v_old_.data(), delta_.data(), spec_.bristles,
+                      spec_.vertices_per_bristle};
+}
+
+BristleRest Brush::rest_view() const {
+  return BristleRest{root_.data(), dir_.data(), seg_length_.data(), bend_k_.data()};
+}
+
+SamplePrev Brush::prev_view() {
+  return SamplePrev{prev_x_.data(), prev_t_.data(), prev_n_.data(), prev_v_.data(), prev_omega_.data()};
+}
+
+SampleView Brush::samples() {
+  SampleView v{};
+#define WB_X(type, name, doc) v.name = s_##name##_.data();
+  WB_SAMPLE_FIELDS(WB_X)
+#undef WB_X
+  v.bristles = spec_.bristles;
+  v.per_bristle = spec_.samples_per_bristle;
+  return v;
+}
+
+BrushFrame Brush::frame_for(const BrushPose& pose) const {
+  BrushFrame f{};
+  f.R = pose.rotation;
+  f.R_B = pose.R_B();
+  f.p = pose.position;
+  return f;
+}
+
+void Brush::reset(const BrushPose& pose) {
+  check_pose(pose, "Brush::reset");
+  pose_ = pose;
+  frame_v_ = Vec3();
+  frame_omega_B_ = Vec3();
+  xb_.copy_from_host(layout_.rest);
+  const BrushFrame f = frame_for(pose);
+  brush_place_on(device_, state_view(), rest_view(), f);
+  sample_history_ = 0;
+  update_samples(1.f, f, last_solid_);
+}
+
+void Brush::step(const BrushPose& pose, float dt, const BrushEnvironment& env) {
+  WB_PROFILE_SCOPE("brush.step");
+  WB_REQUIRE(std::isfinite(dt) && dt > 0.f && dt <= 1.f, "Brush::step: dt must be in (0, 1] s (got " + std::to_string(dt) + ")");
+  check_pose(pose, "Brush::step");
+  WB_REQUIRE(env.friction >= 0.f && env.friction <= 1.f, "Brush::step: friction must be in [0, 1]");
+  WB_REQUIRE(isfinite3(env.gravity), "Brush::step: gravity is not finite");
+  if (env.drag) {
+    const DragField& d = *env.drag;
+    WB_REQUIRE(d.vx && d.vy && d.vz && d.density && d.nx > 0 && d.ny > 0 && d.nz > 0,
+               "Brush::step: drag field needs vx, vy, vz, density and positive dimensions");
+    WB_REQUIRE(std::isfinite(d.k) && d.k >= 0.f, "Brush::step: drag coefficient must be finite and >= 0");
+  }
+  if (env.solid.valid)
+    WB_REQUIRE(env.solid.tiles.slot_of_tile && env.solid.tiles.density && env.solid.tiles.dryness,
+               "Brush::step: solid field is marked valid but has no tile store");
+
+  // Motion of the brush frame (Eq. 2): linear and angular velocity from consecutive poses,
+  // their rates from the previous step's.
+  BrushFrame f = frame_for(pose);
+  const Vec3 v_now = (pose.position - pose_.position) / dt;
+  const Vec3 omega_canvas = brush::rotation_vector(pose.rotation * transpose(pose_.rotation)) / dt;
+  const Vec3 omega_B = f.R_B * omega_canvas;
+  f.vdot_B = f.R_B * ((v_now - frame_v_) / dt);
+  f.omega_B = omega_B;
+  f.omegadot_B = (omega_B - frame_omega_B_) / dt;
+
+  BrushForces forces{};
+  forces.gravity = env.gravity;
+  forces.has_drag = env.drag != nullptr;
+  if (env.drag) forces.drag = *env.drag;
+  const float friction_it = 1.f - std::pow(1.f - env.friction, 1.f / float(params_.iterations));
+
+  const BristleState s = state_view();
+  const BristleRest r = rest_view();
+  {
+    WB_PROFILE_SCOPE("brush.integrate");
+    brush_integrate_on(device_, s, r, f, forces, spec_.beta_B, params_.damping, dt);
+  }
+  {
+    WB_PROFILE_SCOPE("brush.constraints");
+    brush_solve_on(device_, s, r, f, env.solid, params_.iterations, friction_it);
+  }
+  {
+    WB_PROFILE_SCOPE("brush.min_density");
+    apply_min_density();
+  }
+  {
+    WB_PROFILE_SCOPE("brush.finalize");
+    brush_finalize_on(device_, s, r, f, env.solid, dt);
+  }
+  // Containment: a non-finite vertex never propagates; the step is undone.
+  const int64_t N = vertex_count();
+  const int64_t bad = count_nonfinite(device_, reinterpret_cast<const float*>(xb_.data()), 3 * N, ws_) +
+                      count_nonfinite(device_, reinterpret_cast<const float*>(vb_.data()), 3 * N, ws_);
+  if (bad > 0) {
+    brush_restore_on(device_, s, f);
+    ++rollbacks_;
+    frame_v_ = Vec3();
+    frame_omega_B_ = Vec3();
+    sample_history_ = 0;
+  } else {
+    frame_v_ = v_now;
+    frame_omega_B_ = omega_B;
+  }
+  pose_ = pose;
+  last_solid_ = env.solid;
+  WB_PROFILE_SCOPE("brush.samples");
+  update_samples(dt, f, env.solid);
+}
+
+void Brush::apply_min_density() {
+  if (params_.density_iterations <= 0 || spec_.bristles < 2 || !(s_min_ > 0.f)) return;
+  const BristleState s = state_view();
+  const int64_t N = vertex_count();
+  MinDensityGrid g{};
+  g.ids = grid_ids_.data();
+  g.cell_start = cell_start_.data();
+  g.cell_end = cell_end_.data();
+  g.mask = grid_mask_;
+  g.h = 2.f * s_min_;
+  g.rho0 = brush::density_kernel(s_min_, g.h);
+  const float grad = 2.f / s_min_;  // |grad C| of one neighbour at s_min
+  g.eps = 1e-3f * grad * grad;
+  for (int it = 0; it < params_.density_iterations; ++it) {
+    brush_grid_keys_on(device_, s, g.h, grid_mask_, grid_keys_.data(), grid_ids_.data());
+    sort_by_key(device_, grid_keys_.data(), grid_ids_.data(), N, grid_bits_, ws_);
+    brush_grid_clear_on(device_, cell_start_.data(), cell_end_.data(), int64_t(grid_mask_) + 1);
+    brush_grid_ranges_on(device_, grid_keys_.data(), N, cell_start_.data(), cell_end_.data());
+    brush_density_lambda_on(device_, s, g, lambda_.data());
+    brush_density_delta_on(device_, s, g, lambda_.data());
+    brush_density_apply_on(device_, s);
+  }
+}
+
+void Brush::update_samples(float dt, const BrushFrame& frame, const SolidField& solid) {
+  const SampleView sv = samples();
+  const SamplePrev prev = prev_view();
+  samples_spline_on(device_, state_view(), sv, prev, solid);
+  samples_frames_on(device_, sv, frame);
+  samples_motion_on(device_, sv, prev, dt, sample_history_);
+  sample_history_ = std::min(sample_history_ + 1, 2);
+}
+
+void Brush::rasterize(Int3 window_origin, Int3 window_dims, float* psi, float* vx, float* vy, float* vz) {
+  WB_PROFILE_SCOPE("brush.rasterize");
+  WB_REQUIRE(window_dims.x > 0 && window_dims.y > 0 && window_dims.z > 0, "Brush::rasterize: window dims must be positive");
+  WB_REQUIRE(psi && vx && vy && vz, "Brush::rasterize: null output pointer");
+  const int64_t cells = int64_t(window_dims.x) * window_dims.y * window_dims.z;
+  for (float* p : {psi, vx, vy, vz}) mem::fill_zero(device_, p, size_t(cells) * sizeof(float));
+  samples_rasterize_on(device_, samples(), spec_.bristle_radius, window_origin, window_dims, psi, vx, vy, vz);
+  samples_rasterize_finish_on(device_, cells, psi, vx, vy, vz);
+}
+
+int64_t Brush::mark_contacts(int32_t* trace, int trace_w, int trace_h, int ox, int oy, float contact_height) {
+  WB_PROFILE_SCOPE("brush.contacts");
+  WB_REQUIRE(trace && trace_w > 0 && trace_h > 0, "Brush::mark_contacts: empty trace");
+  WB_REQUIRE(uint64_t(trace_w) * uint64_t(trace_h) < (uint64_t(1) << 31), "Brush::mark_contacts: trace too large");
+  WB_REQUIRE(std::isfinite(contact_height) && contact_height >= 0.f, "Brush::mark_contacts: bad contact height");
+  const int64_t S = sample_count();
+  const uint32_t sentinel = uint32_t(trace_w) * uint32_t(trace_h);
+  samples_contact_keys_on(device_, samples(), last_solid_, contact_height, trace, trace_w, trace_h, ox, oy,
+                          contact_keys_.data(), contact_vals_.data());
+  sort_by_key(device_, contact_keys_.data(), contact_vals_.data(), S, bit_width(sentinel), ws_);
+  count_distinct_flags_on(device_, contact_keys_.data(), S, sentinel, scratch_a_.data());
+  return int64_t(std::llround(reduce_sum(device_, scratch_a_.data(), S, ws_)));
+}
+
+BrushStats Brush::stats() {
+  BrushStats st;
+  const int64_t N = vertex_count(), S = sample_count();
+  brush_stretch_and_z_on(device_, state_view(), rest_view(), scratch_a_.data(), scratch_b_.data());
+  st.max_stretch = reduce_max(device_, scratch_a_.data(), N, ws_);
+  const float zv = reduce_min(device_, scratch_b_.data(), N, ws_);
+  samples_z_on(device_, samples(), scratch_b_.data());
+  st.min_z = std::min(zv, reduce_min(device_, scratch_b_.data(), S, ws_));
+  st.nonfinite = rollbacks_;
+  return st;
+}
+
+std::vector<Vec3> Brush::vertices_to_host() const { return x_.to_host(); }
+std::vector<Vec3> Brush::vertices_brush_frame_to_host() const { return xb_.to_host(); }
+std::vector<Vec3> Brush::vertex_velocities_to_host() const { return v_.to_host(); }
+std::vector<Vec3> Brush::samples_to_host() const { return s_x_.to_host(); }
+std::vector<std::vector<Vec3>> Brush::sample_fields_to_host() const {
+  std::vector<std::vector<Vec3>> out;
+#define WB_X(type, name, doc) out.push_back(s_##name##_.to_host());
+  WB_SAMPLE_FIELDS(WB_X)
+#undef WB_X
+  return out;
+}
+
+}  // namespace wb

@@ -1,0 +1,137 @@
+// The bristle brush (paper §4.1, DESIGN step 1-2): bristles of 10 vertices simulated in
+// the non-inertial brush frame (Eq. 1-2, beta_B), with position-based inextensibility,
+// bending, collision and a minimum-density constraint; then 128 Hermite samples per
+// bristle with Bishop frames and their motion, rasterised into psi for the grid.
+#pragma once
+#include <cstdint>
+#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
+#include <vector>
+
+#include "core/brush/bristle_fields.h"
+#include "core/brush/brush_model.h"
+#include "core/brush/brush_spec.h"
+#include "core/brush/brush_stages.h"
+#include "core/brush/brush_views.h"
+#include "core/canvas/window.h"
+#include "core/exec/buffer.h"
+#include "core/exec/workspace.h"
+
+namespace wb {
+
+/// Standard gravity in canvas cells/s^2 (9.81 m/s^2, 1 cell = 0.2 mm).
+inline constexpr float kGravityCells = 49050.f;
+
+/// What the brush feels besides its own pose (a_i of Eq. 2 and the surfaces).
+struct BrushEnvironment {
+  Vec3 gravity{0.f, 0.f, -kGravityCells};  ///< canvas frame, cells/s^2
+  const DragField* drag = nullptr;          ///< paint flow for the drag term; null = none (air)
+  SolidField solid{};                       ///< dried paint; solid.valid = false: none
+  float friction = 0.5f;                    ///< fraction of a contact vertex's sliding removed per step, [0, 1]
+};
+
+/// Numerical parameters of the brush solver (not part of a brush preset).
+struct BrushSolverParams {
+  int iterations = 8;               ///< Gauss-Seidel sweeps per step (bending, length, collision)
+  int density_iterations = 2;       ///< minimum-density Jacobi iterations per step (0 = off)
+  float damping = 0.1f;             ///< fraction of the brush-frame velocity removed per step
+  float min_spacing = -1.f;         ///< s_min, cells; < 0: 2 * bristle_radius, capped by the rest spacing
+};
+
+struct BrushStats {
+  float max_stretch = 0.f;  ///< max over segments of |l - l0| / l0
+  float min_z = 0.f;        ///< lowest canvas z of any vertex or sample, cells
+  int64_t nonfinite = 0;    ///< steps whose result was non-finite and rolled back, since construction
+};
+
+class Brush {
+ public:
+  /// Builds the bristles of `spec` at rest at `pose`; throws wb::Error on a bad spec.
+  Brush(const Device& device, const BrushSpec& spec, const BrushPose& pose, const BrushSolverParams& params = {});
+
+  const Device& device() const { return device_; }
+  const BrushSpec& spec() const { return spec_; }
+  const BrushSolverParams& params() const { return params_; }
+  const BristleLayout& layout() const { return layout_; }
+  const BrushPose& pose() const { return pose_; }
+  int bristles() const { return spec_.bristles; }
+  int vertices_per_bristle() const { return spec_.vertices_per_bristle; }
+  int64_t vertex_count() const { return int64_t(spec_.bristles) * spec_.vertices_per_bristle; }
+  int64_t sample_count() const { return int64_t(spec_.bristles) * spec_.samples_per_bristle; }
+  /// The spacing s_min the minimum-density constraint keeps between bristles, cells.
+  float min_spacing() const { return s_min_; }
+
+  /// Puts the bristles back at rest at `pose`, forgetting all motion.
+  void reset(const BrushPose& pose);
+
+  /// One step: brush-frame dynamics (Eq. 2), constraints, collisions, then the samples.
+  /// Allocates nothing. A non-finite result is rolled back (see stats().nonfinite).
+  void step(const BrushPose& pose, float dt, const BrushEnvironment& env);
+
+  /// Bristle density psi (occupied volume fraction, clamped to 1) and the psi-weighted
+  /// mean bristle velocity (cells/s) on the cell-centred window at `window_origin`, sized
+  /// `window_dims`. Device pointers, window_dims.x*y*z floats each; zeroed here.
+  void rasterize(Int3 window_origin, Int3 window_dims, float* psi, float* vx, float* vy, float* vz);
+
+  /// Sets trace[(y - oy) * trace_w + (x - ox)] = 1 (device pointer) for every canvas cell
+  /// (x, y) holding a sample less than contact_height above the canvas or the dried paint
+  /// of the last step's environment; returns how many distinct cells of the trace this step touches.
+  int64_t mark_contacts(int32_t* trace, int trace_w, int trace_h, int ox, int oy, float contact_height);
+
+  BrushStats stats();
+  /// Device view of the samples; valid until the brush is destroyed (the buffers never move).
+  SampleView samples();
+
+  /// Host copies for tests, images and tools.
+  std::vector<Vec3> vertices_to_host() const;              ///< canvas frame
+  std::vector<Vec3> vertices_brush_frame_to_host() const;  ///< brush frame
+  std::vector<Vec3> vertex_velocities_to_host() const;     ///< canvas frame, cells/s
+  std::vector<Vec3> samples_to_host() const;               ///< sample positions, canvas frame
+  /// Every sample field, in WB_SAMPLE_FIELDS order.
+  std::vector<std::vector<Vec3>> sample_fields_to_host() const;
+
+ private:
+  BristleState state_view();
+  BristleRest rest_view() const;
+  SamplePrev prev_view();
+  BrushFrame frame_for(const BrushPose& pose) const;
+  void update_samples(float dt, const BrushFrame& frame, const SolidField& solid);
+  void apply_min_density();
+
+  Device device_;
+  BrushSpec spec_;
+  BrushSolverParams params_;
+  BristleLayout layout_;
+  Workspace ws_;
+  float s_min_ = 0.f;
+
+  // Pose history for the frame's velocities (Eq. 2).
+  BrushPose pose_;
+  Vec3 frame_v_{};      ///< canvas frame, cells/s
+  Vec3 frame_omega_B_{};
+  int pose_history_ = 0;
+  int sample_history_ = 0;
+  SolidField last_solid_{};
+  int64_t rollbacks_ = 0;
+
+  // Per vertex.
+  DeviceBuffer<Vec3> xb_, vb_, x_, v_, xb_old_, vb_old_, x_old_, v_old_, delta_;
+  DeviceBuffer<float> seg_length_;
+  // Per bristle.
+  DeviceBuffer<Vec3> root_, dir_;
+  DeviceBuffer<float> bend_k_;
+  // Minimum-density hash grid.
+  DeviceBuffer<uint32_t> grid_keys_, grid_ids_, cell_start_, cell_end_;
+  DeviceBuffer<float> lambda_;
+  uint32_t grid_mask_ = 0;
+  int grid_bits_ = 0;
+  // Samples and their previous values.
+#define WB_X(type, name, doc) DeviceBuffer<type> s_##name##_;
+  WB_SAMPLE_FIELDS(WB_X)
+#undef WB_X
+  DeviceBuffer<Vec3> prev_x_, prev_t_, prev_n_, prev_v_, prev_omega_;
+  // Scratch: contact keys, reductions.
+  DeviceBuffer<uint32_t> contact_keys_, contact_vals_;
+  DeviceBuffer<float> scratch_a_, scratch_b_;
+};
+
+}  // namespace wb

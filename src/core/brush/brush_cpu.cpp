@@ -1,0 +1,2 @@
+// Brush stage, CPU (OpenMP) backend.
+#include "core/brush/brush_impl.h"

@@ -1,0 +1,2 @@
+// Brush stage, CUDA backend.
+#include "core/brush/brush_impl.h"

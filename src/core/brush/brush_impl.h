@@ -1,0 +1,366 @@
+// Brush stage drivers (paper §4.1, DESIGN step 1-2), compiled once per backend.
+// Order of one step: integrate Eq. 2 in the brush frame -> per-bristle Gauss-Seidel
+// sweeps (bending, inextensibility, collision + friction) -> minimum-density Jacobi
+// iterations across bristles -> final exact inextensibility + collision -> velocities
+// and canvas positions -> samples (spline, Bishop frames, motion).
+#pragma once
+#include "core/brush/brush_kernels.h"
+#include "core/brush/brush_stages.h"
+#include "core/brush/samples_kernels.h"
+#include "core/exec/atomics.h"
+#include "core/exec/parallel_for.h"
+
+namespace wb::WB_BACKEND_NS {
+
+namespace brush_detail {
+/// Horizontal fallback for splaying a vertical bristle pressed straight down: the
+/// canvas-frame direction of its root away from the ferrule centre.
+WB_HD WB_INLINE Vec3 splay_direction(const BrushFrame& f, Vec3 root) {
+  const Vec3 r = f.R * Vec3(root.x, root.y, 0.f);
+  const Vec3 ax = f.R * Vec3(1.f, 0.f, 0.f);
+  return normalize_or(Vec3(r.x, r.y, 0.f), normalize_or(Vec3(ax.x, ax.y, 0.f), Vec3(1.f, 0.f, 0.f)));
+}
+}  // namespace brush_detail
+
+void brush_integrate(BristleState s, BristleRest r, BrushFrame f, BrushForces e, float beta_B, float damping,
+                     float dt) {
+  const int V = s.per_bristle;
+  parallel_for(s.count(), [=] WB_HD(int64_t g) {
+    s.xb_old[g] = s.xb[g];
+    s.vb_old[g] = s.vb[g];
+    s.x_old[g] = s.x[g];
+    s.v_old[g] = s.v[g];
+    const int64_t k = g / V;
+    if (g % V == 0) {  // the root is pinned in the ferrule
+      s.xb[g] = r.root[k];
+      s.vb[g] = Vec3();
+      return;
+    }
+    Vec3 dv_canvas = e.gravity * dt;
+    if (e.has_drag) dv_canvas += brush::drag_velocity_change(e.drag, s.x[g], s.v[g], dt);
+    const Vec3 a = brush::eq2_acceleration(f.R_B * (dv_canvas / dt), f, s.xb[g], s.vb[g], beta_B);
+    const float length = r.seg_length[k * V + 1] * float(V - 1);
+    Vec3 vb = (s.vb[g] * (1.f - damping) + a * dt);
+    vb = brush::clamp_length(vb, length / dt);
+    s.vb[g] = vb;
+    s.xb[g] = s.xb[g] + vb * dt;
+  });
+}
+
+void brush_solve(BristleState s, BristleRest r, BrushFrame f, SolidField solid, int iterations, float friction_it) {
+  const int V = s.per_bristle;
+  parallel_for(s.bristles, [=] WB_HD(int64_t k) {
+    const int64_t base = k * V;
+    const Vec3 d0 = r.dir[k];
+    const float kb = r.bend_k[k];
+    const Vec3 splay = brush_detail::splay_direction(f, r.root[k]);
+    for (int it = 0; it < iterations; ++it) {
+      for (int i = 1; i < V; ++i) {
+        const int64_t g = base + i;
+        const float l0 = r.seg_length[g];
+        const float tol = 1e-5f * l0;
+        const Vec3 xp = s.xb[g - 1];
+        const Vec3 dir = i == 1 ? d0 : normalize_or(xp - s.xb[g - 2], d0);
+        Vec3 xi = brush::project_bending(s.xb[g], xp + dir * l0, kb, tol);
+        xi = brush::project_distance(xp, xi, l0, tol, dir);
+        Vec3 xc = f.R * xi + f.p;
+        if (brush::collide_vertex(xc, f.R * xp + f.p, l0, solid, splay)) {
+          xc = brush::apply_friction(xc, s.x_old[g], friction_it);
+          xi = f.R_B * (xc - f.p);
+        }
+        s.xb[g] = xi;
+      }
+    }
+  });
+}
+
+void brush_grid_keys(BristleState s, float h, uint32_t mask, uint32_t* keys, uint32_t* ids) {
+  parallel_for(s.count(), [=] WB_HD(int64_t g) {
+    const Vec3 x = s.xb[g];
+    keys[g] = brush::hash_cell(brush::floor_to_int(x.x / h), brush::floor_to_int(x.y / h), brush::floor_to_int(x.z / h),
+                               mask);
+    ids[g] = uint32_t(g);
+  });
+}
+
+void brush_grid_clear(uint32_t* cell_start, uint32_t* cell_end, int64_t table) {
+  parallel_for(table, [=] WB_HD(int64_t i) {
+    cell_start[i] = 0xFFFFFFFFu;
+    cell_end[i] = 0u;
+  });
+}
+
+void brush_grid_ranges(const uint32_t* keys, int64_t n, uint32_t* cell_start, uint32_t* cell_end) {
+  parallel_for(n, [=] WB_HD(int64_t i) {
+    const uint32_t key = keys[i];
+    if (i == 0 || keys[i - 1] != key) cell_start[key] = uint32_t(i);
+    if (i == n - 1 || keys[i + 1] != key) cell_end[key] = uint32_t(i + 1);
+  });
+}
+
+namespace brush_detail {
+/// Visits every vertex of another bristle within h of vertex g (27 cells of the hash
+/// grid; each candidate's own cell is checked so that hash collisions are not counted twice).
+template <typename F>
+WB_HD WB_INLINE void for_each_neighbour(const BristleState& s, const MinDensityGrid& grid, int64_t g, F&& fn) {
+  const Vec3 x = s.xb[g];
+  const int V = s.per_bristle;
+  const int cx = brush::floor_to_int(x.x / grid.h), cy = brush::floor_to_int(x.y / grid.h),
+            cz = brush::floor_to_int(x.z / grid.h);
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const uint32_t key = brush::hash_cell(cx + dx, cy + dy, cz + dz, grid.mask);
+        const uint32_t b = grid.cell_start[key];
+        if (b == 0xFFFFFFFFu) continue;
+        for (uint32_t q = b; q < grid.cell_end[key]; ++q) {
+          const int64_t j = grid.ids[q];
+          if (j / V == g / V) continue;
+          const Vec3 xj = s.xb[j];
+          if (brush::floor_to_int(xj.x / grid.h) != cx + dx || brush::floor_to_int(xj.y / grid.h) != cy + dy ||
+              brush::floor_to_int(xj.z / grid.h) != cz + dz)
+            continue;
+          const Vec3 d = x - xj;
+          const float r = length(d);
+          if (r < grid.h) fn(j, d, r);
+        }
+      }
+}
+}  // namespace brush_detail
+
+void brush_density_lambda(BristleState s, MinDensityGrid grid, float* lambda) {
+  parallel_for(s.count(), [=] WB_HD(int64_t g) {
+    float rho = 0.f, sum_grad2 = 0.f;
+    Vec3 grad_i;
+    brush_detail::for_each_neighbour(s, grid, g, [&](int64_t j, Vec3 d, float r) {
+      rho += brush::density_kernel(r, grid.h);
+      const Vec3 u = r > 1e-6f ? d / r : brush::separation_dir(g, j);
+      const Vec3 gj = u * (brush::density_kernel_dr(r, grid.h) / grid.rho0);  // grad_i of W, / rho0
+      grad_i += gj;
+      sum_grad2 += length2(gj);
+    });
+    const float C = rho / grid.rho0 - 1.f;  // Macklin & Müller 2013 Eq. 1, unilateral
+    lambda[g] = C > 0.f ? -C / (sum_grad2 + length2(grad_i) + grid.eps) : 0.f;
+  });
+}
+
+void brush_density_delta(BristleState s, MinDensityGrid grid, const float* lambda) {
+  parallel_for(s.count(), [=] WB_HD(int64_t g) {
+    const float li = lambda[g];
+    Vec3 dx;
+    brush_detail::for_each_neighbour(s, grid, g, [&](int64_t j, Vec3 d, float r) {
+      const float lsum = li + lambda[j];
+      if (lsum == 0.f) return;
+      const Vec3 u = r > 1e-6f ? d / r : brush::separation_dir(g, j);
+      dx += u * (lsum * brush::density_kernel_dr(r, grid.h) / grid.rho0);  // Macklin & Müller 2013 Eq. 12
+    });
+    s.delta[g] = dx;
+  });
+}
+
+void brush_density_apply(BristleState s) {
+  const int V = s.per_bristle;
+  parallel_for(s.count(), [=] WB_HD(int64_t g) {
+    if (g % V != 0) s.xb[g] = s.xb[g] + s.delta[g];
+  });
+}
+
+void brush_finalize(BristleState s, BristleRest r, BrushFrame f, SolidField solid, float dt) {
+  const int V = s.per_bristle;
+  const float inv_dt = 1.f / dt;
+  parallel_for(s.bristles, [=] WB_HD(int64_t k) {
+    const int64_t base = k * V;
+    const Vec3 d0 = r.dir[k];
+    const Vec3 splay = brush_detail::splay_direction(f, r.root[k]);
+    for (int i = 1; i < V; ++i) {  // exact inextensibility, root to tip, then the surfaces
+      const int64_t g = base + i;
+      const float l0 = r.seg_length[g];
+      const Vec3 xp = s.xb[g - 1];
+      Vec3 xi = brush::project_distance(xp, s.xb[g], l0, 1e-6f * l0, d0);
+      Vec3 xc = f.R * xi + f.p;
+      if (brush::collide_vertex(xc, f.R * xp + f.p, l0, solid, splay)) xi = f.R_B * (xc - f.p);
+      s.xb[g] = xi;
+    }
+    for (int i = 0; i < V; ++i) {  // PBD velocities from the position change
+      const int64_t g = base + i;
+      const Vec3 x = f.R * s.xb[g] + f.p;
+      s.x[g] = x;
+      s.v[g] = (x - s.x_old[g]) * inv_dt;
+      s.vb[g] = i == 0 ? Vec3() : (s.xb[g] - s.xb_old[g]) * inv_dt;
+    }
+  });
+}
+
+void brush_restore(BristleState s, BrushFrame f) {
+  parallel_for(s.count(), [=] WB_HD(int64_t g) {
+    s.xb[g] = s.xb_old[g];
+    s.vb[g] = Vec3();
+    s.x[g] = f.R * s.xb[g] + f.p;
+    s.v[g] = Vec3();
+  });
+}
+
+void brush_place(BristleState s, BristleRest r, BrushFrame f) {
+  parallel_for(s.count(), [=] WB_HD(int64_t g) {
+    const Vec3 x = f.R * s.xb[g] + f.p;
+    s.x[g] = s.x_old[g] = x;
+    s.xb_old[g] = s.xb[g];
+    s.vb[g] = s.vb_old[g] = s.v[g] = s.v_old[g] = Vec3();
+  });
+}
+
+void brush_stretch_and_z(BristleState s, BristleRest r, float* stretch, float* z) {
+  const int V = s.per_bristle;
+  parallel_for(s.count(), [=] WB_HD(int64_t g) {
+    z[g] = s.x[g].z;
+    if (g % V == 0) {
+      stretch[g] = 0.f;
+      return;
+    }
+    const float l0 = r.seg_length[g];
+    stretch[g] = fabsf(length(s.xb[g] - s.xb[g - 1]) - l0) / l0;
+  });
+}
+
+// ---------------------------------------------------------------------------------
+// Samples
+// ---------------------------------------------------------------------------------
+
+void samples_spline(BristleState s, SampleView sv, SamplePrev prev, SolidField solid) {
+  const int V = s.per_bristle, S = sv.per_bristle;
+  const float scale = float(V - 1) / float(S - 1);
+  parallel_for(sv.count(), [=] WB_HD(int64_t q) {
+    prev.x[q] = sv.x[q];
+    prev.t[q] = sv.t[q];
+    prev.n[q] = sv.n[q];
+    prev.v[q] = sv.v[q];
+    prev.omega[q] = sv.omega[q];
+    const int64_t k = q / S;
+    const int j = int(q % S);
+    const Vec3* vx = s.x + k * V;
+    const float sp = float(j) * scale;
+    int i = int(sp);
+    if (i > V - 2) i = V - 2;
+    const float u = sp - float(i);
+    Vec3 d;
+    Vec3 x = brush::hermite(vx[i], brush::fd_tangent(vx, i, V), vx[i + 1], brush::fd_tangent(vx, i + 1, V), u, d);
+    const float h = brush::support_height(solid, x);  // the spline may dip below a vertex
+    if (x.z < h) x.z = h;
+    sv.x[q] = x;
+    sv.t[q] = normalize_or(d, normalize_or(vx[i + 1] - vx[i], Vec3(0.f, 0.f, -1.f)));
+  });
+}
+
+void samples_frames(SampleView sv, BrushFrame f) {
+  const int S = sv.per_bristle;
+  parallel_for(sv.bristles, [=] WB_HD(int64_t k) {
+    const int64_t base = k * S;
+    // Root frame attached to the brush: the handle's x axis made normal to the tangent.
+    const Vec3 t0 = sv.t[base];
+    const Vec3 ax = f.R.col(0), ay = f.R.col(1);
+    Vec3 n = ax - t0 * dot(t0, ax);
+    if (length2(n) < 1e-6f) n = ay - t0 * dot(t0, ay);
+    n = normalize(n);
+    sv.n[base] = n;
+    sv.b[base] = cross(t0, n);
+    for (int j = 1; j < S; ++j) {
+      const Vec3 t = sv.t[base + j];
+      n = brush::parallel_transport(n, sv.t[base + j - 1], t);
+      n = normalize_or(n - t * dot(t, n), sv.n[base + j - 1]);  // keep orthonormal against rounding
+      sv.n[base + j] = n;
+      sv.b[base + j] = cross(t, n);
+    }
+  });
+}
+
+void samples_motion(SampleView sv, SamplePrev prev, float dt, int history) {
+  const float inv_dt = 1.f / dt;
+  parallel_for(sv.count(), [=] WB_HD(int64_t q) {
+    if (history < 1) {
+      sv.v[q] = sv.omega[q] = sv.a[q] = sv.alpha[q] = Vec3();
+      return;
+    }
+    const Vec3 v = (sv.x[q] - prev.x[q]) * inv_dt;
+    const Mat3 F = Mat3::from_columns(sv.t[q], sv.n[q], sv.b[q]);
+    const Mat3 F0 = Mat3::from_columns(prev.t[q], prev.n[q], cross(prev.t[q], prev.n[q]));
+    const Vec3 omega = brush::rotation_vector(F * transpose(F0)) * inv_dt;  // canvas frame
+    sv.v[q] = v;
+    sv.omega[q] = omega;
+    if (history < 2) {
+      sv.a[q] = sv.alpha[q] = Vec3();
+    } else {
+      sv.a[q] = (v - prev.v[q]) * inv_dt;
+      sv.alpha[q] = (omega - prev.omega[q]) * inv_dt;
+    }
+  });
+}
+
+void samples_z(SampleView sv, float* z) {
+  parallel_for(sv.count(), [=] WB_HD(int64_t q) { z[q] = sv.x[q].z; });
+}
+
+void samples_rasterize(SampleView sv, float radius, Int3 origin, Int3 dims, float* psi, float* vx, float* vy,
+                       float* vz) {
+  const int S = sv.per_bristle;
+  parallel_for(sv.count(), [=] WB_HD(int64_t q) {
+    const int j = int(q % S);
+    const Vec3 x = sv.x[q];
+    const float gp = j > 0 ? length(x - sv.x[q - 1]) : 0.f;
+    const float gn = j < S - 1 ? length(sv.x[q + 1] - x) : 0.f;
+    const float vol = brush::sample_volume(radius, gp, gn);
+    // Cell-centred trilinear splat: cell (i, j, k) of the window is centred at origin + (i, j, k) + 0.5.
+    const float gx = x.x - origin.x - 0.5f, gy = x.y - origin.y - 0.5f, gz = x.z - origin.z - 0.5f;
+    const int i0 = brush::floor_to_int(gx), j0 = brush::floor_to_int(gy), k0 = brush::floor_to_int(gz);
+    if (i0 < -1 || j0 < -1 || k0 < -1 || i0 >= dims.x || j0 >= dims.y || k0 >= dims.z) return;
+    const float fx = gx - i0, fy = gy - j0, fz = gz - k0;
+    const Vec3 v = sv.v[q];
+    for (int c = 0; c < 8; ++c) {
+      const int ci = i0 + (c & 1), cj = j0 + ((c >> 1) & 1), ck = k0 + ((c >> 2) & 1);
+      if (ci < 0 || cj < 0 || ck < 0 || ci >= dims.x || cj >= dims.y || ck >= dims.z) continue;
+      const float w = ((c & 1) ? fx : 1.f - fx) * (((c >> 1) & 1) ? fy : 1.f - fy) * (((c >> 2) & 1) ? fz : 1.f - fz);
+      if (w <= 0.f) continue;
+      const int64_t at = (int64_t(ck) * dims.y + cj) * dims.x + ci;
+      const float m = w * vol;
+      atomic_add(&psi[at], m);
+      atomic_add(&vx[at], m * v.x);
+      atomic_add(&vy[at], m * v.y);
+      atomic_add(&vz[at], m * v.z);
+    }
+  });
+}
+
+void samples_rasterize_finish(int64_t cells, float* psi, float* vx, float* vy, float* vz) {
+  parallel_for(cells, [=] WB_HD(int64_t i) {
+    const float p = psi[i];
+    if (p <= 0.f) return;
+    const float inv = 1.f / p;
+    vx[i] *= inv;
+    vy[i] *= inv;
+    vz[i] *= inv;
+    psi[i] = minf(p, 1.f);
+  });
+}
+
+void samples_contact_keys(SampleView sv, SolidField solid, float contact_height, int32_t* trace, int trace_w,
+                          int trace_h, int ox, int oy, uint32_t* keys, uint32_t* vals) {
+  const uint32_t sentinel = uint32_t(trace_w) * uint32_t(trace_h);
+  parallel_for(sv.count(), [=] WB_HD(int64_t q) {
+    const Vec3 x = sv.x[q];
+    vals[q] = uint32_t(q);
+    keys[q] = sentinel;
+    if (!(x.z - brush::ground_below(solid, x, contact_height) < contact_height)) return;
+    const int cx = brush::floor_to_int(x.x) - ox, cy = brush::floor_to_int(x.y) - oy;
+    if (cx < 0 || cy < 0 || cx >= trace_w || cy >= trace_h) return;
+    const uint32_t at = uint32_t(cy) * uint32_t(trace_w) + uint32_t(cx);
+    atomic_or(&trace[at], 1);
+    keys[q] = at;
+  });
+}
+
+void count_distinct_flags(const uint32_t* keys, int64_t n, uint32_t sentinel, float* flags) {
+  parallel_for(n, [=] WB_HD(int64_t i) {
+    flags[i] = keys[i] != sentinel && (i == 0 || keys[i - 1] != keys[i]) ? 1.f : 0.f;
+  });
+}
+
+}  // namespace wb::WB_BACKEND_NS
