@@ -1,0 +1,150 @@
+// Brush settings as JSON: one table of fields and ranges drives reading, writing and
+// validation (paper §4.1; bristle counts and sizes per docs/FORMATS.md).
+#include "core/io/brush_json.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <sstream>
+#include <variant>
+
+#include <nlohmann/json.hpp>
+
+#include "core/exec/error.h"
+
+namespace wb {
+namespace {
+
+using Member = std::variant<int BrushSpec::*, float BrushSpec::*, uint32_t BrushSpec::*>;
+
+struct Field {
+  BrushFieldRange range;
+  Member member;
+};
+
+const std::vector<Field>& fields() {
+  static const std::vector<Field> table = {
+      {{"bristles", 40, 600, true}, &BrushSpec::bristles},
+      {{"vertices_per_bristle", 4, 32, true}, &BrushSpec::vertices_per_bristle},
+      {{"samples_per_bristle", 16, 256, true}, &BrushSpec::samples_per_bristle},
+      {{"length", 1, 1000, false}, &BrushSpec::length},
+      {{"width", 1, 1000, false}, &BrushSpec::width},
+      {{"thickness", 1, 1000, false}, &BrushSpec::thickness},
+      {{"length_variation", 0, 0.5, false}, &BrushSpec::length_variation},
+      {{"stiffness", 0, 1, false}, &BrushSpec::stiffness},
+      {{"stiffness_variation", 0, 0.9, false}, &BrushSpec::stiffness_variation},
+      {{"bristle_radius", 0.01, 5, false}, &BrushSpec::bristle_radius},
+      // Paper Table 1 uses [0, 0.1]; 1 is plain Newtonian dynamics (Eq. 2), still valid.
+      {{"beta_B", 0, 1, false}, &BrushSpec::beta_B},
+      // 1 would put the ferrule on the canvas at full pressure.
+      {{"max_press", 0, 0.9, false}, &BrushSpec::max_press},
+      {{"seed", 0, 4294967295.0, true}, &BrushSpec::seed},
+  };
+  return table;
+}
+
+double get_value(const BrushSpec& b, const Member& m) {
+  return std::visit([&](auto p) { return double(b.*p); }, m);
+}
+
+void set_value(BrushSpec& b, const Member& m, double v) {
+  std::visit(
+      [&](auto p) {
+        using T = std::remove_reference_t<decltype(b.*p)>;
+        b.*p = T(v);
+      },
+      m);
+}
+
+std::string fmt(double v) {
+  std::ostringstream os;
+  os.precision(9);
+  os << v;
+  return os.str();
+}
+
+std::string json_type_name(const nlohmann::json& v) {
+  if (v.is_string()) return "a string (" + v.dump() + ")";
+  return std::string(v.type_name());
+}
+
+/// Float written as the shortest decimal that reads back to the same float, so files
+/// show 0.1 rather than 0.10000000149011612.
+double float_for_json(float v) {
+  char buf[32];
+  auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::strtod(std::string(buf, r.ptr).c_str(), nullptr);
+}
+
+}  // namespace
+
+const std::vector<BrushFieldRange>& brush_field_ranges() {
+  static const std::vector<BrushFieldRange> ranges = [] {
+    std::vector<BrushFieldRange> r;
+    for (const Field& f : fields()) r.push_back(f.range);
+    return r;
+  }();
+  return ranges;
+}
+
+nlohmann::json brush_to_json(const BrushSpec& brush) {
+  nlohmann::json j = nlohmann::json::object();
+  j["shape"] = to_string(brush.shape);
+  for (const Field& f : fields()) {
+    const double v = get_value(brush, f.member);
+    if (f.range.integer)
+      j[f.range.key] = int64_t(v);
+    else
+      j[f.range.key] = float_for_json(float(v));
+  }
+  return j;
+}
+
+void validate_brush(const BrushSpec& brush, const std::string& context) {
+  for (const Field& f : fields()) {
+    const double v = get_value(brush, f.member);
+    if (!std::isfinite(v) || v < f.range.min || v > f.range.max)
+      WB_THROW(context + "." + f.range.key + ": " + fmt(v) + " is outside [" + fmt(f.range.min) + ", " +
+               fmt(f.range.max) + "]");
+  }
+}
+
+BrushSpec brush_from_json(const nlohmann::json& j, const std::string& context, std::vector<std::string>* warnings) {
+  if (!j.is_object()) WB_THROW(context + ": expected an object, found " + json_type_name(j));
+  BrushShape shape = BrushShape::Round;
+  if (auto it = j.find("shape"); it != j.end()) {
+    if (!it->is_string()) WB_THROW(context + ".shape: expected a string, found " + json_type_name(*it));
+    try {
+      shape = brush_shape_from_string(it->get<std::string>());
+    } catch (const Error& e) {
+      std::string msg = e.what();
+      if (const size_t tag = msg.rfind(" ["); tag != std::string::npos && msg.back() == ']') msg.resize(tag);
+      WB_THROW(context + ".shape: " + msg);
+    }
+  }
+  BrushSpec b = default_brush(shape);
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string& key = it.key();
+    if (key == "shape") continue;
+    const Field* field = nullptr;
+    for (const Field& f : fields())
+      if (key == f.range.key) field = &f;
+    if (!field) {
+      if (warnings) warnings->push_back(context + ": unknown key '" + key + "' ignored");
+      continue;
+    }
+    const nlohmann::json& v = *it;
+    const std::string where = context + "." + key;
+    if (!v.is_number()) WB_THROW(where + ": expected a number, found " + json_type_name(v));
+    const double d = v.get<double>();
+    if (!std::isfinite(d)) WB_THROW(where + ": not a finite number");
+    if (field->range.integer && d != std::floor(d)) WB_THROW(where + ": expected an integer, found " + fmt(d));
+    if (d < field->range.min || d > field->range.max)
+      WB_THROW(where + ": " + fmt(d) + " is outside [" + fmt(field->range.min) + ", " + fmt(field->range.max) + "]");
+    set_value(b, field->member, d);
+  }
+  return b;
+}
+
+}  // namespace wb

@@ -1,0 +1,191 @@
+// Stroke replay at the simulation rate (Figure 4 step 1 input; DESIGN "Time": sub-steps
+// when the brush moves more than a few cells in a step).
+#include "core/io/stroke_player.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/exec/error.h"
+#include "core/io/pen_pose.h"
+
+namespace wb {
+namespace {
+
+/// Shortest signed angle from a to b, degrees, in (-180, 180].
+float shortest_angle(float a, float b) {
+  float d = std::fmod(b - a, 360.f);
+  if (d > 180.f) d -= 360.f;
+  if (d <= -180.f) d += 360.f;
+  return d;
+}
+
+/// Points whose motion bounds the bristles' motion: the ferrule centre, the ferrule's
+/// four edge midpoints and the rest-shape tip.
+constexpr int kRefPoints = 6;
+void reference_points(const BrushPose& p, const BrushSpec& b, Vec3 out[kRefPoints]) {
+  const Vec3 ex = p.rotation.col(0), ey = p.rotation.col(1), ez = p.rotation.col(2);
+  out[0] = p.position;
+  out[1] = p.position + ex * (0.5f * b.width);
+  out[2] = p.position - ex * (0.5f * b.width);
+  out[3] = p.position + ey * (0.5f * b.thickness);
+  out[4] = p.position - ey * (0.5f * b.thickness);
+  out[5] = p.position - ez * b.length;
+}
+
+float max_displacement(const Vec3 a[kRefPoints], const Vec3 b[kRefPoints]) {
+  float m = 0.f;
+  for (int i = 0; i < kRefPoints; ++i) m = std::max(m, length(b[i] - a[i]));
+  return m;
+}
+
+}  // namespace
+
+StrokePlayer::StrokePlayer(Stroke stroke) : stroke_(std::move(stroke)) {
+  validate_stroke(stroke_);
+  const auto& s = stroke_.samples;
+  keys_.reserve(s.size() + 2);
+  const auto key_of = [](const PenSample& p, double t, float e) {
+    return Key{t, p.x, p.y, e, p.tilt_x, p.tilt_y, p.twist, 0.f};
+  };
+  if (stroke_.lead_in > 0) keys_.push_back(key_of(s.front(), s.front().t - stroke_.lead_in, -1.f));
+  for (const PenSample& p : s) keys_.push_back(key_of(p, p.t, pen_elevation(p)));
+  if (stroke_.lead_out > 0) keys_.push_back(key_of(s.back(), s.back().t + stroke_.lead_out, -1.f));
+  for (size_t i = 0; i + 1 < keys_.size(); ++i) keys_[i].twist_delta = shortest_angle(keys_[i].twist, keys_[i + 1].twist);
+  // The tiny tolerance keeps an exact multiple of dt from gaining a step to rounding.
+  step_count_ = std::max<int64_t>(1, int64_t(std::ceil(duration() / stroke_.dt - 1e-9)));
+}
+
+void StrokePlayer::rewind() {
+  next_index_ = 0;
+  next_event_ = 0;
+  prev_contact_ = false;
+}
+
+size_t StrokePlayer::segment(double t) const {
+  // Last key with key.t <= t, but never the last key (so that [i, i+1] is a segment).
+  const auto it = std::upper_bound(keys_.begin(), keys_.end(), t, [](double v, const Key& k) { return v < k.t; });
+  size_t i = it == keys_.begin() ? 0 : size_t(it - keys_.begin()) - 1;
+  return keys_.size() < 2 ? 0 : std::min(i, keys_.size() - 2);
+}
+
+StrokePlayer::Key StrokePlayer::interpolate(double t) const {
+  if (keys_.size() == 1 || t <= keys_.front().t) return keys_.front();
+  if (t >= keys_.back().t) return keys_.back();
+  const size_t i = segment(t);
+  const Key& k0 = keys_[i];
+  const Key& k1 = keys_[i + 1];
+  // a = 0 reproduces k0 exactly, so poses at sample times are the samples' poses.
+  const float a = float((t - k0.t) / (k1.t - k0.t));
+  Key k = k0;
+  k.t = t;
+  k.x = k0.x + a * (k1.x - k0.x);
+  k.y = k0.y + a * (k1.y - k0.y);
+  k.e = k0.e + a * (k1.e - k0.e);
+  k.tilt_x = k0.tilt_x + a * (k1.tilt_x - k0.tilt_x);
+  k.tilt_y = k0.tilt_y + a * (k1.tilt_y - k0.tilt_y);
+  k.twist = k0.twist + a * k0.twist_delta;
+  return k;
+}
+
+PenSample StrokePlayer::pen_at(double t) const {
+  const Key k = interpolate(t);
+  PenSample p;
+  p.t = t;
+  p.x = k.x;
+  p.y = k.y;
+  p.pressure = std::max(k.e, 0.f);
+  p.down = k.e >= 0.f;
+  p.tilt_x = k.tilt_x;
+  p.tilt_y = k.tilt_y;
+  p.twist = k.twist;
+  return p;
+}
+
+float StrokePlayer::elevation_at(double t) const { return interpolate(t).e; }
+
+BrushPose StrokePlayer::pose_at(double t) const {
+  const Key k = interpolate(t);
+  PenSample p;
+  p.x = k.x;
+  p.y = k.y;
+  p.tilt_x = k.tilt_x;
+  p.tilt_y = k.tilt_y;
+  p.twist = k.twist;
+  return pose_from_pen(p, k.e, stroke_.brush);
+}
+
+int StrokePlayer::substeps_for(double ta, double tb, float* max_move) const {
+  const float limit = stroke_.max_move_per_substep;
+  const int cap = stroke_.max_substeps;
+  Vec3 a[kRefPoints], b[kRefPoints];
+  // First guess: the longest reference-point path through this step (keys bend it).
+  std::vector<double> breaks{ta};
+  for (const Key& k : keys_)
+    if (k.t > ta && k.t < tb) breaks.push_back(k.t);
+  breaks.push_back(tb);
+  float path = 0.f;
+  {
+    constexpr int kChunks = 8;  // rotations make reference paths curved within a segment
+    float per_point[kRefPoints] = {};
+    reference_points(pose_at(ta), stroke_.brush, a);
+    for (size_t s = 0; s + 1 < breaks.size(); ++s) {
+      for (int c = 1; c <= kChunks; ++c) {
+        const double t = breaks[s] + (breaks[s + 1] - breaks[s]) * double(c) / kChunks;
+        reference_points(pose_at(t), stroke_.brush, b);
+        for (int i = 0; i < kRefPoints; ++i) per_point[i] += length(b[i] - a[i]);
+        std::copy(b, b + kRefPoints, a);
+      }
+    }
+    for (float v : per_point) path = std::max(path, v);
+  }
+  int n = std::clamp(int(std::ceil(path / limit)), 1, cap);
+  // Check the uniform sub-steps (speed varies within a step) and refine.
+  for (;;) {
+    float worst = 0.f;
+    reference_points(pose_at(ta), stroke_.brush, a);
+    for (int k = 1; k <= n; ++k) {
+      const double t = k == n ? tb : ta + (tb - ta) * double(k) / double(n);
+      reference_points(pose_at(t), stroke_.brush, b);
+      worst = std::max(worst, max_displacement(a, b));
+      std::copy(b, b + kRefPoints, a);
+    }
+    if (worst <= limit || n >= cap) {
+      *max_move = worst;
+      return n;
+    }
+    n = std::min(cap, std::max(n + 1, int(std::ceil(double(n) * worst / limit))));
+  }
+}
+
+bool StrokePlayer::next(PlayerStep& out) {
+  if (next_index_ >= step_count_) return false;
+  const double dt = stroke_.dt;
+  const int64_t k = next_index_++;
+  out.index = k;
+  out.t_begin = t_begin() + double(k) * dt;
+  out.t = t_begin() + double(k + 1) * dt;
+  out.dt = dt;
+  out.substeps = substeps_for(out.t_begin, out.t, &out.max_move);
+  out.pen = pen_at(out.t);
+  out.elevation = elevation_at(out.t);
+  out.pose = pose_from_pen(out.pen, out.elevation, stroke_.brush);
+
+  // Elevation is piecewise linear: its maximum over the step is at an end or a key.
+  float e_max = std::max(elevation_at(out.t_begin), out.elevation);
+  for (const Key& key : keys_)
+    if (key.t > out.t_begin && key.t < out.t) e_max = std::max(e_max, key.e);
+  out.pen_down = e_max >= 0.f;
+  out.pen_down_edge = out.pen_down && !prev_contact_;
+  out.pen_up_edge = !out.pen_down && prev_contact_;
+  prev_contact_ = out.pen_down;
+
+  // Each event fires once: in the first step ending at or after it (the last step takes the rest).
+  const auto& ev = stroke_.events;
+  const size_t first = next_event_;
+  const bool last = next_index_ == step_count_;
+  while (next_event_ < ev.size() && (last || ev[next_event_].t <= out.t)) ++next_event_;
+  out.events = std::span<const StrokeEvent>(ev.data() + first, next_event_ - first);
+  return true;
+}
+
+}  // namespace wb
