@@ -2,6 +2,7 @@
 #include "core/particles/hash_grid.h"
 
 #include <cmath>
+#include <cstdint>
 #include <string>
 
 #include "core/exec/algorithms.h"
@@ -9,12 +10,13 @@
 
 namespace wb {
 namespace {
-void keys(const Device& d, const Vec3* x, int64_t n, float inv_h, uint32_t mask, uint32_t* k, uint32_t* idx) {
-  WB_DISPATCH(d, hash_grid_keys(x, n, inv_h, mask, k, idx));
+void keys(const Device& d, const Vec3* x, const Vec3* v, float rw, int64_t n, float inv_h, uint32_t mask, uint32_t* k,
+          uint32_t* idx, int32_t* bounds) {
+  WB_DISPATCH(d, hash_grid_keys(x, v, rw, n, inv_h, mask, k, idx, bounds));
 }
-void ranges(const Device& d, const uint32_t* k, const uint32_t* idx, const Vec3* x, int64_t n, uint32_t* s,
-            uint32_t* e, Vec3* sx) {
-  WB_DISPATCH(d, hash_grid_ranges(k, idx, x, n, s, e, sx));
+void ranges(const Device& d, const uint32_t* k, const uint32_t* idx, const Vec3* x, const Vec3* v, float rw, int64_t n,
+            uint32_t* s, uint32_t* e, Vec3* sx) {
+  WB_DISPATCH(d, hash_grid_ranges(k, idx, x, v, rw, n, s, e, sx));
 }
 void query(const Device& d, HashGridView g, ParticleView p, float r) { WB_DISPATCH(d, hash_grid_query(g, p, r)); }
 }  // namespace
@@ -25,15 +27,18 @@ SampleHashGrid::SampleHashGrid(const Device& device) : device_(device) {
   start_.set_device(device);
   end_.set_device(device);
   sorted_x_.set_device(device);
+  bounds_.set_device(device);
 }
 
-void SampleHashGrid::build(const SampleView& s, float cell_size, Workspace& ws) {
+void SampleHashGrid::build(const SampleView& s, float cell_size, Workspace& ws, float rewind_dt) {
   WB_REQUIRE(std::isfinite(cell_size) && cell_size > 0.f,
              "SampleHashGrid::build: cell size must be positive, got " + std::to_string(cell_size));
   WB_REQUIRE(s.bristles >= 0 && s.per_bristle >= 0, "SampleHashGrid::build: negative sample counts");
   const int64_t n = s.count();
   WB_REQUIRE(n < (int64_t(1) << 31), "SampleHashGrid::build: too many samples (" + std::to_string(n) + ")");
   WB_REQUIRE(n == 0 || s.x != nullptr, "SampleHashGrid::build: sample positions are null");
+  WB_REQUIRE(std::isfinite(rewind_dt) && rewind_dt >= 0.f, "SampleHashGrid::build: rewind time must be >= 0");
+  WB_REQUIRE(rewind_dt == 0.f || n == 0 || s.v != nullptr, "SampleHashGrid::build: rewinding needs sample velocities");
   count_ = n;
   h_ = cell_size;
   // About two buckets per sample keeps collisions rare; at least 1024.
@@ -47,19 +52,22 @@ void SampleHashGrid::build(const SampleView& s, float cell_size, Workspace& ws) 
   }
   start_.fill_zero();
   end_.fill_zero();
+  // Empty box (lo > hi) until the key pass widens it with integer atomics.
+  const int32_t empty_box[6] = {INT32_MAX, INT32_MAX, INT32_MAX, INT32_MIN, INT32_MIN, INT32_MIN};
+  bounds_.copy_from_host(empty_box, 6);
   if (n == 0) return;
   if (keys_.size() < size_t(n)) {
     keys_.grow_keep(size_t(n));
     index_.grow_keep(size_t(n));
     sorted_x_.grow_keep(size_t(n));
   }
-  keys(device_, s.x, n, 1.f / h_, mask_, keys_.data(), index_.data());
+  keys(device_, s.x, s.v, rewind_dt, n, 1.f / h_, mask_, keys_.data(), index_.data(), bounds_.data());
   sort_by_key(device_, keys_.data(), index_.data(), n, bits, ws);
-  ranges(device_, keys_.data(), index_.data(), s.x, n, start_.data(), end_.data(), sorted_x_.data());
+  ranges(device_, keys_.data(), index_.data(), s.x, s.v, rewind_dt, n, start_.data(), end_.data(), sorted_x_.data());
 }
 
 HashGridView SampleHashGrid::view() const {
-  return HashGridView{start_.data(), end_.data(), index_.data(), sorted_x_.data(), count_, h_, mask_};
+  return HashGridView{start_.data(), end_.data(), index_.data(), sorted_x_.data(), count_, h_, mask_, bounds_.data()};
 }
 
 void SampleHashGrid::query_nearest(const ParticleView& p, float max_range) const {

@@ -20,9 +20,12 @@ class SampleHashGrid {
   SampleHashGrid() = default;
   explicit SampleHashGrid(const Device& device);
 
-  /// Hashes the samples into cells of size cell_size (canvas cells). Buffers grow
-  /// geometrically and are kept: no allocation once warm.
-  void build(const SampleView& samples, float cell_size, Workspace& ws);
+  /// Hashes the samples into cells of size cell_size (canvas cells), at x - v rewind_dt.
+  /// The brush step runs first, so its samples hold t + dt while the particles are still at
+  /// t: the simulator passes the step's dt to compare both at t (the frame Eq. 9 starts
+  /// from, see local_frame_step); 0 hashes x as it is. Buffers grow geometrically and are
+  /// kept: no allocation once warm.
+  void build(const SampleView& samples, float cell_size, Workspace& ws, float rewind_dt = 0.f);
   /// For every particle: nearest = nearest sample within max_range (-1: none), d_B = its
   /// distance (max_range when none), key = the particle's bucket.
   void query_nearest(const ParticleView& particles, float max_range) const;
@@ -39,21 +42,24 @@ class SampleHashGrid {
   uint32_t mask_ = 0;
   DeviceBuffer<uint32_t> keys_, index_, start_, end_;
   DeviceBuffer<Vec3> sorted_x_;
+  DeviceBuffer<int32_t> bounds_;
 };
 
 /// Reference for tests: the nearest sample to p among all n (host arrays), within max_range.
 NearestSample nearest_sample_brute_force(const Vec3* samples, int64_t n, Vec3 p, float max_range);
 
 namespace cpu {
-void hash_grid_keys(const Vec3* x, int64_t n, float inv_h, uint32_t mask, uint32_t* keys, uint32_t* index);
-void hash_grid_ranges(const uint32_t* sorted_keys, const uint32_t* index, const Vec3* x, int64_t n, uint32_t* start,
-                      uint32_t* end, Vec3* sorted_x);
+void hash_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, uint32_t mask,
+                    uint32_t* keys, uint32_t* index, int32_t* bounds);
+void hash_grid_ranges(const uint32_t* sorted_keys, const uint32_t* index, const Vec3* x, const Vec3* v, float rewind_dt,
+                      int64_t n, uint32_t* start, uint32_t* end, Vec3* sorted_x);
 void hash_grid_query(HashGridView g, ParticleView p, float max_range);
 }  // namespace cpu
 namespace cuda {
-void hash_grid_keys(const Vec3* x, int64_t n, float inv_h, uint32_t mask, uint32_t* keys, uint32_t* index);
-void hash_grid_ranges(const uint32_t* sorted_keys, const uint32_t* index, const Vec3* x, int64_t n, uint32_t* start,
-                      uint32_t* end, Vec3* sorted_x);
+void hash_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, uint32_t mask,
+                    uint32_t* keys, uint32_t* index, int32_t* bounds);
+void hash_grid_ranges(const uint32_t* sorted_keys, const uint32_t* index, const Vec3* x, const Vec3* v, float rewind_dt,
+                      int64_t n, uint32_t* start, uint32_t* end, Vec3* sorted_x);
 void hash_grid_query(HashGridView g, ParticleView p, float max_range);
 }  // namespace cuda
 

@@ -1,27 +1,40 @@
 // Sample hash grid drivers (paper §6, Green 2010), compiled once per backend.
 #pragma once
+#include "core/exec/atomics.h"
 #include "core/exec/parallel_for.h"
 #include "core/particles/hash_grid.h"
 
 namespace wb::WB_BACKEND_NS {
 
-void hash_grid_keys(const Vec3* x, int64_t n, float inv_h, uint32_t mask, uint32_t* keys, uint32_t* index) {
+// Position hashed for sample i: x - v rewind_dt (v may be null when rewind_dt is 0).
+WB_HD WB_INLINE Vec3 hashed_position(const Vec3* x, const Vec3* v, float rewind_dt, int64_t i) {
+  return rewind_dt != 0.f ? x[i] - v[i] * rewind_dt : x[i];
+}
+
+void hash_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, uint32_t mask,
+                    uint32_t* keys, uint32_t* index, int32_t* bounds) {
   parallel_for(n, [=] WB_HD(int64_t i) {
     int cx, cy, cz;
-    hash_cell_of(x[i], inv_h, cx, cy, cz);
+    hash_cell_of(hashed_position(x, v, rewind_dt, i), inv_h, cx, cy, cz);
+    atomic_min(&bounds[0], int32_t(cx));
+    atomic_min(&bounds[1], int32_t(cy));
+    atomic_min(&bounds[2], int32_t(cz));
+    atomic_max(&bounds[3], int32_t(cx));
+    atomic_max(&bounds[4], int32_t(cy));
+    atomic_max(&bounds[5], int32_t(cz));
     keys[i] = hash_bucket(cx, cy, cz, mask);
     index[i] = uint32_t(i);
   });
 }
 
 // Buckets were zeroed (start == end == 0: empty); each run of equal keys marks its ends.
-void hash_grid_ranges(const uint32_t* sorted_keys, const uint32_t* index, const Vec3* x, int64_t n, uint32_t* start,
-                      uint32_t* end, Vec3* sorted_x) {
+void hash_grid_ranges(const uint32_t* sorted_keys, const uint32_t* index, const Vec3* x, const Vec3* v, float rewind_dt,
+                      int64_t n, uint32_t* start, uint32_t* end, Vec3* sorted_x) {
   parallel_for(n, [=] WB_HD(int64_t i) {
     const uint32_t k = sorted_keys[i];
     if (i == 0 || sorted_keys[i - 1] != k) start[k] = uint32_t(i);
     if (i == n - 1 || sorted_keys[i + 1] != k) end[k] = uint32_t(i + 1);
-    sorted_x[i] = x[index[i]];
+    sorted_x[i] = hashed_position(x, v, rewind_dt, int64_t(index[i]));
   });
 }
 

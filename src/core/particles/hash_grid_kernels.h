@@ -20,7 +20,11 @@ struct HashGridView {
   int64_t count;               ///< number of samples
   float h;                     ///< cell size, canvas cells
   uint32_t mask;               ///< bucket count - 1 (a power of two)
+  const int32_t* bounds;       ///< cell bounding box of the samples: lo x, y, z, hi x, y, z
 };
+
+WB_HD WB_INLINE int imax(int a, int b) { return a > b ? a : b; }
+WB_HD WB_INLINE int imin(int a, int b) { return a < b ? a : b; }
 
 /// Integer cell of p for cell size h.
 WB_HD WB_INLINE void hash_cell_of(Vec3 p, float inv_h, int& ix, int& iy, int& iz) {
@@ -55,28 +59,38 @@ WB_HD WB_INLINE void scan_bucket(const HashGridView& g, uint32_t bucket, Vec3 p,
 }
 
 /// Nearest sample to p within max_range. Shells of cells at Chebyshev ring R = 0, 1, ...
-/// around p's cell are visited in order; after ring R every unvisited sample is farther
-/// than R h, so the search stops once the best distance is below R h, or R h >= max_range.
+/// around p's cell are visited in order, clipped to the samples' cell bounding box; after
+/// ring R every unvisited sample is farther than R h, so the search stops once the best
+/// distance is below R h, R h reaches max_range, or the shell has left the box.
 WB_HD WB_INLINE NearestSample nearest_sample(const HashGridView& g, Vec3 p, float max_range) {
   NearestSample out{-1, max_range};
   if (g.count == 0) return out;
   const float inv_h = 1.f / g.h;
   int cx, cy, cz;
   hash_cell_of(p, inv_h, cx, cy, cz);
+  // Box of sample cells relative to p's cell.
+  const int lx = g.bounds[0] - cx, ly = g.bounds[1] - cy, lz = g.bounds[2] - cz;
+  const int hx = g.bounds[3] - cx, hy = g.bounds[4] - cy, hz = g.bounds[5] - cz;
+  const int r_box = imax(imax(imax(-lx, hx), imax(-ly, hy)), imax(-lz, hz));  // farthest box cell
+  const int r_near = imax(imax(imax(lx, -hx), imax(ly, -hy)), imax(imax(lz, -hz), 0));  // nearest box cell
   float best_d2 = max_range * max_range;
   int32_t best = -1;
   // Cells of ring R hold points at distance <= max_range only while (R - 1) h < max_range.
-  const int r_max = int(ceilf(max_range * inv_h)) + 1;
-  for (int R = 0; R <= r_max; ++R) {
-    for (int dz = -R; dz <= R; ++dz)
-      for (int dy = -R; dy <= R; ++dy) {
-        const bool face = (dz == -R || dz == R || dy == -R || dy == R);
-        const int step = face ? 1 : 2 * R;  // inner rows: only the two end cells are on the shell
-        for (int dx = -R; dx <= R; dx += (step > 0 ? step : 1))
-          scan_bucket(g, hash_bucket(cx + dx, cy + dy, cz + dz, g.mask), p, best_d2, best);
-      }
+  const int r_max = imin(int(ceilf(max_range * inv_h)) + 1, r_box);
+  for (int R = r_near; R <= r_max; ++R) {
     const float reach = float(R) * g.h;
-    if ((best >= 0 && best_d2 < reach * reach) || reach >= max_range) break;
+    if (R > 0 && float(R - 1) * g.h >= max_range) break;
+    for (int dz = imax(-R, lz); dz <= imin(R, hz); ++dz)
+      for (int dy = imax(-R, ly); dy <= imin(R, hy); ++dy) {
+        if (dz == -R || dz == R || dy == -R || dy == R) {
+          for (int dx = imax(-R, lx); dx <= imin(R, hx); ++dx)
+            scan_bucket(g, hash_bucket(cx + dx, cy + dy, cz + dz, g.mask), p, best_d2, best);
+        } else {  // inner rows: only the two end cells lie on the shell
+          if (lx <= -R && -R <= hx) scan_bucket(g, hash_bucket(cx - R, cy + dy, cz + dz, g.mask), p, best_d2, best);
+          if (lx <= R && R <= hx) scan_bucket(g, hash_bucket(cx + R, cy + dy, cz + dz, g.mask), p, best_d2, best);
+        }
+      }
+    if (best >= 0 && best_d2 < reach * reach) break;
   }
   if (best >= 0 && best_d2 < max_range * max_range) {
     out.index = best;

@@ -1,0 +1,103 @@
+// Sample hash grid (paper §6, Green 2010): the nearest-sample query against brute force.
+#include <random>
+
+#include "backend_fixture.h"
+#include "core/particles/hash_grid.h"
+#include "core/particles/particle_store.h"
+#include "particles/sample_fixture.h"
+
+namespace wb::test {
+
+class HashGridTest : public BackendTest {};
+
+namespace {
+ParticleHost particles_at(const std::vector<Vec3>& x) {
+  ParticleHost h;
+  h.resize(x.size());
+  h.x = x;
+  return h;
+}
+}  // namespace
+
+TEST_F(HashGridTest, NearestSampleEqualsBruteForce) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> U(0.f, 1.f);
+  // 40 curved bristles of 64 samples in an 80-cell box, plus particles spread around it
+  // (some beyond every range), so both hits and misses are exercised.
+  HostSamples hs;
+  hs.resize(40, 64);
+  for (int b = 0; b < 40; ++b) {
+    Vec3 p(1000.f + 60.f * U(rng), 2000.f + 60.f * U(rng), 20.f + 60.f * U(rng));
+    Vec3 dir = normalize(Vec3(U(rng) - 0.5f, U(rng) - 0.5f, -1.f));
+    for (int j = 0; j < 64; ++j) {
+      hs.x[size_t(b) * 64 + j] = p;
+      dir = normalize(dir + Vec3(U(rng) - 0.5f, U(rng) - 0.5f, U(rng) - 0.5f) * 0.2f);
+      p += dir * 0.8f;
+    }
+  }
+  std::vector<Vec3> px(8000);
+  for (auto& x : px) x = Vec3(960.f + 140.f * U(rng), 1960.f + 140.f * U(rng), -20.f + 140.f * U(rng));
+  DeviceSamples ds(device_);
+  ds.upload(hs);
+  ParticleStore store(device_);
+  store.append(particles_at(px));
+  SampleHashGrid grid(device_);
+  for (float h : {2.f, 4.f, 15.f}) {
+    for (float range : {15.f, 50.f}) {
+      grid.build(ds.view(), h, ws_);
+      grid.query_nearest(store.view(), range);
+      const auto nearest = store.nearest.to_host();
+      const auto dB = store.d_B.to_host();
+      int misses = 0;
+      for (size_t k = 0; k < px.size(); ++k) {
+        const NearestSample ref = nearest_sample_brute_force(hs.x.data(), int64_t(hs.x.size()), px[k], range);
+        ASSERT_EQ(nearest[k], ref.index) << "h=" << h << " range=" << range << " particle " << k;
+        ASSERT_NEAR(dB[k], ref.dist, 1e-5f * std::max(1.f, ref.dist)) << "h=" << h << " particle " << k;
+        misses += ref.index < 0;
+      }
+      // The set-up must exercise both outcomes.
+      EXPECT_GT(misses, 100);
+      EXPECT_LT(misses, int(px.size()) - 100);
+    }
+  }
+}
+
+TEST_F(HashGridTest, RewindHashesStartOfStepPositions) {
+  // A bristle that moved by v dt: with rewind the particle at the old place is on it.
+  HostSamples hs;
+  hs.resize(1, 32);
+  straight_bristle(hs, 0, Vec3(110.f, 100.f, 40.f), Vec3(0, 1, 0), Vec3(0, 0, 1), 0.8f, Vec3(600.f, 0, 0), Vec3());
+  DeviceSamples ds(device_);
+  ds.upload(hs);
+  ParticleStore store(device_);
+  store.append(particles_at({Vec3(100.f, 108.f, 40.f)}));
+  SampleHashGrid grid(device_);
+  grid.build(ds.view(), 4.f, ws_);
+  grid.query_nearest(store.view(), 50.f);
+  EXPECT_NEAR(store.d_B.to_host()[0], 10.f, 1e-4f);
+  grid.build(ds.view(), 4.f, ws_, 1.f / 60.f);
+  grid.query_nearest(store.view(), 50.f);
+  EXPECT_NEAR(store.d_B.to_host()[0], 0.f, 1e-4f);
+  EXPECT_EQ(store.nearest.to_host()[0], 10);
+}
+
+TEST_F(HashGridTest, EmptySamplesAndBadInput) {
+  HostSamples hs;
+  hs.resize(0, 128);
+  DeviceSamples ds(device_);
+  ds.upload(hs);
+  ParticleStore store(device_);
+  store.append(particles_at({Vec3(1, 2, 3), Vec3(4, 5, 6)}));
+  SampleHashGrid grid(device_);
+  EXPECT_THROW(grid.query_nearest(store.view(), 15.f), Error);  // not built
+  grid.build(ds.view(), 4.f, ws_);
+  grid.query_nearest(store.view(), 15.f);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(store.nearest.to_host()[k], -1);
+    EXPECT_EQ(store.d_B.to_host()[k], 15.f);
+  }
+  EXPECT_THROW(grid.build(ds.view(), 0.f, ws_), Error);
+  EXPECT_THROW(grid.query_nearest(store.view(), -1.f), Error);
+}
+
+}  // namespace wb::test
