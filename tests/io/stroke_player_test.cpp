@@ -72,7 +72,8 @@ TEST(StrokePlayer, PosesExactAtSampleTimes) {
   StrokePlayer player(s);
   for (const PenSample& p : s.samples) {
     const BrushPose a = player.pose_at(p.t);
-    const BrushPose b = pose_from_pen(p, s.brush);
+    // The pen-up sample is 0.05 s after a contact: half the lift (kLiftTime = 0.1 s).
+    const BrushPose b = p.down ? pose_from_pen(p, s.brush) : pose_from_pen(p, -0.5f, s.brush);
     EXPECT_EQ(a.position.x, b.position.x);
     EXPECT_EQ(a.position.y, b.position.y);
     EXPECT_EQ(a.position.z, b.position.z);
@@ -113,6 +114,24 @@ TEST(StrokePlayer, StaysLiftedBetweenPenUpSamples) {
                           pen(0.5, 400, 300, 0.3, false), pen(0.6, 420, 300, 0.5)});
   StrokePlayer player(s);
   for (double t = 0.1; t <= 0.5; t += 0.05) EXPECT_FLOAT_EQ(player.elevation_at(t), -1.f) << t;
+}
+
+TEST(StrokePlayer, HoverNearContactIsPartlyLifted) {
+  // Hover events every 5 ms up to a contact, as a tablet reports them.
+  std::vector<PenSample> v;
+  for (int i = 0; i < 40; ++i) v.push_back(pen(0.005 * i, 100 + i, 100, 0, false));
+  v.push_back(pen(0.2, 140, 100, 0.02));  // touches lightly, then presses in
+  v.push_back(pen(0.3, 160, 100, 0.3));
+  Stroke s = make_stroke(v);
+  StrokePlayer player(s);
+  EXPECT_FLOAT_EQ(player.elevation_at(0.0), -1.f);     // 0.2 s from the contact
+  EXPECT_FLOAT_EQ(player.elevation_at(0.195), -0.05f);  // 5 ms before it
+  EXPECT_NEAR(player.elevation_at(0.15), -0.5f, 1e-6f);
+  PlayerStep st;
+  int max_n = 0;
+  while (player.next(st)) max_n = std::max(max_n, st.substeps);
+  // Full lift (half the 90-cell length) over kLiftTime: under 8 cells per 1/60 s step.
+  EXPECT_LE(max_n, 8);
 }
 
 TEST(StrokePlayer, SubstepsBoundMovement) {
@@ -238,6 +257,33 @@ TEST(StrokePlayer, RejectsInvalidStroke) {
   EXPECT_THROW(StrokePlayer{s}, Error);
   s.samples.clear();
   EXPECT_THROW(StrokePlayer{s}, Error);
+}
+
+}  // namespace
+}  // namespace wb
+
+namespace wb {
+namespace {
+
+// The shipped examples load cleanly, stay short (quick replays) and touch the canvas.
+TEST(StrokeExamples, LoadAndPlay) {
+  const std::string dir = std::string(WB_SOURCE_DIR) + "/examples/";
+  for (const char* name : {"press-and-drag.json", "s-curve-flat.json", "stab-and-roll.json", "tablet-scribble.txt"}) {
+    const Stroke s = load_stroke(dir + name);
+    EXPECT_TRUE(s.warnings.empty()) << name << ": " << s.warnings.front();
+    EXPECT_GE(s.duration(), 1.0) << name;
+    EXPECT_LE(s.duration(), 3.0) << name;
+    StrokePlayer player(s);
+    PlayerStep st;
+    int edges = 0, down = 0;
+    while (player.next(st)) {
+      edges += st.pen_down_edge;
+      down += st.pen_down;
+      EXPECT_LE(st.max_move, s.max_move_per_substep + 1e-4f) << name << " step " << st.index;
+    }
+    EXPECT_GE(edges, 1) << name;
+    EXPECT_GT(down, 30) << name;
+  }
 }
 
 }  // namespace

@@ -50,6 +50,21 @@ StrokePlayer::StrokePlayer(Stroke stroke) : stroke_(std::move(stroke)) {
   if (stroke_.lead_in > 0) keys_.push_back(key_of(s.front(), s.front().t - stroke_.lead_in, -1.f));
   for (const PenSample& p : s) keys_.push_back(key_of(p, p.t, pen_elevation(p)));
   if (stroke_.lead_out > 0) keys_.push_back(key_of(s.back(), s.back().t + stroke_.lead_out, -1.f));
+  // A pen-up sample near a contact is lifted in proportion to the time to that contact
+  // (full lift kLiftTime away): a tablet goes from hover to touch within one 5 ms event,
+  // and a brush dropped from full lift that fast would hit the canvas at ~10 m/s.
+  {
+    const size_t first = stroke_.lead_in > 0 ? 1 : 0;
+    const size_t n = s.size();
+    std::vector<double> prev_contact(n, -1e300), next_contact(n, 1e300);
+    for (size_t i = 0; i < n; ++i) prev_contact[i] = s[i].down ? s[i].t : (i ? prev_contact[i - 1] : -1e300);
+    for (size_t i = n; i-- > 0;) next_contact[i] = s[i].down ? s[i].t : (i + 1 < n ? next_contact[i + 1] : 1e300);
+    for (size_t i = 0; i < n; ++i) {
+      if (s[i].down) continue;
+      const double gap = std::min(s[i].t - prev_contact[i], next_contact[i] - s[i].t);
+      keys_[first + i].e = -float(std::min(1.0, gap / kLiftTime));
+    }
+  }
   for (size_t i = 0; i + 1 < keys_.size(); ++i) keys_[i].twist_delta = shortest_angle(keys_[i].twist, keys_[i + 1].twist);
   // The tiny tolerance keeps an exact multiple of dt from gaining a step to rounding.
   step_count_ = std::max<int64_t>(1, int64_t(std::ceil(duration() / stroke_.dt - 1e-9)));

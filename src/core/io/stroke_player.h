@@ -30,10 +30,15 @@ struct PlayerStep {
   std::span<const StrokeEvent> events;  ///< events firing in this step, in time order
 };
 
+/// Seconds of hover between full lift and contact: a pen-up sample closer than this (in
+/// time) to a pen-down sample is lifted only by that fraction of the full lift.
+inline constexpr double kLiftTime = 0.1;
+
 /// Replays a stroke. Timeline: from t_begin() = first sample t - lead_in (the brush held
 /// lifted above the first sample, descending to it) to t_end() = last sample t + lead_out
 /// (rising above the last sample). Between keys x, y, elevation and tilt are linear and
-/// twist follows the shortest angle; between pen-up samples the brush stays lifted.
+/// twist follows the shortest angle; between pen-up samples the brush stays lifted (by less
+/// within kLiftTime of a contact). Poses at pen-down sample times are the samples' poses.
 class StrokePlayer {
  public:
   explicit StrokePlayer(Stroke stroke);
