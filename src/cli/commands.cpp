@@ -26,6 +26,7 @@ void set_action(CLI::App* sub, std::function<int()> action) { actions()[sub] = s
 
 void register_all(CLI::App& app) {
   register_devices(app);
+  register_replay(app);
   register_solver_study(app);
 }
 

@@ -19,6 +19,7 @@ Device resolve_device(const std::string& device_text);
 void set_action(CLI::App* sub, std::function<int()> action);
 
 void register_devices(CLI::App& app);
+void register_replay(CLI::App& app);
 void register_solver_study(CLI::App& app);
 void register_all(CLI::App& app);
 int run_selected(CLI::App& app);

@@ -26,6 +26,11 @@ size_t Profiler::count(const std::string& name) const {
   auto it = samples_.find(name);
   return it == samples_.end() ? 0 : it->second.size();
 }
+const std::vector<double>& Profiler::samples(const std::string& name) const {
+  static const std::vector<double> empty;
+  auto it = samples_.find(name);
+  return it == samples_.end() ? empty : it->second;
+}
 std::vector<std::string> Profiler::names() const {
   std::vector<std::string> n;
   for (auto& [k, v] : samples_) n.push_back(k);

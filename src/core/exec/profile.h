@@ -20,6 +20,8 @@ class Profiler {
   double total_ms(const std::string& name) const;
   size_t count(const std::string& name) const;
   std::vector<std::string> names() const;
+  /// Every recorded duration of `name`, in ms, in order.
+  const std::vector<double>& samples(const std::string& name) const;
   void clear() { samples_.clear(); }
   const Device& device() const { return device_; }
 

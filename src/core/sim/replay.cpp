@@ -1,0 +1,78 @@
+#include "core/sim/replay.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace wb {
+
+CanvasRect stroke_region(const Stroke& stroke) {
+  float x0 = 1e30f, y0 = 1e30f, x1 = -1e30f, y1 = -1e30f;
+  for (const PenSample& s : stroke.samples) {
+    x0 = std::min(x0, s.x);
+    y0 = std::min(y0, s.y);
+    x1 = std::max(x1, s.x);
+    y1 = std::max(y1, s.y);
+  }
+  if (stroke.samples.empty()) x0 = y0 = x1 = y1 = 0.f;
+  const float reach = stroke.brush.length + std::max(stroke.brush.width, stroke.brush.thickness);
+  CanvasRect r;
+  r.x0 = std::max(0, int(std::floor(x0 - reach)));
+  r.y0 = std::max(0, int(std::floor(y0 - reach)));
+  const int xe = std::min(stroke.canvas.width, int(std::ceil(x1 + reach)) + 1);
+  const int ye = std::min(stroke.canvas.height, int(std::ceil(y1 + reach)) + 1);
+  r.width = std::max(1, xe - r.x0);
+  r.height = std::max(1, ye - r.y0);
+  return r;
+}
+
+Replay::Replay(Simulator& sim, StrokePlayer& player)
+    : sim_(sim), player_(player), region_(stroke_region(player.stroke())), last_t_(player.t_begin()) {
+  trace_.set_device(sim.device());
+  trace_.resize(size_t(region_.width) * region_.height);
+  trace_.fill_zero();
+  sim_.reset_brush(player_.pose_at(player_.t_begin()));
+}
+
+bool Replay::advance() {
+  PlayerStep step;
+  if (!player_.next(step)) return false;
+  const float dt_sub = float(step.dt / step.substeps);
+  for (int k = 1; k <= step.substeps; ++k) {
+    sim_.step(player_.pose_at(StrokePlayer::substep_time(step, k)), dt_sub);
+    // A bristle is in contact when a sample is within one cell of the canvas or dried paint.
+    const int64_t touched = sim_.brush().mark_contacts(trace_.data(), region_.width, region_.height, region_.x0,
+                                                       region_.y0, 1.0f);
+    contact_cells_max_ = std::max(contact_cells_max_, touched);
+    max_stretch_ = std::max(max_stretch_, sim_.brush().stats().max_stretch);
+  }
+  last_t_ = step.t;
+  return true;
+}
+
+std::vector<uint8_t> Replay::brush_image() const {
+  const int w = region_.width, h = region_.height;
+  std::vector<uint8_t> img(size_t(w) * h * 3);
+  const std::vector<int32_t> trace = trace_.to_host();
+  for (size_t i = 0; i < size_t(w) * h; ++i) {
+    const bool t = trace[i] != 0;
+    img[3 * i + 0] = t ? 150 : 236;  // contact trace: a cool grey on primed-canvas white
+    img[3 * i + 1] = t ? 160 : 232;
+    img[3 * i + 2] = t ? 178 : 222;
+  }
+  // Bristles of the final pose, drawn from high to low so lower samples win, shaded by height.
+  std::vector<Vec3> s = sim_.brush().samples_to_host();
+  std::sort(s.begin(), s.end(), [](const Vec3& a, const Vec3& b) { return a.z > b.z; });
+  const float top = std::max(1.f, sim_.brush().spec().length);
+  for (const Vec3& p : s) {
+    const int x = int(std::floor(p.x)) - region_.x0, y = int(std::floor(p.y)) - region_.y0;
+    if (x < 0 || y < 0 || x >= w || y >= h || !std::isfinite(p.z)) continue;
+    const float k = std::clamp(p.z / top, 0.f, 1.f);  // 0 on the canvas .. 1 a length above it
+    const size_t i = (size_t(y) * w + x) * 3;
+    img[i + 0] = uint8_t(90 + 110 * k);
+    img[i + 1] = uint8_t(50 + 90 * k);
+    img[i + 2] = uint8_t(20 + 60 * k);
+  }
+  return img;
+}
+
+}  // namespace wb

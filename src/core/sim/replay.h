@@ -1,0 +1,53 @@
+// Replays a stroke through the simulator: the StrokePlayer gives the steps (poses,
+// sub-steps, pen edges, events), this driver runs them and keeps what a replay reports.
+// Used by `wetbrush replay`, `wetbrush bench` and the tests, so there is one replay path.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "core/io/stroke_player.h"
+#include "core/sim/simulator.h"
+
+namespace wb {
+
+/// The canvas rectangle a replay looks at: the samples' bounding box grown by the brush's
+/// reach (length + width), clipped to the canvas.
+struct CanvasRect {
+  int x0 = 0, y0 = 0, width = 0, height = 0;
+};
+CanvasRect stroke_region(const Stroke& stroke);
+
+class Replay {
+ public:
+  Replay(Simulator& sim, StrokePlayer& player);
+
+  /// Runs the next player step (all its sub-steps); false when the stroke is over.
+  bool advance();
+  int64_t steps_done() const { return player_.steps_done(); }
+  int64_t step_count() const { return player_.step_count(); }
+  double sim_time() const { return last_t_ - player_.t_begin(); }
+  const CanvasRect& region() const { return region_; }
+
+  /// Most canvas cells the bristles touched in one step.
+  int64_t contact_cells_max() const { return contact_cells_max_; }
+  /// Largest relative segment stretch seen after any step.
+  float max_stretch() const { return max_stretch_; }
+  /// Every canvas cell of the region that bristles touched so far (row-major, region-sized).
+  std::vector<int32_t> contact_trace() const { return trace_.to_host(); }
+
+  /// Top view of the region: paper, the contact trace, and the bristles of the current
+  /// pose drawn over it (darker where closer to the canvas). RGB8, rows top = y0.
+  std::vector<uint8_t> brush_image() const;
+
+ private:
+  Simulator& sim_;
+  StrokePlayer& player_;
+  CanvasRect region_;
+  DeviceBuffer<int32_t> trace_;
+  int64_t contact_cells_max_ = 0;
+  float max_stretch_ = 0.f;
+  double last_t_ = 0.0;
+};
+
+}  // namespace wb
