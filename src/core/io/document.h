@@ -1,0 +1,56 @@
+// Painting files (DESIGN "Files"): OpenRaster (.ora: a ZIP with mimetype, stack.xml, PNG
+// layers, mergedimage.png, Thumbnails/thumbnail.png), which MyPaint, Krita and GIMP open as
+// the flat rendered painting, plus the sparse 3D paint volume that wetbrush needs as the extra
+// entry wetbrush/volume.bin (zstd per tile, format version, CRC32 checksums) and the metadata
+// as wetbrush/metadata.json. Saves are atomic. Format: docs/FORMATS.md "Painting files".
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/canvas/tile_store.h"
+#include "core/render/renderer.h"
+
+namespace wb {
+
+/// Version of wetbrush/volume.bin this build writes and the newest it reads.
+inline constexpr uint32_t kVolumeFormatVersion = 1;
+inline constexpr const char* kOraMimetype = "image/openraster";
+inline constexpr const char* kVolumeEntry = "wetbrush/volume.bin";
+inline constexpr const char* kMetadataEntry = "wetbrush/metadata.json";
+
+struct Painting {
+  TileStore canvas;
+  nlohmann::json metadata;
+};
+
+struct SaveOptions {
+  /// Called at "partial-write" (half the bytes are in the temporary file) and "before-rename";
+  /// a hook that throws makes the save fail there (tests of atomicity).
+  std::function<void(const std::string& stage)> fault_hook;
+  int thumbnail_px = 256;  ///< longest side of Thumbnails/thumbnail.png
+};
+
+/// Writes the painting atomically: the whole file goes to a temporary file in the same
+/// directory, which is fsync'ed and renamed over `path`, then the directory is fsync'ed.
+/// A failure at any point leaves an existing file at `path` untouched. `merged` is the
+/// rendered painting (any size; usually one pixel per canvas cell).
+void save_painting(const std::string& path, const TileStore& canvas, const Image& merged,
+                   const nlohmann::json& metadata, const SaveOptions& options = {});
+
+/// Reads a painting onto `device`. Truncated, corrupted, foreign or newer-version files are
+/// rejected with a wb::Error that names the file and what is wrong.
+Painting load_painting(const std::string& path, const Device& device);
+
+/// The volume entry alone (exposed for tests and tools).
+std::vector<uint8_t> encode_volume(const TileStore& canvas);
+TileStore decode_volume(const uint8_t* bytes, size_t size, const Device& device, const std::string& what);
+
+/// Writes bytes to `path` atomically (temporary file, fsync, rename, directory fsync).
+void write_file_atomic(const std::string& path, const std::vector<uint8_t>& bytes,
+                       const std::function<void(const std::string&)>& fault_hook = {});
+
+}  // namespace wb

@@ -1,0 +1,347 @@
+// Ray casting of the paint volume (paper §6 "Liquid rendering"): march the density at a
+// quarter-cell step, find the surface at a density threshold (refined between the two
+// bracketing samples), normal from the density gradient, pigment and oil there, and gather
+// pigment below the surface over an oil-dependent penetration distance. Backend-free WB_HD code.
+#pragma once
+#include <math.h>
+
+#include <cstdint>
+
+#include "core/canvas/tile_store.h"
+#include "core/canvas/window.h"
+#include "core/color/ryb.h"
+#include "core/math/vec.h"
+#include "core/render/camera.h"
+#include "core/render/render_params.h"
+
+namespace wb {
+
+/// Temporary density layer of splatted particles (same layout as a PaintWindowView).
+struct SplatView {
+  float* density;  ///< particle paint volume per cell, cell volumes
+  float *pigment_r, *pigment_y, *pigment_b, *oil;  ///< mass-weighted sums, then normalised
+  int nx, ny, nz, ox, oy, oz;
+  WB_HD int64_t index(int x, int y, int z) const { return (int64_t(z) * ny + y) * nx + x; }
+  WB_HD int64_t size() const { return int64_t(nx) * ny * nz; }
+};
+
+inline constexpr int kTopBlock = 8;  ///< cells per side of a block of the coarse top map
+
+/// Everything the ray caster reads: tiles, the optional live window and particle splat
+/// (which replace resp. add to the tiles' cells), and the column-top maps that let empty
+/// space be skipped without touching the tiles.
+struct RenderVolume {
+  TileStoreView tiles;
+  PaintWindowView win;
+  int has_win;
+  SplatView splat;
+  int has_splat;
+  const uint16_t* top;  ///< per column: 1 + highest z holding paint, 0 = empty column
+  int top_x0, top_y0, top_w, top_h;
+  const uint16_t* block_top;  ///< max of `top` over kTopBlock^2 columns
+  int blk_w, blk_h;
+  int z_top_max;  ///< max of `top` over the map
+};
+
+/// One cell's paint, as rendered (window replaces tiles; splat adds, density-weighted).
+struct RenderCell {
+  float density, r, y, b, oil, dryness;
+};
+
+/// 1 + highest z holding paint in column (x, y); the canvas depth where the map does not reach.
+WB_HD WB_INLINE int column_top(const RenderVolume& v, int x, int y) {
+  if (x < 0 || y < 0 || x >= v.tiles.width || y >= v.tiles.height) {
+    // Off-canvas columns hold only splatted particles, if any.
+    return v.has_splat ? v.tiles.depth : 0;
+  }
+  const int lx = x - v.top_x0, ly = y - v.top_y0;
+  if (lx < 0 || ly < 0 || lx >= v.top_w || ly >= v.top_h) return v.tiles.depth;
+  return v.top[int64_t(ly) * v.top_w + lx];
+}
+
+WB_HD WB_INLINE bool in_window(const PaintWindowView& w, int x, int y, int z) {
+  return x >= w.ox && y >= w.oy && z >= w.oz && x < w.ox + w.nx && y < w.oy + w.ny && z < w.oz + w.nz;
+}
+WB_HD WB_INLINE bool in_splat(const SplatView& s, int x, int y, int z) {
+  return x >= s.ox && y >= s.oy && z >= s.oz && x < s.ox + s.nx && y < s.oy + s.ny && z < s.oz + s.nz;
+}
+
+/// Density of cell (x, y, z), without the column-top shortcut.
+WB_HD WB_INLINE float cell_density_raw(const RenderVolume& v, int x, int y, int z) {
+  float d = 0.f;
+  if (v.has_win && in_window(v.win, x, y, z)) {
+    d = v.win.density[v.win.index(x - v.win.ox, y - v.win.oy, z - v.win.oz)];
+  } else if (v.tiles.inside(x, y, z)) {
+    const int32_t slot = v.tiles.slot_of_tile[(y / kTileSize) * v.tiles.tiles_x + x / kTileSize];
+    if (slot >= 0) d = v.tiles.density[int64_t(slot) * v.tiles.tile_cells() + v.tiles.cell_offset(x % kTileSize, y % kTileSize, z)];
+  }
+  if (v.has_splat && in_splat(v.splat, x, y, z)) d += v.splat.density[v.splat.index(x - v.splat.ox, y - v.splat.oy, z - v.splat.oz)];
+  return d;
+}
+
+/// Density of cell (x, y, z); cells at or above their column's top are empty without a fetch.
+WB_HD WB_INLINE float cell_density(const RenderVolume& v, int x, int y, int z) {
+  if (z < 0 || z >= column_top(v, x, y)) return 0.f;
+  return cell_density_raw(v, x, y, z);
+}
+
+/// All fields of cell (x, y, z).
+WB_HD WB_INLINE RenderCell cell_full(const RenderVolume& v, int x, int y, int z) {
+  RenderCell c{0.f, 0.f, 0.f, 0.f, 0.f, 0.f};
+  if (z < 0 || z >= column_top(v, x, y)) return c;
+  if (v.has_win && in_window(v.win, x, y, z)) {
+    const int64_t i = v.win.index(x - v.win.ox, y - v.win.oy, z - v.win.oz);
+    c = RenderCell{v.win.density[i], v.win.pigment_r[i], v.win.pigment_y[i], v.win.pigment_b[i], v.win.oil[i],
+                   v.win.dryness[i]};
+  } else if (v.tiles.inside(x, y, z)) {
+    const int32_t slot = v.tiles.slot_of_tile[(y / kTileSize) * v.tiles.tiles_x + x / kTileSize];
+    if (slot >= 0) {
+      const int64_t a = int64_t(slot) * v.tiles.tile_cells() + v.tiles.cell_offset(x % kTileSize, y % kTileSize, z);
+      c = RenderCell{v.tiles.density[a], decode_unorm16(v.tiles.pigment_r[a]), decode_unorm16(v.tiles.pigment_y[a]),
+                     decode_unorm16(v.tiles.pigment_b[a]), decode_unorm16(v.tiles.oil[a]),
+                     decode_unorm16(v.tiles.dryness[a])};
+    }
+  }
+  if (v.has_splat && in_splat(v.splat, x, y, z)) {
+    // Particles are wet paint: their density adds, their pigment and oil mix by density.
+    const int64_t i = v.splat.index(x - v.splat.ox, y - v.splat.oy, z - v.splat.oz);
+    const float ds = v.splat.density[i];
+    if (ds > 0.f) {
+      const float dt = c.density + ds;
+      const float wg = c.density / dt, wsp = ds / dt;
+      c.r = c.r * wg + v.splat.pigment_r[i] * wsp;
+      c.y = c.y * wg + v.splat.pigment_y[i] * wsp;
+      c.b = c.b * wg + v.splat.pigment_b[i] * wsp;
+      c.oil = c.oil * wg + v.splat.oil[i] * wsp;
+      c.dryness = c.dryness * wg;
+      c.density = dt;
+    }
+  }
+  return c;
+}
+
+/// Trilinear density at a continuous point (cell centres at integer + 0.5); corners with
+/// zero weight are not fetched, so axis-aligned rays through cell centres cost two fetches.
+WB_HD WB_INLINE float sample_density(const RenderVolume& v, Vec3 p) {
+  const float fx = p.x - 0.5f, fy = p.y - 0.5f, fz = p.z - 0.5f;
+  const float flx = floorf(fx), fly = floorf(fy), flz = floorf(fz);
+  const int ix = int(flx), iy = int(fly), iz = int(flz);
+  const float ax = fx - flx, ay = fy - fly, az = fz - flz;
+  float s = 0.f;
+  for (int c = 0; c < 8; ++c) {
+    const float wx = (c & 1) ? ax : 1.f - ax;
+    const float wy = (c & 2) ? ay : 1.f - ay;
+    const float wz = (c & 4) ? az : 1.f - az;
+    const float w = wx * wy * wz;
+    if (w <= 0.f) continue;
+    s += w * cell_density(v, ix + (c & 1), iy + ((c >> 1) & 1), iz + ((c >> 2) & 1));
+  }
+  return s;
+}
+
+/// Density-weighted trilinear paint at a point: pigment, oil and dryness of the paint there
+/// (empty cells have no pigment, which would otherwise read as white).
+struct PaintSample {
+  Vec3 ryb;
+  float oil, dryness, density;
+};
+WB_HD WB_INLINE PaintSample sample_paint(const RenderVolume& v, Vec3 p) {
+  const float fx = p.x - 0.5f, fy = p.y - 0.5f, fz = p.z - 0.5f;
+  const float flx = floorf(fx), fly = floorf(fy), flz = floorf(fz);
+  const int ix = int(flx), iy = int(fly), iz = int(flz);
+  const float ax = fx - flx, ay = fy - fly, az = fz - flz;
+  PaintSample s{Vec3(0.f, 0.f, 0.f), 0.f, 0.f, 0.f};
+  float wsum = 0.f;
+  for (int c = 0; c < 8; ++c) {
+    const float w = ((c & 1) ? ax : 1.f - ax) * ((c & 2) ? ay : 1.f - ay) * ((c & 4) ? az : 1.f - az);
+    if (w <= 0.f) continue;
+    const RenderCell k = cell_full(v, ix + (c & 1), iy + ((c >> 1) & 1), iz + ((c >> 2) & 1));
+    s.density += w * k.density;
+    const float wd = w * k.density;
+    if (wd <= 0.f) continue;
+    s.ryb += Vec3(k.r, k.y, k.b) * wd;
+    s.oil += k.oil * wd;
+    s.dryness += k.dryness * wd;
+    wsum += wd;
+  }
+  if (wsum > 0.f) {
+    s.ryb = s.ryb / wsum;
+    s.oil /= wsum;
+    s.dryness /= wsum;
+  }
+  return s;
+}
+
+/// Surface normal n = -grad(rho)/|grad(rho)| by central differences of the trilinear density.
+WB_HD WB_INLINE Vec3 density_normal(const RenderVolume& v, Vec3 p, float e) {
+  const Vec3 g((sample_density(v, p + Vec3(e, 0, 0)) - sample_density(v, p - Vec3(e, 0, 0))),
+               (sample_density(v, p + Vec3(0, e, 0)) - sample_density(v, p - Vec3(0, e, 0))),
+               (sample_density(v, p + Vec3(0, 0, e)) - sample_density(v, p - Vec3(0, 0, e))));
+  return normalize_or(-g, Vec3(0.f, 0.f, 1.f));
+}
+
+/// Height of the canvas weave at (x, y): two crossing thread families (over-under pattern).
+WB_HD WB_INLINE float weave_height(const RenderParams& p, float x, float y) {
+  if (p.weave_amplitude <= 0.f) return 0.f;
+  const float k = 6.2831853f / p.weave_period;
+  return p.weave_amplitude * 0.25f * (2.f + cosf(k * x) * sinf(0.5f * k * y) + sinf(0.5f * k * x) * cosf(k * y));
+}
+WB_HD WB_INLINE Vec3 weave_normal(const RenderParams& p, float x, float y) {
+  if (p.weave_amplitude <= 0.f) return Vec3(0.f, 0.f, 1.f);
+  const float e = 0.25f;
+  const float hx = (weave_height(p, x + e, y) - weave_height(p, x - e, y)) / (2 * e);
+  const float hy = (weave_height(p, x, y + e) - weave_height(p, x, y - e)) / (2 * e);
+  return normalize(Vec3(-hx, -hy, 1.f));
+}
+
+/// What one ray found: the surface point, its normal, the blended pigment and the paint state.
+struct RayHit {
+  int kind;     ///< 0 = missed the canvas (background), 1 = bare canvas, 2 = paint surface
+  Vec3 pos;     ///< hit point, cells
+  Vec3 normal;
+  Vec3 albedo;  ///< unlit RGB after blending the pigment samples below the surface
+  float dryness;
+};
+
+/// The ray of pixel (i, j) starts at height z_start above the canvas.
+WB_HD WB_INLINE void pixel_ray(const CameraBasis& cam, float i, float j, Vec3& ground, Vec3& dir) {
+  ground = cam.p00 + cam.du * i + cam.dv * j;  // point of the image plane through the canvas centre
+  dir = cam.dir;
+}
+
+/// Pigment gathered below the surface (§6): samples every penetration_step within
+/// L = oil * penetration_per_oil along the ray, tent-weighted w = 1 - s/L so that the surface
+/// counts most; samples below the canvas see the primed canvas. The blend is linear in RYB
+/// (glazing mixes pigment like the colour model does) and converted to RGB once.
+WB_HD WB_INLINE Vec3 gather_pigment(const RenderVolume& v, const RenderParams& P, Vec3 hit, Vec3 dir, Vec3 n,
+                                    PaintSample surf) {
+  const float L = surf.oil * P.penetration_per_oil;
+  if (!(L > P.penetration_step)) return ryb_to_rgb(surf.ryb);
+  Vec3 acc = surf.ryb;
+  float wsum = 1.f;
+  for (float s = P.penetration_step; s < L; s += P.penetration_step) {
+    const float w = 1.f - s / L;
+    const Vec3 q = hit + dir * s;
+    if (q.z <= 0.f) {
+      acc += P.paper_ryb * w;
+      wsum += w;
+      continue;
+    }
+    const PaintSample k = sample_paint(v, q);
+    if (k.density < P.threshold) continue;  // an air gap along the ray: nothing to see there
+    acc += k.ryb * w;
+    wsum += w;
+  }
+  return ryb_to_rgb(acc / wsum);
+}
+
+/// Casts one ray: march from `start` along `dir` at P.step until the density reaches the
+/// threshold or the ray meets the canvas plane z = 0.
+WB_HD WB_INLINE RayHit cast_ray(const RenderVolume& v, const RenderParams& P, Vec3 start, Vec3 dir) {
+  RayHit h;
+  h.kind = 0;
+  h.normal = Vec3(0.f, 0.f, 1.f);
+  h.albedo = P.background_rgb;
+  h.dryness = 1.f;
+  const float t_end = start.z / -dir.z;  // where the ray meets z = 0 (dir.z < 0)
+  float t_prev = 0.f, d_prev = sample_density(v, start);
+  bool found = d_prev >= P.threshold;
+  float t_hit = 0.f;
+  if (!found) {
+    for (float t = P.step; t <= t_end + 1e-4f; t += P.step) {
+      const float d = sample_density(v, start + dir * t);
+      if (d >= P.threshold) {
+        // Refine between the bracketing samples: linear guess, then two secant/bisection steps.
+        float ta = t_prev, da = d_prev, tb = t, db = d;
+        float tm = ta;
+        for (int k = 0; k < 3; ++k) {
+          tm = ta + (tb - ta) * clampf((P.threshold - da) / maxf(db - da, 1e-6f), 0.f, 1.f);
+          if (k == 2) break;
+          const float dm = sample_density(v, start + dir * tm);
+          if (dm >= P.threshold) {
+            tb = tm;
+            db = dm;
+          } else {
+            ta = tm;
+            da = dm;
+          }
+        }
+        t_hit = tm;
+        found = true;
+        break;
+      }
+      t_prev = t;
+      d_prev = d;
+    }
+  }
+  if (found) {
+    h.kind = 2;
+    h.pos = start + dir * t_hit;
+    h.normal = density_normal(v, h.pos, P.normal_eps);
+    // Pigment just inside the surface.
+    const PaintSample surf = sample_paint(v, h.pos - h.normal * 0.5f);
+    h.dryness = surf.dryness;
+    h.albedo = gather_pigment(v, P, h.pos, dir, h.normal, surf);
+    return h;
+  }
+  const Vec3 g = start + dir * t_end;
+  if (g.x < 0.f || g.y < 0.f || g.x >= float(v.tiles.width) || g.y >= float(v.tiles.height)) return h;
+  h.kind = 1;
+  h.pos = Vec3(g.x, g.y, 0.f);
+  h.normal = weave_normal(P, g.x, g.y);
+  // Paint too thin to reach the threshold stains the canvas by its density.
+  const PaintSample film = sample_paint(v, Vec3(g.x, g.y, 0.5f));
+  const float a = clampf(film.density / P.threshold, 0.f, 1.f);
+  h.albedo = lerp(P.paper_rgb, ryb_to_rgb(film.ryb), a);
+  h.dryness = a > 0.f ? film.dryness : 1.f;
+  return h;
+}
+
+/// Starting point of pixel (i, j)'s ray: just above the highest paint it can meet.
+WB_HD WB_INLINE Vec3 ray_start(const RenderVolume& v, const CameraBasis& cam, float i, float j) {
+  Vec3 g, dir;
+  pixel_ray(cam, i, j, g, dir);
+  int ztop = v.z_top_max;
+  if (cam.top) {
+    // Straight down: only the (up to four) columns the trilinear sample touches matter.
+    // Straight down: only the columns the trilinear sample gives weight to matter (one at
+    // pixel centres on cell centres, up to four otherwise).
+    const float fx = g.x - 0.5f, fy = g.y - 0.5f;
+    const int ix = int(floorf(fx)), iy = int(floorf(fy));
+    const bool wx = fx - floorf(fx) > 0.f, wy = fy - floorf(fy) > 0.f;
+    ztop = 0;
+    for (int c = 0; c < 4; ++c) {
+      if (((c & 1) && !wx) || ((c & 2) && !wy)) continue;
+      const int t = column_top(v, ix + (c & 1), iy + (c >> 1));
+      ztop = t > ztop ? t : ztop;
+    }
+  }
+  const float z0 = float(ztop) + 0.5f;
+  // Move back along -dir from the plane point g until height z0.
+  const float t = (z0 - g.z) / -dir.z;
+  return g - dir * t;
+}
+
+/// Blinn-Phong shading of a hit: ambient (times AO) + diffuse + specular fading with dryness.
+WB_HD WB_INLINE Vec3 shade(const RenderParams& P, const RayHit& h, Vec3 dir, float ao) {
+  if (h.kind == 0) return P.background_rgb;
+  const Vec3 L = P.light_dir;  // normalised on the host
+  const float ndl = maxf(dot(h.normal, L), 0.f);
+  Vec3 c = h.albedo * (P.ambient * ao + P.diffuse * ndl);
+  if (h.kind == 2 && P.specular > 0.f) {
+    const Vec3 H = normalize(L - dir);
+    const float ndh = maxf(dot(h.normal, H), 0.f);
+    const float wet = 1.f - clampf(h.dryness, 0.f, 1.f);
+    c += Vec3(1.f, 1.f, 1.f) * (P.specular * wet * powf(ndh, P.shininess) * (ndl > 0.f ? 1.f : 0.f));
+  }
+  return Vec3(clampf(c.x, 0.f, 1.f), clampf(c.y, 0.f, 1.f), clampf(c.z, 0.f, 1.f));
+}
+
+WB_HD WB_INLINE uint32_t pack_rgba8(Vec3 c) {
+  const uint32_t r = uint32_t(clampf(c.x, 0.f, 1.f) * 255.f + 0.5f);
+  const uint32_t g = uint32_t(clampf(c.y, 0.f, 1.f) * 255.f + 0.5f);
+  const uint32_t b = uint32_t(clampf(c.z, 0.f, 1.f) * 255.f + 0.5f);
+  return r | (g << 8) | (b << 16) | (255u << 24);
+}
+
+}  // namespace wb

@@ -1,0 +1,1 @@
+#include "core/render/render_impl.h"

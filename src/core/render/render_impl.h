@@ -1,0 +1,132 @@
+// Render stage driver (paper §6, DESIGN step 9), compiled once per backend: column-top maps
+// for empty-space skipping, particle splatting into the temporary density layer, and the
+// per-pixel ray cast with AO and shading.
+#pragma once
+#include "core/exec/atomics.h"
+#include "core/exec/parallel_for.h"
+#include "core/render/ao_kernels.h"
+#include "core/render/raycast_kernels.h"
+#include "core/render/renderer.h"
+
+namespace wb::WB_BACKEND_NS {
+
+void render_top_map(RenderVolume v, int x0, int y0, int w, int h, uint16_t* top) {
+  parallel_for(int64_t(w) * h, [=] WB_HD(int64_t i) {
+    const int x = x0 + int(i % w), y = y0 + int(i / w);
+    int t = 0;
+    if (!v.has_win && !v.has_splat) {
+      // Tiles only: one slot lookup, then a strided scan down the column.
+      const int32_t slot = v.tiles.slot_of_tile[(y / kTileSize) * v.tiles.tiles_x + x / kTileSize];
+      if (slot >= 0) {
+        const float* col = v.tiles.density + int64_t(slot) * v.tiles.tile_cells() + v.tiles.cell_offset(x % kTileSize, y % kTileSize, 0);
+        for (int z = v.tiles.depth - 1; z >= 0; --z)
+          if (col[int64_t(z) * kTileSize * kTileSize] > 0.f) {
+            t = z + 1;
+            break;
+          }
+      }
+    } else {
+      for (int z = v.tiles.depth - 1; z >= 0; --z)
+        if (cell_density_raw(v, x, y, z) > 0.f) {
+          t = z + 1;
+          break;
+        }
+    }
+    top[i] = uint16_t(t);
+  });
+}
+
+void render_block_top(const uint16_t* top, int w, int h, uint16_t* blocks, int bw, int bh) {
+  parallel_for(int64_t(bw) * bh, [=] WB_HD(int64_t i) {
+    const int bx = int(i % bw), by = int(i / bw);
+    uint16_t m = 0;
+    for (int y = by * kTopBlock; y < (by + 1) * kTopBlock && y < h; ++y)
+      for (int x = bx * kTopBlock; x < (bx + 1) * kTopBlock && x < w; ++x) {
+        const uint16_t t = top[int64_t(y) * w + x];
+        m = t > m ? t : m;
+      }
+    blocks[i] = m;
+  });
+}
+
+void render_splat(SplatView s, ParticleOverlay p) {
+  // Each particle spreads its paint volume over the cells within `radius` with a normalised
+  // (1 - d^2/r^2)^2 kernel, so the layer holds exactly the particles' volume (where inside).
+  parallel_for(p.n, [=] WB_HD(int64_t k) {
+    const Vec3 c = p.x[k];
+    const float m = p.mass[k];
+    if (!(m > 0.f) || !isfinite3(c)) return;
+    const float r = maxf(p.radius, 0.5f), r2 = r * r;
+    const int x0 = int(floorf(c.x - r)), x1 = int(floorf(c.x + r));
+    const int y0 = int(floorf(c.y - r)), y1 = int(floorf(c.y + r));
+    const int z0 = int(floorf(c.z - r)), z1 = int(floorf(c.z + r));
+    float wsum = 0.f;
+    for (int z = z0; z <= z1; ++z)
+      for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) {
+          const Vec3 d = Vec3(x + 0.5f, y + 0.5f, z + 0.5f) - c;
+          const float q = 1.f - length2(d) / r2;
+          if (q > 0.f) wsum += q * q;
+        }
+    if (!(wsum > 0.f)) return;
+    const float pr = p.r ? p.r[k] : 0.f, py = p.y ? p.y[k] : 0.f, pb = p.b ? p.b[k] : 0.f;
+    const float po = p.oil ? p.oil[k] : 0.f;
+    for (int z = z0; z <= z1; ++z)
+      for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) {
+          if (!in_splat(s, x, y, z)) continue;
+          const Vec3 d = Vec3(x + 0.5f, y + 0.5f, z + 0.5f) - c;
+          const float q = 1.f - length2(d) / r2;
+          if (q <= 0.f) continue;
+          const float dm = m * q * q / wsum;
+          const int64_t i = s.index(x - s.ox, y - s.oy, z - s.oz);
+          atomic_add(&s.density[i], dm);
+          atomic_add(&s.pigment_r[i], dm * pr);
+          atomic_add(&s.pigment_y[i], dm * py);
+          atomic_add(&s.pigment_b[i], dm * pb);
+          atomic_add(&s.oil[i], dm * po);
+        }
+  });
+  // Mass-weighted sums to mean pigment and oil.
+  parallel_for(s.size(), [=] WB_HD(int64_t i) {
+    const float d = s.density[i];
+    if (d > 0.f) {
+      s.pigment_r[i] /= d;
+      s.pigment_y[i] /= d;
+      s.pigment_b[i] /= d;
+      s.oil[i] /= d;
+    }
+  });
+}
+
+void render_pixels(RenderVolume v, RenderParams P, CameraBasis cam, const Vec3* ao_dirs, const int32_t* tiles,
+                   int ntiles, int tile_px, int img_w, int img_h, int mode, uint32_t* rgba, float* fout) {
+  const int64_t per_tile = int64_t(tile_px) * tile_px;
+  const int tiles_x = (img_w + tile_px - 1) / tile_px;
+  parallel_for(int64_t(ntiles) * per_tile, [=] WB_HD(int64_t i) {
+    const int tile = tiles[i / per_tile];
+    const int local = int(i % per_tile);
+    const int px = (tile % tiles_x) * tile_px + local % tile_px;
+    const int py = (tile / tiles_x) * tile_px + local / tile_px;
+    if (px >= img_w || py >= img_h) return;
+    const int64_t o = i;  // tile-major output: the host places the tiles
+    const Vec3 start = ray_start(v, cam, px + 0.5f, py + 0.5f);
+    const RayHit h = cast_ray(v, P, start, cam.dir);
+    if (mode == int(RenderOutput::Shaded)) {
+      const float ao = h.kind == 0 ? 1.f : ambient_occlusion(v, P, ao_dirs, h.pos, h.normal);
+      rgba[o] = pack_rgba8(shade(P, h, cam.dir, ao));
+    } else if (mode == int(RenderOutput::Height)) {
+      fout[o * 4] = h.kind == 2 ? h.pos.z : 0.f;
+    } else if (mode == int(RenderOutput::Normal)) {
+      fout[o * 4] = h.normal.x;
+      fout[o * 4 + 1] = h.normal.y;
+      fout[o * 4 + 2] = h.normal.z;
+    } else {
+      fout[o * 4] = h.albedo.x;
+      fout[o * 4 + 1] = h.albedo.y;
+      fout[o * 4 + 2] = h.albedo.z;
+    }
+  });
+}
+
+}  // namespace wb::WB_BACKEND_NS
