@@ -79,6 +79,9 @@ Stroke parse_mypaint_events(std::string_view text, const std::string& source) {
       const char* e = b + tok.size();
       if (b < e && *b == '+') ++b;  // from_chars rejects a leading '+'
       auto r = std::from_chars(b, e, v[c]);
+      if (r.ec == std::errc::result_out_of_range)
+        WB_THROW(where + "column " + std::to_string(c + 1) + " (" + kColumns[c] + "): '" + std::string(tok) +
+                 "' is out of range");
       if (r.ec != std::errc() || r.ptr != e)
         WB_THROW(where + "column " + std::to_string(c + 1) + " (" + kColumns[c] + "): '" + std::string(tok) +
                  "' is not a number");

@@ -83,6 +83,14 @@ size_t StrokePlayer::segment(double t) const {
   return keys_.size() < 2 ? 0 : std::min(i, keys_.size() - 2);
 }
 
+std::pair<std::vector<StrokePlayer::Key>::const_iterator, std::vector<StrokePlayer::Key>::const_iterator>
+StrokePlayer::keys_inside(double ta, double tb) const {
+  const auto by_t = [](const Key& k, double v) { return k.t < v; };
+  const auto first = std::upper_bound(keys_.begin(), keys_.end(), ta, [](double v, const Key& k) { return v < k.t; });
+  const auto last = std::lower_bound(first, keys_.end(), tb, by_t);
+  return {first, last};
+}
+
 StrokePlayer::Key StrokePlayer::interpolate(double t) const {
   if (keys_.size() == 1 || t <= keys_.front().t) return keys_.front();
   if (t >= keys_.back().t) return keys_.back();
@@ -135,8 +143,7 @@ int StrokePlayer::substeps_for(double ta, double tb, float* max_move) const {
   Vec3 a[kRefPoints], b[kRefPoints];
   // First guess: the longest reference-point path through this step (keys bend it).
   std::vector<double> breaks{ta};
-  for (const Key& k : keys_)
-    if (k.t > ta && k.t < tb) breaks.push_back(k.t);
+  for (auto [it, end] = keys_inside(ta, tb); it != end; ++it) breaks.push_back(it->t);
   breaks.push_back(tb);
   float path = 0.f;
   {
@@ -187,8 +194,7 @@ bool StrokePlayer::next(PlayerStep& out) {
 
   // Elevation is piecewise linear: its maximum over the step is at an end or a key.
   float e_max = std::max(elevation_at(out.t_begin), out.elevation);
-  for (const Key& key : keys_)
-    if (key.t > out.t_begin && key.t < out.t) e_max = std::max(e_max, key.e);
+  for (auto [it, end] = keys_inside(out.t_begin, out.t); it != end; ++it) e_max = std::max(e_max, it->e);
   out.pen_down = e_max >= 0.f;
   out.pen_down_edge = out.pen_down && !prev_contact_;
   out.pen_up_edge = !out.pen_down && prev_contact_;

@@ -5,6 +5,7 @@
 #pragma once
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "core/brush/brush_spec.h"
@@ -75,6 +76,8 @@ class StrokePlayer {
   };
   size_t segment(double t) const;
   Key interpolate(double t) const;
+  /// Keys with ta < key.t < tb.
+  std::pair<std::vector<Key>::const_iterator, std::vector<Key>::const_iterator> keys_inside(double ta, double tb) const;
   int substeps_for(double ta, double tb, float* max_move) const;
 
   Stroke stroke_;
