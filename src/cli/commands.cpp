@@ -26,7 +26,10 @@ void set_action(CLI::App* sub, std::function<int()> action) { actions()[sub] = s
 
 void register_all(CLI::App& app) {
   register_devices(app);
+  register_render(app);
+  register_export(app);
   register_replay(app);
+  register_params(app);
   register_solver_study(app);
 }
 

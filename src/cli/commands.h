@@ -19,7 +19,10 @@ Device resolve_device(const std::string& device_text);
 void set_action(CLI::App* sub, std::function<int()> action);
 
 void register_devices(CLI::App& app);
+void register_render(CLI::App& app);
+void register_export(CLI::App& app);
 void register_replay(CLI::App& app);
+void register_params(CLI::App& app);
 void register_solver_study(CLI::App& app);
 void register_all(CLI::App& app);
 int run_selected(CLI::App& app);

@@ -1,0 +1,191 @@
+#include "core/params/param_table.h"
+
+#include <cmath>
+#include <type_traits>
+
+#include "core/exec/error.h"
+
+namespace wb {
+namespace {
+
+template <typename T>
+constexpr ParamKind kind_of() {
+  if constexpr (std::is_same_v<T, bool>) return ParamKind::Bool;
+  else if constexpr (std::is_integral_v<T> || std::is_enum_v<T>) return ParamKind::Int;
+  else return ParamKind::Float;
+}
+
+template <typename T>
+T from_double(double v) {
+  if constexpr (std::is_same_v<T, bool>) return v != 0.0;
+  else if constexpr (std::is_enum_v<T>) return static_cast<T>(static_cast<std::underlying_type_t<T>>(std::llround(v)));
+  else if constexpr (std::is_integral_v<T>) return static_cast<T>(std::llround(v));
+  else return static_cast<T>(v);
+}
+
+template <typename T>
+double to_double(T v) {
+  if constexpr (std::is_enum_v<T>) return double(static_cast<std::underlying_type_t<T>>(v));
+  else return double(v);
+}
+
+// One row: the accessors are generated from the member path, so defaults and types are never repeated.
+#define WB_PARAM(path, label, unit, paper, lo, hi, tip)                                                    \
+  ParamInfo {                                                                                             \
+    #path, label, unit, paper, tip, kind_of<std::remove_cvref_t<decltype(SimParams{}.path)>>(), lo, hi,   \
+        [](const SimParams& p) { return to_double(p.path); },                                             \
+        [](SimParams& p, double v) { p.path = from_double<std::remove_cvref_t<decltype(p.path)>>(v); }    \
+  }
+
+std::vector<ParamInfo> build_table() {
+  return {
+      // Brush solver (§4.1).
+      WB_PARAM(brush_solver.iterations, "Constraint sweeps", "", "§4.1", 1, 100,
+               "Gauss-Seidel sweeps of the inextensibility, bending and collision constraints per step"),
+      WB_PARAM(brush_solver.density_iterations, "Minimum-density iterations", "", "§4.1", 0, 20,
+               "Iterations of the minimum-density constraint that keeps bristles from collapsing (0 = off)"),
+      WB_PARAM(brush_solver.damping, "Bristle damping", "", "", 0, 1,
+               "Fraction of the brush-frame velocity removed per step"),
+      WB_PARAM(brush_solver.min_spacing, "Minimum bristle spacing", "cells", "§4.1", -1, 10,
+               "Spacing the minimum-density constraint keeps; negative = twice the bristle radius"),
+      // Grid (§4.2, Algorithm 1).
+      WB_PARAM(grid.solver, "Pressure solver", "", "§4.2", 0, 3,
+               "0 fixed-point (Alg. 1), 1 Jacobi, 2 weighted Jacobi, 3 Chebyshev"),
+      WB_PARAM(grid.jacobi_L, "Fixed-point iterations L", "", "Alg. 1", 0, 1000,
+               "Fixed-point iterations of Algorithm 1, two Jacobi sweeps each"),
+      WB_PARAM(grid.alpha, "Fixed-point alpha", "", "Eq. 3", 0, 1, "Restart weight of Algorithm 1"),
+      WB_PARAM(grid.solver_sweeps, "Solver sweeps", "", "§4.2", 0, 10000,
+               "Sweeps of the Jacobi, weighted Jacobi and Chebyshev solvers"),
+      WB_PARAM(grid.jacobi_omega, "Jacobi weight", "", "Eq. 7", 0.01, 1, "Weight of weighted Jacobi"),
+      WB_PARAM(grid.chebyshev_rho, "Chebyshev rho", "", "Eq. 6", 0, 0.9999,
+               "Spectral-radius estimate for Chebyshev; 0 = estimate by power iteration"),
+      WB_PARAM(grid.nu_thick, "Viscosity without oil", "cells^2/s", "§4.2", 0, 1e7,
+               "Kinematic viscosity of paint with no oil"),
+      WB_PARAM(grid.nu_thin, "Viscosity of oil", "cells^2/s", "§4.2", 0, 1e7,
+               "Kinematic viscosity of pure oil; nu(oil) interpolates geometrically"),
+      WB_PARAM(grid.viscosity_iterations, "Viscosity sweeps", "", "§4.2", 0, 100,
+               "Jacobi sweeps of the implicit viscosity solve"),
+      WB_PARAM(grid.gravity, "Gravity", "cells/s^2", "Eq. 2", 0, 1e6, "Gravity on the grid paint (down)"),
+      WB_PARAM(grid.yield_height, "Yield head", "cells", "", 0, 1e4,
+               "Paint columns lower than this (times 1 - oil) hold their shape"),
+      WB_PARAM(grid.liquid_threshold, "Liquid threshold", "", "§4.2", 0.01, 1,
+               "Density at and above which a cell takes part in the projection"),
+      WB_PARAM(grid.dry_rate, "Drying rate", "1/s", "§4.2", 0, 1000, "Dryness added per second"),
+      WB_PARAM(grid.dry_threshold, "Dry threshold", "", "§4.2", 0.01, 1,
+               "Dryness at and above which paint is solid"),
+      WB_PARAM(grid.mass_correction, "Advection mass correction", "", "", 0, 1,
+               "Restore the mass semi-Lagrangian advection loses or gains"),
+      WB_PARAM(grid.window_snap, "Window snap", "cells", "§4.2", 1, 64,
+               "The active window moves in steps of this many cells"),
+      // Particles (§4.3, Table 1).
+      WB_PARAM(particles.beta_L, "beta_L", "", "Eq. 9", 0, 0.2,
+               "Inertial weight in the bristle-sample frame: small = particles stick to bristles"),
+      WB_PARAM(particles.D1, "Adhesion range D1", "cells", "Eq. 10", 0, 100,
+               "Distance to the bristles within which the local-frame result is blended in"),
+      WB_PARAM(particles.D0, "Particle range D0", "cells", "§5.2", 0, 200,
+               "Paint within this distance of the bristles is simulated as particles"),
+      WB_PARAM(particles.delta, "Friction range delta", "1/cells", "Eq. 8", 0.01, 1,
+               "Friction vanishes beyond 1/delta from a solid surface"),
+      WB_PARAM(particles.gamma, "PIC weight gamma", "", "Eq. 11", 0, 1,
+               "Weight of the projected grid velocity in the particle velocity update"),
+      WB_PARAM(particles.hash_cell, "Hash cell", "cells", "§6", 0.5, 100, "Cell size of the sample hash grid"),
+      WB_PARAM(particles.max_particles, "Particle limit", "", "§7", 1, 2147483647.0, "Most particles at once"),
+      // Rendering (§6).
+      WB_PARAM(render.step, "Ray step", "cells", "§6", 0.05, 2, "Ray-march step"),
+      WB_PARAM(render.threshold, "Surface density", "", "§6", 0.01, 1, "Density at which the surface is found"),
+      WB_PARAM(render.penetration_per_oil, "Oil penetration", "cells", "§6", 0, 100,
+               "How far below the surface pigment is gathered, per unit of oil"),
+      WB_PARAM(render.ao_rays, "AO rays", "", "§6", 0, 256, "Ambient-occlusion rays per hit"),
+      WB_PARAM(render.ao_length, "AO length", "cells", "§6", 0, 64, "How far an AO ray looks"),
+      WB_PARAM(render.ao_strength, "AO strength", "", "§6", 0, 1, "How dark full occlusion makes the ambient"),
+      WB_PARAM(render.light_dir.x, "Light x", "", "", -1, 1, "Direction towards the light, x"),
+      WB_PARAM(render.light_dir.y, "Light y", "", "", -1, 1, "Direction towards the light, y"),
+      WB_PARAM(render.light_dir.z, "Light z", "", "", 0.05, 1, "Direction towards the light, z (up)"),
+      WB_PARAM(render.ambient, "Ambient", "", "", 0, 2, "Ambient light"),
+      WB_PARAM(render.diffuse, "Diffuse", "", "", 0, 2, "Directional light"),
+      WB_PARAM(render.specular, "Wet specular", "", "", 0, 2, "Specular of wet paint; fades as it dries"),
+      WB_PARAM(render.shininess, "Shininess", "", "", 1, 1000, "Blinn-Phong exponent"),
+      WB_PARAM(render.weave_amplitude, "Canvas weave", "cells", "", 0, 4, "Height of the canvas weave"),
+  };
+}
+#undef WB_PARAM
+
+}  // namespace
+
+const std::vector<ParamInfo>& param_table() {
+  static const std::vector<ParamInfo> table = build_table();
+  return table;
+}
+
+const ParamInfo* find_param(const std::string& id) {
+  for (const ParamInfo& p : param_table())
+    if (p.id == id) return &p;
+  return nullptr;
+}
+
+void set_param(SimParams& p, const std::string& id, double value) {
+  const ParamInfo* info = find_param(id);
+  WB_REQUIRE(info, "unknown parameter '" + id + "' (see `wetbrush params`)");
+  WB_REQUIRE(std::isfinite(value), "parameter " + id + ": value is not finite");
+  if (info->kind != ParamKind::Float)
+    WB_REQUIRE(value == std::floor(value), "parameter " + id + ": " + std::to_string(value) + " is not an integer");
+  WB_REQUIRE(value >= info->min && value <= info->max, "parameter " + id + " = " + std::to_string(value) +
+                                                          " is outside [" + std::to_string(info->min) + ", " +
+                                                          std::to_string(info->max) + "]");
+  info->set(p, value);
+}
+
+void apply_param_assignment(SimParams& p, const std::string& assignment) {
+  const size_t eq = assignment.find('=');
+  WB_REQUIRE(eq != std::string::npos && eq > 0, "expected id=value, got '" + assignment + "'");
+  const std::string id = assignment.substr(0, eq), text = assignment.substr(eq + 1);
+  double v = 0.0;
+  if (text == "true") v = 1.0;
+  else if (text == "false") v = 0.0;
+  else {
+    size_t used = 0;
+    try {
+      v = std::stod(text, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    WB_REQUIRE(used == text.size() && !text.empty(), "parameter " + id + ": '" + text + "' is not a number");
+  }
+  set_param(p, id, v);
+}
+
+nlohmann::json params_to_json(const SimParams& p) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const ParamInfo& info : param_table()) {
+    nlohmann::json* node = &j;
+    std::string rest = info.id;
+    for (size_t dot; (dot = rest.find('.')) != std::string::npos; rest = rest.substr(dot + 1))
+      node = &(*node)[rest.substr(0, dot)];
+    const double v = info.get(p);
+    if (info.kind == ParamKind::Bool) (*node)[rest] = v != 0.0;
+    else if (info.kind == ParamKind::Int) (*node)[rest] = static_cast<long long>(v);
+    else (*node)[rest] = v;
+  }
+  return j;
+}
+
+void params_from_json(SimParams& p, const nlohmann::json& j, std::vector<std::string>& warnings) {
+  std::function<void(const nlohmann::json&, const std::string&)> walk = [&](const nlohmann::json& node,
+                                                                             const std::string& prefix) {
+    WB_REQUIRE(node.is_object(), "parameters: '" + prefix + "' must be an object");
+    for (auto it = node.begin(); it != node.end(); ++it) {
+      const std::string id = prefix.empty() ? it.key() : prefix + "." + it.key();
+      if (it->is_object()) {
+        walk(*it, id);
+      } else if (find_param(id)) {
+        WB_REQUIRE(it->is_number() || it->is_boolean(), "parameter " + id + ": expected a number");
+        set_param(p, id, it->is_boolean() ? (it->get<bool>() ? 1.0 : 0.0) : it->get<double>());
+      } else {
+        warnings.push_back("unknown parameter '" + id + "' ignored");
+      }
+    }
+  };
+  walk(j, "");
+}
+
+}  // namespace wb
