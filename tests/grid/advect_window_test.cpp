@@ -1,0 +1,134 @@
+// Advection (semi-Lagrangian, Stam 1999) and the active window (§4.2 last paragraph):
+// a blob lands where a uniform field takes it, velocity sampling is exact on linear
+// fields, window moves never change the total mass and carry the velocity with them.
+#include <cmath>
+#include <random>
+
+#include "backend_fixture.h"
+#include "core/grid/advect_kernels.h"
+#include "grid/grid_test_util.h"
+
+namespace wb::test {
+
+class AdvectWindowTest : public BackendTest {};
+
+TEST_F(AdvectWindowTest, SmoothBlobLandsWithinHalfACell) {
+  TileStore canvas(device_, CanvasDims{256, 256, 64});
+  Grid g(canvas, GridParams{}, Int3{48, 48, 24}, Int3{0, 0, 0});
+  const GridDims d = g.dims();
+  const Vec3 start(14.f, 16.f, 8.f), vel(30.f, 15.f, 12.f);
+  paint_cells(g, [&](int i, int j, int k) {
+    const float dx = i + 0.5f - start.x, dy = j + 0.5f - start.y, dz = k + 0.5f - start.z;
+    return std::exp(-(dx * dx + dy * dy + dz * dz) / (2.f * 2.5f * 2.5f));
+  });
+  const auto rho0 = host_density(g);
+  const Vec3 c0 = centroid(d, rho0);
+  const float dt = g.params().dt;
+  const int steps = 30;
+  for (int s = 0; s < steps; ++s) {
+    for (int c = 0; c < 3; ++c) {
+      std::vector<float> v(size_t(d.faces(c)), vel[c]);
+      g.window().velocity(c).copy_from_host(v);
+    }
+    g.classify();
+    g.advect(dt);
+  }
+  const auto rho1 = host_density(g);
+  const Vec3 c1 = centroid(d, rho1);
+  const Vec3 expect = c0 + vel * (dt * steps);
+  EXPECT_NEAR(c1.x, expect.x, 0.5f);
+  EXPECT_NEAR(c1.y, expect.y, 0.5f);
+  EXPECT_NEAR(c1.z, expect.z, 0.5f);
+  float peak0 = 0, peak1 = 0;
+  for (float x : rho0) peak0 = std::max(peak0, x);
+  for (float x : rho1) peak1 = std::max(peak1, x);
+  EXPECT_LE(peak1, peak0 * 1.0001f);  // trilinear sampling is bounded
+  EXPECT_NEAR(sum(rho1), sum(rho0), 1e-4 * sum(rho0));  // with the mass correction
+}
+
+TEST_F(AdvectWindowTest, VelocitySamplingIsExactOnLinearFields) {
+  const GridDims d{12, 10, 8};
+  std::vector<float> f[3];
+  auto field = [](int c, Vec3 p) { return c == 0 ? 1.f + 2.f * p.x - p.y : (c == 1 ? 0.5f * p.z + p.x : -3.f + p.y); };
+  for (int c = 0; c < 3; ++c) {
+    f[c].resize(size_t(d.faces(c)));
+    int ex, ey, ez;
+    d.face_extent(c, ex, ey, ez);
+    for (int k = 0; k < ez; ++k)
+      for (int j = 0; j < ey; ++j)
+        for (int i = 0; i < ex; ++i) f[c][size_t(d.fidx(c, i, j, k))] = field(c, face_position(c, i, j, k));
+  }
+  GridView v{};
+  v.d = d;
+  for (int c = 0; c < 3; ++c) v.vel[c] = f[c].data();
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(1.f, 7.f);
+  for (int t = 0; t < 100; ++t) {
+    const Vec3 p(u(rng), u(rng), u(rng) * 0.9f);
+    const Vec3 s = sample_velocity(v, p);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(s[c], field(c, p), 1e-4f);
+  }
+}
+
+TEST_F(AdvectWindowTest, WindowMovesNeverChangeTotalMass) {
+  TileStore canvas(device_, CanvasDims{300, 260, 64});
+  ActiveWindow w(canvas, Int3{64, 48, 32}, Int3{100, 100, 0});
+  // Paint the canvas through the window at a few places.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  for (Int3 o : {Int3{100, 100, 0}, Int3{10, 30, 0}, Int3{200, 190, 0}, Int3{150, 40, 0}}) {
+    w.move_to(o);
+    auto f = w.paint().to_host();
+    for (size_t c = 0; c < f[0].size(); ++c)
+      if (u(rng) < 0.3f) f[0][c] += u(rng) * 1.3f;
+    w.paint().from_host(f);
+  }
+  Workspace ws(device_);
+  const double total0 = w.total_mass(ws);
+  ASSERT_GT(total0, 1000.0);
+  std::uniform_int_distribution<int> ox(-70, 290), oy(-60, 250);
+  for (int m = 0; m < 40; ++m) {
+    Int3 o{ox(rng), oy(rng), 0};
+    if (m % 3 == 0) o = Int3{w.origin().x + 8, w.origin().y - 8, 0};  // small overlapping moves
+    w.move_to(o);
+    EXPECT_NEAR(w.total_mass(ws), total0, 1e-6 * total0) << "move " << m;
+  }
+  w.flush();
+  EXPECT_NEAR(canvas.total_density(ws), total0, 1e-6 * total0);
+}
+
+TEST_F(AdvectWindowTest, MovesCarryVelocityWithTheCanvas) {
+  TileStore canvas(device_, CanvasDims{512, 512, 64});
+  ActiveWindow w(canvas, Int3{32, 24, 16}, Int3{100, 100, 0});
+  const GridDims d = w.grid_dims();
+  // u as a function of the canvas position of each face.
+  auto value = [](int cx, int cy, int cz) { return float(cx) + 1000.f * float(cy) + 0.25f * float(cz); };
+  std::vector<float> u0(size_t(d.nu()));
+  for (int k = 0; k < d.nz; ++k)
+    for (int j = 0; j < d.ny; ++j)
+      for (int i = 0; i <= d.nx; ++i) u0[size_t(d.uidx(i, j, k))] = value(i + 100, j + 100, k);
+  w.velocity(0).copy_from_host(u0);
+  w.move_to(Int3{108, 92, 0});
+  const auto u1 = w.velocity(0).to_host();
+  for (int k = 0; k < d.nz; ++k)
+    for (int j = 0; j < d.ny; ++j)
+      for (int i = 0; i <= d.nx; ++i) {
+        const int cx = i + 108, cy = j + 92;
+        const bool overlap = cx - 100 <= d.nx && cy - 100 >= 0;
+        const float expect = overlap ? value(cx, cy, k) : 0.f;
+        ASSERT_EQ(u1[size_t(d.uidx(i, j, k))], expect) << i << " " << j << " " << k;
+      }
+}
+
+TEST_F(AdvectWindowTest, RecentreSnapsToTheGrid) {
+  TileStore canvas(device_, CanvasDims{1024, 1024, 64});
+  ActiveWindow w(canvas, Int3{128, 128, 32}, Int3{0, 0, 0});
+  EXPECT_TRUE(w.recentre_on(Vec3(500.f, 300.f, 0.f), 8));
+  EXPECT_EQ(w.origin().x % 8, 0);
+  EXPECT_EQ(w.origin().y % 8, 0);
+  EXPECT_LE(std::abs(w.origin().x + 64 - 500), 4);
+  EXPECT_LE(std::abs(w.origin().y + 64 - 300), 4);
+  EXPECT_FALSE(w.recentre_on(Vec3(502.f, 301.f, 0.f), 8));  // less than the snap: no gather/scatter
+}
+
+}  // namespace wb::test
