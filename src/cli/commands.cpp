@@ -28,8 +28,6 @@ void register_all(CLI::App& app) {
   register_devices(app);
   register_render(app);
   register_export(app);
-  register_render(app);
-  register_export(app);
   register_replay(app);
   register_params(app);
   register_solver_study(app);

@@ -21,8 +21,6 @@ void set_action(CLI::App* sub, std::function<int()> action);
 void register_devices(CLI::App& app);
 void register_render(CLI::App& app);
 void register_export(CLI::App& app);
-void register_render(CLI::App& app);
-void register_export(CLI::App& app);
 void register_replay(CLI::App& app);
 void register_params(CLI::App& app);
 void register_solver_study(CLI::App& app);
