@@ -18,17 +18,23 @@ void register_solver_study(CLI::App& app) {
     int sweeps = 40;
     unsigned seed = 1;
     bool json = false;
+    std::string scene = "window";
     std::string device;
   };
   auto o = std::make_shared<Opts>();
   sub->add_option("--size", o->size, "Window of size x size x max(size/4, 8) cells")->capture_default_str()->check(CLI::Range(16, 512));
   sub->add_option("--sweeps", o->sweeps, "Report sweeps 0..K")->capture_default_str()->check(CLI::Range(0, 10000));
   sub->add_option("--seed", o->seed, "Seed of the scene's paint and bristle noise")->capture_default_str();
+  sub->add_option("--scene", o->scene,
+                  "window: paint layer + pressed brush (size x size x size/4); cube: size^3 liquid, random velocity")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"window", "cube"}));
   sub->add_flag("--json", o->json, "Print JSON instead of a table");
   add_device_option(sub, o->device);
   set_action(sub, [o]() {
     const Device d = resolve_device(o->device);
-    const SolverStudyResult r = run_solver_study(d, o->size, o->sweeps, o->seed);
+    const SolverStudyResult r = run_solver_study(
+        d, o->size, o->sweeps, o->seed, o->scene == "cube" ? StudySceneKind::kCube : StudySceneKind::kBrushWindow);
     const std::string out = o->json ? solver_study_json(r) : solver_study_text(r);
     std::fwrite(out.data(), 1, out.size(), stdout);
     if (o->json) std::printf("\n");

@@ -22,14 +22,18 @@ uint32_t hash3(int i, int j, int k, unsigned seed) {
   return h;
 }
 float unit(uint32_t h) { return float(h & 0xFFFFFF) / float(0x1000000); }
-Int3 study_dims(int size) { return Int3{size, size, std::max(size / 4, 8)}; }
+Int3 study_dims(int size, StudySceneKind kind) {
+  return kind == StudySceneKind::kCube ? Int3{size, size, size} : Int3{size, size, std::max(size / 4, 8)};
+}
 }  // namespace
 
-StudyScene::StudyScene(const Device& device, int size, unsigned seed)
-    : canvas_(device, CanvasDims{std::max(512, size * 2), std::max(512, size * 2), 64}),
-      grid_(canvas_, GridParams{}, study_dims(size), Int3{64, 64, 0}) {
+StudyScene::StudyScene(const Device& device, int size, unsigned seed, StudySceneKind kind)
+    : kind_(kind),
+      canvas_(device, CanvasDims{std::max(512, size * 2), std::max(512, size * 2), std::max(64, size)}),
+      grid_(canvas_, GridParams{}, study_dims(size, kind), Int3{64, 64, 0}) {
   WB_REQUIRE(size >= 16 && size <= 512, "solver study: --size must be in [16, 512]");
-  const Int3 n = study_dims(size);
+  WB_REQUIRE(kind == StudySceneKind::kBrushWindow || size <= 128, "solver study: cube scene needs --size <= 128");
+  const Int3 n = study_dims(size, kind);
   const int64_t cells = int64_t(n.x) * n.y * n.z;
   // Paint layer: a wavy layer about size/16 cells thick (at least 3), with ridges.
   std::vector<std::vector<float>> f(kPaintFieldCount, std::vector<float>(size_t(cells), 0.f));
@@ -41,7 +45,7 @@ StudyScene::StudyScene(const Device& device, int size, unsigned seed)
       for (int i = 0; i < n.x; ++i) {
         const size_t c = size_t((int64_t(k) * n.y + j) * n.x + i);
         const float h = base * (1.f + 0.35f * std::sin(0.31f * i) * std::cos(0.23f * j)) + 1.5f * unit(hash3(i, j, 0, seed));
-        const float fill = std::clamp(h - float(k), 0.f, 1.f);
+        const float fill = kind == StudySceneKind::kCube ? 1.f : std::clamp(h - float(k), 0.f, 1.f);
         f[0][c] = fill;
         f[1][c] = fill > 0 ? 0.8f : 0.f;
         f[2][c] = fill > 0 ? 0.2f : 0.f;
@@ -52,7 +56,7 @@ StudyScene::StudyScene(const Device& device, int size, unsigned seed)
         const float ex = (float(i) + 0.5f - cx) / ax, ey = (float(j) + 0.5f - cy) / ay;
         const float r2 = ex * ex + ey * ey;
         const float top = 2.f * base * (1.f - 0.5f * r2) + 1.f;
-        if (r2 < 1.f && float(k) < top) {
+        if (kind == StudySceneKind::kBrushWindow && r2 < 1.f && float(k) < top) {
           psi[c] = std::min(1.f, 0.45f + 0.5f * unit(hash3(i, j, k, seed + 7)));
           vx[c] = 240.f;
           vy[c] = 30.f * ey;
@@ -70,12 +74,24 @@ StudyScene::StudyScene(const Device& device, int size, unsigned seed)
   vy_.copy_from_host(vy);
   vz_.copy_from_host(vz);
   grid_.set_bristles(bristles());
+  if (kind == StudySceneKind::kCube) {
+    for (int c = 0; c < 3; ++c) {
+      std::vector<float> v(size_t(grid_.dims().faces(c)));
+      for (size_t f = 0; f < v.size(); ++f) v[f] = 2.f * unit(hash3(int(f), c, 1, seed)) - 1.f;
+      grid_.window().velocity(c).copy_from_host(v);
+    }
+  }
 }
 
 BristleField StudyScene::bristles() { return BristleField{psi_.data(), vx_.data(), vy_.data(), vz_.data()}; }
 
 void StudyScene::prepare_system(int warmup_steps) {
   const float dt = grid_.params().dt;
+  if (kind_ == StudySceneKind::kCube) {  // the random velocity's divergence, nothing else
+    grid_.classify();
+    grid_.compute_rhs();
+    return;
+  }
   for (int s = 0; s < warmup_steps; ++s) grid_.step(dt);
   grid_.classify();
   grid_.advect(dt);
@@ -138,11 +154,13 @@ std::vector<double> diagonal(const HostPoisson& s) {
 }
 }  // namespace
 
-std::vector<double> cg_solve(const HostPoisson& s, double tol, int max_iter, int* iterations) {
+namespace {
+/// Jacobi-preconditioned CG on A x = rhs (rhs on liquid cells), double precision.
+std::vector<double> cg_core(const HostPoisson& s, const std::vector<double>& diag, const std::vector<double>& rhs,
+                            double tol, int max_iter, int* iterations) {
   const size_t n = size_t(s.d.cells());
-  const std::vector<double> diag = diagonal(s);
   std::vector<double> x(n, 0.0), r(n), z(n), p(n), q(n);
-  for (size_t i = 0; i < n; ++i) r[i] = (s.cls[i] == kCellLiquid && diag[i] > 1e-6) ? double(s.b[i]) : 0.0;
+  for (size_t i = 0; i < n; ++i) r[i] = (s.cls[i] == kCellLiquid && diag[i] > 1e-6) ? rhs[i] : 0.0;
   const double bnorm = std::sqrt(dot(r, r));
   auto precondition = [&] {
     for (size_t i = 0; i < n; ++i) z[i] = diag[i] > 1e-6 ? r[i] / diag[i] : 0.0;
@@ -167,6 +185,37 @@ std::vector<double> cg_solve(const HostPoisson& s, double tol, int max_iter, int
   }
   if (iterations) *iterations = it;
   return x;
+}
+}  // namespace
+
+std::vector<double> cg_solve(const HostPoisson& s, double tol, int max_iter, int* iterations) {
+  const std::vector<double> rhs(s.b.begin(), s.b.end());
+  return cg_core(s, diagonal(s), rhs, tol, max_iter, iterations);
+}
+
+double jacobi_rho_by_inverse_iteration(const HostPoisson& s, int iters) {
+  // rho(D^-1 R) = 1 - lambda_min of A x = lambda D x; inverse iteration x <- A^-1 D x with
+  // CG solves, Rayleigh quotient x'Ax / x'Dx.
+  const std::vector<double> diag = diagonal(s);
+  const size_t n = diag.size();
+  std::vector<double> x(n, 0.0), dx(n), ax(n);
+  for (size_t i = 0; i < n; ++i) x[i] = (s.cls[i] == kCellLiquid && diag[i] > 1e-6) ? 1.0 + 0.1 * unit(hash3(int(i), 0, 0, 3)) : 0.0;
+  double lambda = 1.0;
+  for (int it = 0; it < iters; ++it) {
+    for (size_t i = 0; i < n; ++i) dx[i] = diag[i] * x[i];
+    x = cg_core(s, diag, dx, 1e-8, 100000, nullptr);
+    apply_host(s, x, ax);
+    double xax = 0, xdx = 0;
+    for (size_t i = 0; i < n; ++i) {
+      xax += x[i] * ax[i];
+      xdx += x[i] * diag[i] * x[i];
+    }
+    if (xdx <= 0) return 0.0;
+    lambda = xax / xdx;
+    const double inv = 1.0 / std::sqrt(xdx);
+    for (double& v : x) v *= inv;
+  }
+  return 1.0 - lambda;
 }
 
 double relative_error(const HostPoisson& s, const std::vector<float>& x, const std::vector<double>& ref) {
@@ -206,13 +255,14 @@ std::string SolverStudyResult::best_at(int sweeps) const {
   return best;
 }
 
-SolverStudyResult run_solver_study(const Device& device, int size, int sweeps, unsigned seed) {
+SolverStudyResult run_solver_study(const Device& device, int size, int sweeps, unsigned seed, StudySceneKind kind) {
   WB_REQUIRE(sweeps >= 0 && sweeps <= 10000, "solver study: --sweeps must be in [0, 10000]");
-  StudyScene scene(device, size, seed);
+  StudyScene scene(device, size, seed, kind);
   scene.prepare_system();
   Grid& grid = scene.grid();
   const HostPoisson sys = download_system(grid);
   SolverStudyResult res;
+  res.scene = kind == StudySceneKind::kCube ? "cube" : "brush-window";
   res.nx = sys.d.nx;
   res.ny = sys.d.ny;
   res.nz = sys.d.nz;
@@ -236,7 +286,7 @@ SolverStudyResult run_solver_study(const Device& device, int size, int sweeps, u
   SolverScratch& scratch = grid.solver_scratch();
   res.rho_estimate = estimate_jacobi_rho(device, s, 300, scratch, grid.workspace());
 
-  std::vector<float> host(size_t(n));
+  std::vector<float> host(static_cast<size_t>(n));
   auto run = [&](const std::string& name, float param, SolverConfig cfg, bool with_residual) {
     SolverCurve curve;
     curve.name = name;
@@ -277,6 +327,10 @@ SolverStudyResult run_solver_study(const Device& device, int size, int sweeps, u
   cfg.kind = PressureSolver::Chebyshev;
   cfg.rho = res.rho_estimate;
   res.curves.push_back(run("chebyshev", res.rho_estimate, cfg, true));
+  // The asymptotically optimal rho (the true spectral radius), as the paper's Figure 6 uses.
+  res.rho_exact = float(jacobi_rho_by_inverse_iteration(sys, 12));
+  cfg.rho = std::min(res.rho_exact, 0.999999f);
+  res.curves.push_back(run("chebyshev_exact_rho", cfg.rho, cfg, true));
   for (float a : {0.f, 0.5f, 1.f}) {
     cfg.kind = PressureSolver::FixedPoint;
     cfg.alpha = a;
@@ -291,12 +345,14 @@ std::string solver_study_text(const SolverStudyResult& r) {
   std::string out;
   char line[512];
   std::snprintf(line, sizeof(line),
-                "# system: %d x %d x %d window, %lld liquid cells; x* by Jacobi-preconditioned CG in double, "
+                "# system: %s, %d x %d x %d cells, %lld liquid cells; x* by Jacobi-preconditioned CG in double, "
                 "%d iterations, relative residual %.2e\n",
-                r.nx, r.ny, r.nz, (long long)r.liquid_cells, r.cg_iterations, r.cg_relative_residual);
+                r.scene.c_str(), r.nx, r.ny, r.nz, (long long)r.liquid_cells, r.cg_iterations, r.cg_relative_residual);
   out += line;
-  std::snprintf(line, sizeof(line), "# rho(D^-1 R) estimate (300 power sweeps): %.5f; best weighted-Jacobi omega at 6 sweeps: %.2f\n",
-                double(r.rho_estimate), double(r.best_omega));
+  std::snprintf(line, sizeof(line),
+                "# rho(D^-1 R): %.5f by 300 power sweeps (\"chebyshev\"), %.6f by inverse iteration "
+                "(\"chebyshev_exact_rho\"); best weighted-Jacobi omega at 6 sweeps: %.2f\n",
+                double(r.rho_estimate), double(r.rho_exact), double(r.best_omega));
   out += line;
   out += "# error = ||x - x*|| / ||x*||, residual = ||b - A x|| / ||b||; fixed point: one iterate per 2 sweeps\n";
   out += "sweeps";
@@ -328,11 +384,13 @@ std::string solver_study_text(const SolverStudyResult& r) {
 
 std::string solver_study_json(const SolverStudyResult& r) {
   nlohmann::json j;
+  j["scene"] = r.scene;
   j["window"] = {r.nx, r.ny, r.nz};
   j["liquid_cells"] = r.liquid_cells;
   j["cg_iterations"] = r.cg_iterations;
   j["cg_relative_residual"] = r.cg_relative_residual;
   j["rho_estimate"] = r.rho_estimate;
+  j["rho_exact"] = r.rho_exact;
   j["best_omega"] = r.best_omega;
   auto arr = [](const std::vector<double>& v) {
     nlohmann::json a = nlohmann::json::array();
