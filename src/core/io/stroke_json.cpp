@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -455,6 +456,8 @@ void save_stroke_json(const Stroke& stroke, const std::string& path) {
 }
 
 Stroke load_stroke(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) WB_THROW("cannot read stroke file '" + path + "': it is a directory");
   std::ifstream in(path, std::ios::binary);
   if (!in) WB_THROW("cannot open stroke file '" + path + "': " + std::strerror(errno));
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
