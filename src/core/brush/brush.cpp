@@ -32,7 +32,8 @@ WB_BRUSH_CALL(brush_grid_ranges, (const uint32_t* k, int64_t n, uint32_t* a, uin
 WB_BRUSH_CALL(brush_density_lambda, (BristleState s, MinDensityGrid g, float* l), (s, g, l))
 WB_BRUSH_CALL(brush_density_delta, (BristleState s, MinDensityGrid g, const float* l), (s, g, l))
 WB_BRUSH_CALL(brush_density_apply, (BristleState s), (s))
-WB_BRUSH_CALL(brush_finalize, (BristleState s, BristleRest r, BrushFrame f, SolidField so, float dt), (s, r, f, so, dt))
+WB_BRUSH_CALL(brush_inextensible, (BristleState s, BristleRest r, BrushFrame f, SolidField so), (s, r, f, so))
+WB_BRUSH_CALL(brush_velocities, (BristleState s, BrushFrame f, SolidField so, float dt), (s, f, so, dt))
 WB_BRUSH_CALL(brush_restore, (BristleState s, BrushFrame f), (s, f))
 WB_BRUSH_CALL(brush_place, (BristleState s, BristleRest r, BrushFrame f), (s, r, f))
 WB_BRUSH_CALL(brush_stretch_and_z, (BristleState s, BristleRest r, float* a, float* b), (s, r, a, b))
@@ -241,15 +242,15 @@ void Brush::step(const BrushPose& pose, float dt, const BrushEnvironment& env) {
   {
     WB_PROFILE_SCOPE("brush.constraints");
     brush_solve_on(device_, s, r, f, env.solid, params_.iterations, friction_it);
+    brush_inextensible_on(device_, s, r, f, env.solid);
   }
   {
+    // Last, so that bristles pressed together keep apart; its corrections are lateral and
+    // carried down each bristle, so they leave the segment lengths intact to second order.
     WB_PROFILE_SCOPE("brush.min_density");
-    apply_min_density();
+    apply_min_density(params_.density_iterations);
   }
-  {
-    WB_PROFILE_SCOPE("brush.finalize");
-    brush_finalize_on(device_, s, r, f, env.solid, dt);
-  }
+  brush_velocities_on(device_, s, f, env.solid, dt);
   // Containment: a non-finite vertex never propagates; the step is undone.
   const int64_t N = vertex_count();
   const int64_t bad = count_nonfinite(device_, reinterpret_cast<const float*>(xb_.data()), 3 * N, ws_) +
@@ -270,8 +271,8 @@ void Brush::step(const BrushPose& pose, float dt, const BrushEnvironment& env) {
   update_samples(dt, f, env.solid);
 }
 
-void Brush::apply_min_density() {
-  if (params_.density_iterations <= 0 || spec_.bristles < 2 || !(s_min_ > 0.f)) return;
+void Brush::apply_min_density(int iterations) {
+  if (iterations <= 0 || spec_.bristles < 2 || !(s_min_ > 0.f)) return;
   const BristleState s = state_view();
   const int64_t N = vertex_count();
   MinDensityGrid g{};
@@ -283,7 +284,7 @@ void Brush::apply_min_density() {
   g.rho0 = brush::density_kernel(s_min_, g.h);
   const float grad = 2.f / s_min_;  // |grad C| of one neighbour at s_min
   g.eps = 1e-3f * grad * grad;
-  for (int it = 0; it < params_.density_iterations; ++it) {
+  for (int it = 0; it < iterations; ++it) {
     brush_grid_keys_on(device_, s, g.h, grid_mask_, grid_keys_.data(), grid_ids_.data());
     sort_by_key(device_, grid_keys_.data(), grid_ids_.data(), N, grid_bits_, ws_);
     brush_grid_clear_on(device_, cell_start_.data(), cell_end_.data(), int64_t(grid_mask_) + 1);

@@ -32,7 +32,7 @@ struct BrushEnvironment {
 /// Numerical parameters of the brush solver (not part of a brush preset).
 struct BrushSolverParams {
   int iterations = 8;               ///< Gauss-Seidel sweeps per step (bending, length, collision)
-  int density_iterations = 2;       ///< minimum-density Jacobi iterations per step (0 = off)
+  int density_iterations = 4;       ///< minimum-density Jacobi iterations per step (0 = off)
   float damping = 0.1f;             ///< fraction of the brush-frame velocity removed per step
   float min_spacing = -1.f;         ///< s_min, cells; < 0: 2 * bristle_radius, capped by the rest spacing
 };
@@ -95,7 +95,7 @@ class Brush {
   SamplePrev prev_view();
   BrushFrame frame_for(const BrushPose& pose) const;
   void update_samples(float dt, const BrushFrame& frame, const SolidField& solid);
-  void apply_min_density();
+  void apply_min_density(int iterations);
 
   Device device_;
   BrushSpec spec_;

@@ -75,10 +75,11 @@ void brush_solve(BristleState s, BristleRest r, BrushFrame f, SolidField solid, 
 }
 
 void brush_grid_keys(BristleState s, float h, uint32_t mask, uint32_t* keys, uint32_t* ids) {
+  const float inv_cell = 0.5f / h;  // cells of 2h: see for_each_neighbour
   parallel_for(s.count(), [=] WB_HD(int64_t g) {
     const Vec3 x = s.xb[g];
-    keys[g] = brush::hash_cell(brush::floor_to_int(x.x / h), brush::floor_to_int(x.y / h), brush::floor_to_int(x.z / h),
-                               mask);
+    keys[g] = brush::hash_cell(brush::floor_to_int(x.x * inv_cell), brush::floor_to_int(x.y * inv_cell),
+                               brush::floor_to_int(x.z * inv_cell), mask);
     ids[g] = uint32_t(g);
   });
 }
@@ -99,32 +100,37 @@ void brush_grid_ranges(const uint32_t* keys, int64_t n, uint32_t* cell_start, ui
 }
 
 namespace brush_detail {
-/// Visits every vertex of another bristle within h of vertex g (27 cells of the hash
-/// grid; each candidate's own cell is checked so that hash collisions are not counted twice).
+/// Visits every vertex of another bristle within h of vertex g. The grid cells are 2h
+/// wide, so the ball of radius h overlaps at most 2 x 2 x 2 of them; each candidate's own
+/// cell is checked so that hash collisions are neither counted twice nor mistaken.
 template <typename F>
 WB_HD WB_INLINE void for_each_neighbour(const BristleState& s, const MinDensityGrid& grid, int64_t g, F&& fn) {
   const Vec3 x = s.xb[g];
   const int V = s.per_bristle;
-  const int cx = brush::floor_to_int(x.x / grid.h), cy = brush::floor_to_int(x.y / grid.h),
-            cz = brush::floor_to_int(x.z / grid.h);
-  for (int dz = -1; dz <= 1; ++dz)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        const uint32_t key = brush::hash_cell(cx + dx, cy + dy, cz + dz, grid.mask);
-        const uint32_t b = grid.cell_start[key];
-        if (b == 0xFFFFFFFFu) continue;
-        for (uint32_t q = b; q < grid.cell_end[key]; ++q) {
-          const int64_t j = grid.ids[q];
-          if (j / V == g / V) continue;
-          const Vec3 xj = s.xb[j];
-          if (brush::floor_to_int(xj.x / grid.h) != cx + dx || brush::floor_to_int(xj.y / grid.h) != cy + dy ||
-              brush::floor_to_int(xj.z / grid.h) != cz + dz)
-            continue;
-          const Vec3 d = x - xj;
-          const float r = length(d);
-          if (r < grid.h) fn(j, d, r);
-        }
-      }
+  const float inv_cell = 0.5f / grid.h;
+  const float gx = x.x * inv_cell, gy = x.y * inv_cell, gz = x.z * inv_cell;
+  const int cx = brush::floor_to_int(gx), cy = brush::floor_to_int(gy), cz = brush::floor_to_int(gz);
+  // The other cell along each axis: the side of the cell's centre x lies on.
+  const int ox = gx - float(cx) < 0.5f ? -1 : 1, oy = gy - float(cy) < 0.5f ? -1 : 1, oz = gz - float(cz) < 0.5f ? -1 : 1;
+  for (int c = 0; c < 8; ++c) {
+    const int nx = cx + ((c & 1) ? ox : 0), ny = cy + ((c & 2) ? oy : 0), nz = cz + ((c & 4) ? oz : 0);
+    const uint32_t key = brush::hash_cell(nx, ny, nz, grid.mask);
+    const uint32_t b = grid.cell_start[key];
+    if (b == 0xFFFFFFFFu) continue;
+    const uint32_t e = grid.cell_end[key];
+    for (uint32_t q = b; q < e; ++q) {
+      const int64_t j = grid.ids[q];
+      if (j / V == g / V) continue;
+      const Vec3 xj = s.xb[j];
+      const Vec3 d = x - xj;
+      const float r2 = length2(d);
+      if (r2 >= grid.h * grid.h) continue;
+      if (brush::floor_to_int(xj.x * inv_cell) != nx || brush::floor_to_int(xj.y * inv_cell) != ny ||
+          brush::floor_to_int(xj.z * inv_cell) != nz)
+        continue;
+      fn(j, d, sqrtf(r2));
+    }
+  }
 }
 }  // namespace brush_detail
 
@@ -160,14 +166,24 @@ void brush_density_delta(BristleState s, MinDensityGrid grid, const float* lambd
 
 void brush_density_apply(BristleState s) {
   const int V = s.per_bristle;
-  parallel_for(s.count(), [=] WB_HD(int64_t g) {
-    if (g % V != 0) s.xb[g] = s.xb[g] + s.delta[g];
+  // Only the part of a correction across its segment is kept, and a vertex pushed aside
+  // carries the rest of its bristle with it (prefix sum from root to tip): a segment's
+  // length then changes only to second order (|d|^2 / 2 l0), so the constraint can act
+  // last in the step without breaking inextensibility.
+  parallel_for(s.bristles, [=] WB_HD(int64_t k) {
+    Vec3 carried;
+    for (int i = 1; i < V; ++i) {
+      const int64_t g = k * V + i;
+      const Vec3 t = normalize_or(s.xb[g] - s.xb[g - 1], Vec3());
+      const Vec3 d = s.delta[g];
+      carried += d - t * dot(t, d);
+      s.xb[g] = s.xb[g] + carried;
+    }
   });
 }
 
-void brush_finalize(BristleState s, BristleRest r, BrushFrame f, SolidField solid, float dt) {
+void brush_inextensible(BristleState s, BristleRest r, BrushFrame f, SolidField solid) {
   const int V = s.per_bristle;
-  const float inv_dt = 1.f / dt;
   parallel_for(s.bristles, [=] WB_HD(int64_t k) {
     const int64_t base = k * V;
     const Vec3 d0 = r.dir[k];
@@ -181,13 +197,24 @@ void brush_finalize(BristleState s, BristleRest r, BrushFrame f, SolidField soli
       if (brush::collide_vertex(xc, f.R * xp + f.p, l0, solid, splay)) xi = f.R_B * (xc - f.p);
       s.xb[g] = xi;
     }
-    for (int i = 0; i < V; ++i) {  // PBD velocities from the position change
-      const int64_t g = base + i;
-      const Vec3 x = f.R * s.xb[g] + f.p;
-      s.x[g] = x;
-      s.v[g] = (x - s.x_old[g]) * inv_dt;
-      s.vb[g] = i == 0 ? Vec3() : (s.xb[g] - s.xb_old[g]) * inv_dt;
+  });
+}
+
+void brush_velocities(BristleState s, BrushFrame f, SolidField solid, float dt) {
+  const int V = s.per_bristle;
+  const float inv_dt = 1.f / dt;
+  parallel_for(s.count(), [=] WB_HD(int64_t g) {
+    Vec3 x = f.R * s.xb[g] + f.p;
+    if (g % V != 0) {  // the last correction may have nudged a vertex into a surface: lift it
+      const float h = brush::support_height(solid, x);
+      if (x.z < h) {
+        x.z = h;
+        s.xb[g] = f.R_B * (x - f.p);
+      }
     }
+    s.x[g] = x;
+    s.v[g] = (x - s.x_old[g]) * inv_dt;  // PBD velocities from the position change
+    s.vb[g] = g % V == 0 ? Vec3() : (s.xb[g] - s.xb_old[g]) * inv_dt;
   });
 }
 

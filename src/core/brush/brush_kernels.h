@@ -65,9 +65,10 @@ WB_HD WB_INLINE Vec3 drag_velocity_change(const DragField& d, Vec3 x, Vec3 v, fl
 }
 
 /// Limits |v| to vmax (a bristle cannot leave its ferrule by more than its length a step).
+/// A non-finite v passes through unchanged: the step's finiteness check must see it.
 WB_HD WB_INLINE Vec3 clamp_length(Vec3 v, float vmax) {
   const float l2 = length2(v);
-  if (!(l2 <= vmax * vmax)) return l2 > 0.f && isfinite(l2) ? v * (vmax / sqrtf(l2)) : Vec3();
+  if (l2 > vmax * vmax && isfinite(l2)) return v * (vmax / sqrtf(l2));
   return v;
 }
 
@@ -192,9 +193,13 @@ WB_HD WB_INLINE float density_kernel_dr(float r, float h) {
   return -2.f * (1.f - r / h) / h;
 }
 
-/// Hash of an integer grid cell into a power-of-two table (Teschner et al. 2003 primes).
+/// Hash of an integer grid cell into a power-of-two table (Teschner et al. 2003 primes, then mixed).
 WB_HD WB_INLINE uint32_t hash_cell(int cx, int cy, int cz, uint32_t mask) {
-  return ((uint32_t(cx) * 73856093u) ^ (uint32_t(cy) * 19349663u) ^ (uint32_t(cz) * 83492791u)) & mask;
+  uint32_t h = (uint32_t(cx) * 73856093u) ^ (uint32_t(cy) * 19349663u) ^ (uint32_t(cz) * 83492791u);
+  h ^= h >> 16;  // avalanche (murmur3 finaliser): the low bits alone would alias neighbouring cells
+  h *= 0x85EBCA6Bu;
+  h ^= h >> 13;
+  return h & mask;
 }
 
 /// Deterministic unit direction separating two coincident vertices (the gradient of the

@@ -83,7 +83,7 @@ BrushSpec default_brush(BrushShape shape) {
       break;
     case BrushShape::Rigger:  // long and thin liner, few bristles
       b.bristles = 40;
-      b.length = 115.f;
+      b.length = 110.f;
       b.width = b.thickness = 8.f;
       b.stiffness = 0.55f;
       b.length_variation = 0.05f;

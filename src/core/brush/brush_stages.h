@@ -41,7 +41,8 @@ struct SamplePrev {
   void brush_density_lambda(BristleState s, MinDensityGrid g, float* lambda);                                      \
   void brush_density_delta(BristleState s, MinDensityGrid g, const float* lambda);                                 \
   void brush_density_apply(BristleState s);                                                                        \
-  void brush_finalize(BristleState s, BristleRest r, BrushFrame f, SolidField solid, float dt);                    \
+  void brush_inextensible(BristleState s, BristleRest r, BrushFrame f, SolidField solid);                         \
+  void brush_velocities(BristleState s, BrushFrame f, SolidField solid, float dt);                                \
   void brush_restore(BristleState s, BrushFrame f);                                                                \
   void brush_place(BristleState s, BristleRest r, BrushFrame f);                                                   \
   void brush_stretch_and_z(BristleState s, BristleRest r, float* stretch, float* z);                              \
