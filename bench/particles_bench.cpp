@@ -1,0 +1,144 @@
+// Particle stage (paper §4.3, §6) at the paper's Figure 12 load: 210K particles around a
+// brush of 200 bristles x 128 samples. Hash-grid build, nearest-sample query, adhesion step
+// and rasterisation, on the device named by WB_DEVICE.
+#include <benchmark/benchmark.h>
+
+#include <random>
+
+#include "core/exec/device.h"
+#include "core/exec/workspace.h"
+#include "core/particles/hash_grid.h"
+#include "core/particles/particle_store.h"
+#include "core/particles/particles.h"
+#include "../tests/particles/sample_fixture.h"  // synthetic samples shared with the tests
+
+namespace {
+using namespace wb;
+
+struct Scene {
+  Device d = Device::from_env();
+  Workspace ws{d};
+  test::HostSamples hs;
+  test::DeviceSamples ds{d};
+  ParticleStore store{d};
+  SampleHashGrid grid{d};
+  ParticleParams prm;
+  float dt = 1.f / 60.f;
+
+  Scene() {
+    d.activate();
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<float> U(0.f, 1.f);
+    // Round brush, radius 20 cells, bristles 100 cells long, bent back along the stroke (+x
+    // motion) as they touch the canvas; 0.8 cells between samples.
+    hs.resize(200, 128);
+    const Vec3 V(600.f, 0.f, 0.f);
+    for (int b = 0; b < 200; ++b) {
+      const float r = 20.f * std::sqrt(U(rng)), a = 6.2831853f * U(rng);
+      Vec3 p(2000.f + r * std::cos(a), 2000.f + r * std::sin(a), 100.f);
+      for (int j = 0; j < 128; ++j) {
+        const float s = float(j) / 127.f;
+        const Vec3 t = normalize(Vec3(-0.9f * s * s, 0.f, -1.f + 0.9f * s * s));
+        const size_t i = size_t(b) * 128 + j;
+        hs.x[i] = p;
+        hs.t[i] = t;
+        hs.n[i] = normalize(cross(Vec3(0, 1, 0), t));
+        hs.b[i] = cross(t, hs.n[i]);
+        hs.v[i] = V;
+        hs.omega[i] = Vec3(0.f, 0.3f, 0.f);
+        hs.a[i] = Vec3(-200.f, 0.f, 0.f);
+        hs.alpha[i] = Vec3();
+        p += t * 0.8f;
+      }
+    }
+    ds.upload(hs);
+    // 210K particles: 90% within 8 cells of a random sample, 10% up to 40 cells away.
+    ParticleHost ph;
+    ph.resize(210000);
+    for (size_t k = 0; k < ph.size(); ++k) {
+      const Vec3 s = hs.x[size_t(U(rng) * float(hs.x.size() - 1))];
+      const float reach = k % 10 == 0 ? 40.f : 8.f;
+      Vec3 o;
+      do o = Vec3(2.f * U(rng) - 1.f, 2.f * U(rng) - 1.f, 2.f * U(rng) - 1.f);
+      while (length2(o) > 1.f);
+      ph.x[k] = s + o * reach;
+      if (ph.x[k].z < 0.f) ph.x[k].z = -ph.x[k].z;
+      ph.v[k] = Vec3(500.f, 0.f, 0.f);
+      ph.m[k] = 1e-9f;
+    }
+    store.append(ph);
+  }
+};
+
+Scene& scene() {
+  static Scene s;
+  return s;
+}
+
+void BM_SampleHashBuild(benchmark::State& state) {
+  Scene& s = scene();
+  for (auto _ : state) {
+    s.grid.build(s.ds.view(), float(state.range(0)), s.ws, s.dt);
+    s.d.synchronize();
+  }
+  state.SetItemsProcessed(state.iterations() * s.ds.view().count());
+}
+BENCHMARK(BM_SampleHashBuild)->Arg(4)->Unit(benchmark::kMicrosecond);
+
+void BM_NearestSampleQuery(benchmark::State& state) {
+  Scene& s = scene();
+  s.grid.build(s.ds.view(), float(state.range(0)), s.ws, s.dt);
+  const float range = state.range(1) ? s.prm.D0 : s.prm.D1;
+  for (auto _ : state) {
+    s.grid.query_nearest(s.store.view(), range);
+    s.d.synchronize();
+  }
+  state.SetItemsProcessed(state.iterations() * s.store.size());
+}
+// cell size (cells) x range (0: D1 = 15, 1: D0 = 50)
+BENCHMARK(BM_NearestSampleQuery)->Args({2, 0})->Args({4, 0})->Args({8, 0})->Args({4, 1})->Args({8, 1})->Unit(benchmark::kMillisecond);
+
+void BM_AdhesionStep(benchmark::State& state) {
+  Scene& s = scene();
+  s.grid.build(s.ds.view(), s.prm.hash_cell, s.ws, s.dt);
+  s.grid.query_nearest(s.store.view(), s.prm.D0);
+  const ParticleHost start = s.store.to_host();
+  SolidView solid;
+  for (auto _ : state) {
+    particles_adhesion_step(s.d, s.store.view(), s.ds.view(), solid, s.prm, s.dt);
+    s.d.synchronize();
+    state.PauseTiming();
+    s.store.clear();
+    s.store.append(start);  // the same input every iteration
+    s.grid.query_nearest(s.store.view(), s.prm.D0);
+    s.d.synchronize();
+    state.ResumeTiming();
+  }
+  state.SetItemsProcessed(state.iterations() * s.store.size());
+}
+BENCHMARK(BM_AdhesionStep)->Unit(benchmark::kMillisecond);
+
+void BM_Rasterise(benchmark::State& state) {
+  Scene& s = scene();
+  // A 128 x 128 x 32 window around the brush.
+  const int nx = 128, ny = 128, nz = 32;
+  DeviceBuffer<float> mass(s.d, size_t(nx) * ny * nz), mom[3], wt[3];
+  ParticleRasterView g{mass.data(), {}, {}, nx, ny, nz, 1936, 1936, 0};
+  for (int c = 0; c < 3; ++c) {
+    const size_t nf = size_t(nx + (c == 0)) * (ny + (c == 1)) * (nz + (c == 2));
+    mom[c] = DeviceBuffer<float>(s.d, nf);
+    wt[c] = DeviceBuffer<float>(s.d, nf);
+    g.mom[c] = mom[c].data();
+    g.weight[c] = wt[c].data();
+  }
+  for (auto _ : state) {
+    mass.fill_zero();
+    for (int c = 0; c < 3; ++c) mom[c].fill_zero(), wt[c].fill_zero();
+    particles_rasterise(s.d, s.store.view(), g);
+    s.d.synchronize();
+  }
+  state.SetItemsProcessed(state.iterations() * s.store.size());
+}
+BENCHMARK(BM_Rasterise)->Unit(benchmark::kMillisecond);
+
+}  // namespace
