@@ -1,0 +1,86 @@
+// Grid stage (paper §4.2) on the default 128 x 128 x 32 window: per-stage times of one
+// step with a paint layer and a pressed brush (the solver study's scene), and the window
+// move (scatter + velocity shift + gather).
+#include <benchmark/benchmark.h>
+
+#include "core/exec/device.h"
+#include "core/grid/solver_study.h"
+
+namespace {
+
+wb::StudyScene& scene() {
+  static wb::StudyScene s(wb::Device::from_env(), 128);
+  static bool ready = false;
+  if (!ready) {
+    s.prepare_system(2);
+    ready = true;
+  }
+  return s;
+}
+
+void BM_GridMoveWindow(benchmark::State& state) {
+  wb::Grid& g = scene().grid();
+  const wb::Int3 o = g.window().origin();
+  int step = 0;
+  for (auto _ : state) {
+    g.move_window(wb::Int3{o.x + ((step & 1) ? 8 : 0), o.y, 0});
+    ++step;
+  }
+  g.move_window(o);
+}
+BENCHMARK(BM_GridMoveWindow)->Unit(benchmark::kMillisecond);
+
+void BM_GridClassify(benchmark::State& state) {
+  wb::Grid& g = scene().grid();
+  for (auto _ : state) g.classify();
+}
+BENCHMARK(BM_GridClassify)->Unit(benchmark::kMillisecond);
+
+void BM_GridAdvect(benchmark::State& state) {
+  wb::Grid& g = scene().grid();
+  g.classify();
+  for (auto _ : state) g.advect(g.params().dt);
+}
+BENCHMARK(BM_GridAdvect)->Unit(benchmark::kMillisecond);
+
+void BM_GridForces(benchmark::State& state) {
+  wb::Grid& g = scene().grid();
+  g.classify();
+  for (auto _ : state) g.add_external_forces(g.params().dt);
+}
+BENCHMARK(BM_GridForces)->Unit(benchmark::kMillisecond);
+
+void BM_GridViscosity(benchmark::State& state) {
+  wb::Grid& g = scene().grid();
+  g.classify();
+  for (auto _ : state) g.apply_viscosity(g.params().dt);
+}
+BENCHMARK(BM_GridViscosity)->Unit(benchmark::kMillisecond);
+
+/// Arg: 0 fixed point (L = 3), 1 Jacobi (6), 2 Chebyshev (6 sweeps, rho estimated by 30 sweeps).
+void BM_GridProject(benchmark::State& state) {
+  wb::Grid& g = scene().grid();
+  const wb::GridParams saved = g.params();
+  g.params().solver = state.range(0) == 0   ? wb::PressureSolver::FixedPoint
+                      : state.range(0) == 1 ? wb::PressureSolver::Jacobi
+                                            : wb::PressureSolver::Chebyshev;
+  g.params().track_mass = false;
+  g.classify();
+  for (auto _ : state) g.project();
+  g.params() = saved;
+}
+BENCHMARK(BM_GridProject)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+
+void BM_GridDry(benchmark::State& state) {
+  wb::Grid& g = scene().grid();
+  for (auto _ : state) g.dry(g.params().dt);
+}
+BENCHMARK(BM_GridDry)->Unit(benchmark::kMillisecond);
+
+void BM_GridStep(benchmark::State& state) {
+  wb::Grid& g = scene().grid();
+  for (auto _ : state) g.step(g.params().dt);
+}
+BENCHMARK(BM_GridStep)->Unit(benchmark::kMillisecond);
+
+}  // namespace
