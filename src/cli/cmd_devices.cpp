@@ -10,12 +10,17 @@ namespace wb::cli {
 void register_devices(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("devices", "List the backends compiled in and the devices found");
   auto check = std::make_shared<bool>(false);
+  auto only = std::make_shared<std::string>();
   sub->add_flag("--check", *check, "Run a self-test kernel (atomics, parallel_for) on each device");
-  set_action(sub, [check]() {
+  sub->add_option("--device", *only, "Show (and check) only this device: cpu, cuda, cuda:N or auto");
+  set_action(sub, [check, only]() {
+    const bool filtered = !only->empty();
+    const Device wanted = filtered ? resolve_device(*only) : Device();
     std::printf("backends compiled in: cpu%s\n", cuda_compiled() ? ", cuda" : "");
     std::printf("auto selects: %s\n", Device::auto_select().to_string().c_str());
     int failures = 0;
     for (const DeviceInfo& info : list_devices()) {
+      if (filtered && !(info.device == wanted)) continue;
       std::printf("%-8s %s", info.device.to_string().c_str(), info.name.c_str());
       if (info.memory_bytes) std::printf(", %.1f GiB", double(info.memory_bytes) / (1 << 30));
       if (!info.detail.empty()) std::printf(" (%s)", info.detail.c_str());

@@ -1,5 +1,7 @@
 // Small fixed-size vector and matrix types for WB_HD kernel code (both backends).
 #pragma once
+#include <math.h>  // the global isfinite/sqrtf used by WB_HD code on the host too
+
 #include <cmath>
 
 #include "core/exec/hd.h"
