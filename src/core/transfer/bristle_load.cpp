@@ -1,0 +1,149 @@
+// The paint on the brush (paper §5.1): loading, dipping, wiping, cleaning and the UI sums.
+#include "core/transfer/bristle_load.h"
+
+#include <cmath>
+#include <string>
+
+#include "core/color/ryb.h"
+#include "core/exec/algorithms.h"
+#include "core/exec/dispatch.h"
+#include "core/exec/error.h"
+#include "core/transfer/transfer.h"
+
+namespace wb {
+namespace {
+
+void d_dip(const Device& d, BristleLoadView l, Vec3 ryb, float oil, float level, int replace, float* added) {
+  WB_DISPATCH(d, transfer_load_dip(l, ryb, oil, level, replace, added));
+}
+void d_scale(const Device& d, BristleLoadView l, float keep, float* removed) {
+  WB_DISPATCH(d, transfer_load_scale(l, keep, removed));
+}
+void d_product(const Device& d, const float* a, const float* b, float* out, int64_t n) {
+  WB_DISPATCH(d, transfer_product(a, b, out, n));
+}
+void d_brightness(const Device& d, BristleLoadView l, float* out) { WB_DISPATCH(d, transfer_load_brightness(l, out)); }
+
+void validate(const PaintLoad& p, const char* what) {
+  for (int c = 0; c < 3; ++c)
+    WB_REQUIRE(std::isfinite(p.ryb[c]) && p.ryb[c] >= 0.f && p.ryb[c] <= 1.f,
+               std::string(what) + ": pigment component " + std::to_string(c) + " must lie in [0, 1]");
+  WB_REQUIRE(std::isfinite(p.oil) && p.oil >= 0.f && p.oil <= 1.f, std::string(what) + ": oil must lie in [0, 1]");
+  WB_REQUIRE(std::isfinite(p.load) && p.load >= 0.f && p.load <= 1.f, std::string(what) + ": load must lie in [0, 1]");
+}
+
+}  // namespace
+
+BristleLoad::BristleLoad(const Device& device, int64_t samples, const TransferParams& params)
+    : device_(device), count_(samples) {
+  WB_REQUIRE(samples >= 0, "BristleLoad: negative sample count");
+  WB_REQUIRE(std::isfinite(params.M_max) && params.M_max > 0.f, "BristleLoad: M_max must be positive");
+#define WB_X(name, doc)    \
+  name.set_device(device); \
+  name.resize(size_t(samples));
+  WB_BRISTLE_LOAD_FIELDS(WB_X)
+#undef WB_X
+  scratch_.set_device(device);
+  scratch_.resize(size_t(samples));
+  BristleLoadHost h;
+#define WB_X(name, doc) h.name.assign(size_t(samples), 0.f);
+  WB_BRISTLE_LOAD_FIELDS(WB_X)
+#undef WB_X
+  const float cm = params.cell_mass();
+  h.potential.assign(size_t(samples), params.M_max);
+  h.capacity.assign(size_t(samples), params.M_max);
+  h.radius.assign(size_t(samples), std::cbrt(3.f * params.M_max / (4.f * 3.14159265f * cm)));
+  from_host(h);
+}
+
+BristleLoadView BristleLoad::view() {
+  BristleLoadView v{};
+#define WB_X(name, doc) v.name = name.data();
+  WB_BRISTLE_LOAD_FIELDS(WB_X)
+#undef WB_X
+  v.count = count_;
+  return v;
+}
+
+double BristleLoad::fill(const PaintLoad& paint) {
+  validate(paint, "BristleLoad::fill");
+  if (count_ == 0) return 0.0;
+  d_dip(device_, view(), Vec3(paint.ryb[0], paint.ryb[1], paint.ryb[2]), paint.oil, paint.load, 1, scratch_.data());
+  Workspace ws(device_);
+  return reduce_sum(device_, scratch_.data(), count_, ws);
+}
+
+double BristleLoad::dip(const PaintLoad& paint) {
+  validate(paint, "BristleLoad::dip");
+  if (count_ == 0) return 0.0;
+  d_dip(device_, view(), Vec3(paint.ryb[0], paint.ryb[1], paint.ryb[2]), paint.oil, paint.load, 0, scratch_.data());
+  Workspace ws(device_);
+  return reduce_sum(device_, scratch_.data(), count_, ws);
+}
+
+double BristleLoad::wipe(float fraction) {
+  WB_REQUIRE(std::isfinite(fraction) && fraction >= 0.f && fraction <= 1.f,
+             "BristleLoad::wipe: the fraction must lie in [0, 1], got " + std::to_string(fraction));
+  if (count_ == 0) return 0.0;
+  d_scale(device_, view(), 1.f - fraction, scratch_.data());
+  Workspace ws(device_);
+  return reduce_sum(device_, scratch_.data(), count_, ws);
+}
+
+double BristleLoad::clean() {
+  if (count_ == 0) return 0.0;
+  // A fill with nothing: no load, no pigment (white), no oil.
+  d_dip(device_, view(), Vec3(0.f, 0.f, 0.f), 0.f, 0.f, 1, scratch_.data());
+  Workspace ws(device_);
+  return -reduce_sum(device_, scratch_.data(), count_, ws);
+}
+
+double BristleLoad::total_mass(Workspace& ws) const { return reduce_sum(device_, m.data(), count_, ws); }
+
+Vec3 BristleLoad::mean_color(Workspace& ws) {
+  const double w = total_mass(ws);
+  if (!(w > 0.0)) return Vec3(0.f, 0.f, 0.f);
+  double sums[4];
+  const float* comp[3] = {pigment_r.data(), pigment_y.data(), pigment_b.data()};
+  for (int c = 0; c < 3; ++c) {
+    d_product(device_, m.data(), comp[c], scratch_.data(), count_);
+    sums[c] = reduce_sum(device_, scratch_.data(), count_, ws);
+  }
+  d_brightness(device_, view(), scratch_.data());
+  sums[3] = reduce_sum(device_, scratch_.data(), count_, ws);
+  // Many-colour Algorithm 2: mass-weighted RYB mean, rescaled to the mass-weighted brightness.
+  const Vec3 lin(float(sums[0] / w), float(sums[1] / w), float(sums[2] / w));
+  return rescale_to_brightness(lin, float(sums[3] / w));
+}
+
+float BristleLoad::mean_oil(Workspace& ws) {
+  const double w = total_mass(ws);
+  if (!(w > 0.0)) return 0.f;
+  d_product(device_, m.data(), oil.data(), scratch_.data(), count_);
+  return float(reduce_sum(device_, scratch_.data(), count_, ws) / w);
+}
+
+BristleLoadHost BristleLoad::to_host() const {
+  BristleLoadHost h;
+#define WB_X(name, doc) h.name = name.to_host();
+  WB_BRISTLE_LOAD_FIELDS(WB_X)
+#undef WB_X
+  return h;
+}
+
+void BristleLoad::from_host(const BristleLoadHost& h) {
+#define WB_X(name, doc)                                                                                       \
+  WB_REQUIRE(int64_t(h.name.size()) == count_, "BristleLoad::from_host: field '" #name "' has " +            \
+                                                   std::to_string(h.name.size()) + " entries, the brush has " + \
+                                                   std::to_string(count_) + " samples");
+  WB_BRISTLE_LOAD_FIELDS(WB_X)
+#undef WB_X
+  for (size_t j = 0; j < h.m.size(); ++j)
+    WB_REQUIRE(std::isfinite(h.m[j]) && h.m[j] >= 0.f,
+               "BristleLoad::from_host: sample " + std::to_string(j) + " has a negative or non-finite load");
+#define WB_X(name, doc) name.copy_from_host(h.name);
+  WB_BRISTLE_LOAD_FIELDS(WB_X)
+#undef WB_X
+}
+
+}  // namespace wb

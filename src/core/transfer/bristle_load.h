@@ -1,0 +1,92 @@
+// The paint on the brush (paper §5.1): per bristle sample its liquid load m_j (kg), pigment
+// c_j (RYB) and oil, and the capacity the last transfer step computed (M'_j of Eq. 12, M_j
+// of Eq. 13, the load radius R_j). Loading, dipping, wiping and cleaning act on the whole
+// brush; the transfer stage (transfer.h) moves paint between samples and particles.
+#pragma once
+#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
+#include <cstdint>
+#include <vector>
+
+#include "core/exec/buffer.h"
+#include "core/exec/device.h"
+#include "core/exec/workspace.h"
+#include "core/io/stroke.h"
+#include "core/math/vec.h"
+#include "core/transfer/transfer_params.h"
+
+// X(name, description); all float, one entry per bristle sample.
+#define WB_BRISTLE_LOAD_FIELDS(X)                                              \
+  X(m, "liquid load m_j, kg")                                                \
+  X(pigment_r, "RYB pigment c_j, red in [0, 1]")                             \
+  X(pigment_y, "RYB pigment c_j, yellow in [0, 1]")                          \
+  X(pigment_b, "RYB pigment c_j, blue in [0, 1]")                            \
+  X(oil, "oil fraction of the load in [0, 1]")                               \
+  X(potential, "potential capacity M'_j of Eq. 12, kg (last transfer step)") \
+  X(capacity, "capacity M_j of Eq. 13, kg (last transfer step)")             \
+  X(radius, "load radius R_j, cells (last transfer step)")
+
+namespace wb {
+
+/// POD view of the brush's load: device pointers plus the sample count. Passed by value.
+struct BristleLoadView {
+#define WB_X(name, doc) float* name;
+  WB_BRISTLE_LOAD_FIELDS(WB_X)
+#undef WB_X
+  int64_t count;
+};
+
+/// Host copy of every field.
+struct BristleLoadHost {
+#define WB_X(name, doc) std::vector<float> name;
+  WB_BRISTLE_LOAD_FIELDS(WB_X)
+#undef WB_X
+};
+
+class BristleLoad {
+ public:
+  BristleLoad() = default;
+  /// An empty (clean) brush of `samples` samples; capacities start at params.M_max (psi = 0,
+  /// no surface near) until the first transfer step computes them.
+  BristleLoad(const Device& device, int64_t samples, const TransferParams& params = {});
+
+  const Device& device() const { return device_; }
+  int64_t size() const { return count_; }
+  BristleLoadView view();
+
+  /// A fresh brush loaded with `paint`: m_j = paint.load * M'_j (the potential capacity of
+  /// Eq. 12 from the last transfer step, M_max before it), colour paint.ryb, oil paint.oil.
+  /// Returns the net change of the brush's paint, kg (what entered minus what it replaced).
+  double fill(const PaintLoad& paint);
+  /// Dips the brush into a well of `paint` (dirty brush): every sample is topped up to
+  /// paint.load * M'_j with the new paint, mixed into what it holds (Algorithm 2 by mass, oil
+  /// by mass); a sample already above that level keeps its paint unchanged. Returns the kg added.
+  double dip(const PaintLoad& paint);
+  /// Wipes the brush on a rag: removes `fraction` (in [0, 1]) of every sample's load. Returns the kg removed.
+  double wipe(float fraction);
+  /// Cleans the brush in solvent: no load, no pigment, no oil. Returns the kg removed.
+  double clean();
+
+  /// Sum of the loads, kg (double).
+  double total_mass(Workspace& ws) const;
+  /// Mass-weighted pigment of the whole brush (Algorithm 2 over all samples), for the UI;
+  /// zero (white) when the brush is clean.
+  Vec3 mean_color(Workspace& ws);
+  /// Mass-weighted oil fraction of the load (0 when clean).
+  float mean_oil(Workspace& ws);
+
+  BristleLoadHost to_host() const;
+  /// Replaces every field (each size() long); throws wb::Error on a size mismatch or a
+  /// negative / non-finite load.
+  void from_host(const BristleLoadHost& h);
+
+#define WB_X(name, doc) DeviceBuffer<float> name;
+  WB_BRISTLE_LOAD_FIELDS(WB_X)
+#undef WB_X
+
+ private:
+  Device device_;
+  int64_t count_ = 0;
+  DeviceBuffer<float> scratch_;
+};
+
+}  // namespace wb

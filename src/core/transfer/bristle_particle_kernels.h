@@ -1,0 +1,127 @@
+// Bristle <-> particle liquid transfer (paper §5.1, Eq. 12-14, Figures 9-10): the capacity of a
+// bristle sample from the bristle density psi (Eq. 12) and the spherical cap cut off by a
+// nearby surface (Eq. 13), absorption with colour mixing (Eq. 14), colour bleeding of
+// saturated samples, and emission in the lower hemisphere. Colours mix by Algorithm 2.
+#pragma once
+#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
+#include <cstdint>
+
+#include "core/color/ryb.h"
+#include "core/exec/hd.h"
+#include "core/math/vec.h"
+#include "core/transfer/grid_particle_kernels.h"
+
+namespace wb {
+
+inline constexpr float kTransferPi = 3.14159265358979f;
+
+/// Eq. 12: potential capacity M'_j = max((1 - mu psi(x_j)) M_max, M_min), kg.
+WB_HD WB_INLINE float potential_capacity(float psi, float mu, float M_max, float M_min) {
+  return maxf((1.f - mu * psi) * M_max, M_min);
+}
+
+/// Radius of the load sphere, R_j = (3 M'_j / (4 pi rho0))^(1/3) (§5.1), in cells;
+/// cell_mass = rho0 cell^3 converts kg to cell volumes.
+WB_HD WB_INLINE float load_radius(float M_prime, float cell_mass) {
+  return cbrtf(3.f * maxf(M_prime, 0.f) / (4.f * kTransferPi * cell_mass));
+}
+
+/// Volume of the spherical cap of height h cut from a sphere of radius R: pi h^2 (R - h/3).
+WB_HD WB_INLINE float spherical_cap_volume(float R, float h) { return kTransferPi * h * h * (R - h / 3.f); }
+
+/// Eq. 13: M_j = M'_j - rho0 pi (R_j - r_j)^2 (R_j - (R_j - r_j)/3), r_j clamped to [0, R_j];
+/// lengths in cells, cell_mass = rho0 cell^3. Between M'_j (r = R) and M'_j / 2 (r = 0).
+WB_HD WB_INLINE float surface_capacity(float M_prime, float R, float r, float cell_mass) {
+  const float h = R - clampf(r, 0.f, R);
+  return maxf(M_prime - cell_mass * spherical_cap_volume(R, h), 0.f);
+}
+
+/// r_j of Eq. 13: distance from the sample at x (canvas cells) to the nearest surface below it,
+/// clamped to [0, R]: the canvas floor at floor_z, or the first point of a downward march
+/// (steps of `step` cells) where the window density reaches `threshold` (grid liquid or dried
+/// paint; linear between the last two points). The brush works from above, so the surfaces
+/// that cut its load lie below it: the march is along -z only.
+WB_HD WB_INLINE float surface_distance(Vec3 x, float R, float floor_z, const CellField& density, float threshold,
+                                       float step) {
+  float r = x.z - floor_z;
+  if (density.f != nullptr && r > 0.f) {
+    float prev = cell_field_at(density, x);
+    if (prev >= threshold) return 0.f;
+    float s_prev = 0.f;
+    const float reach = minf(R, r);
+    for (int it = 0; it < 4096 && s_prev < reach; ++it) {
+      const float s = minf(s_prev + step, reach);
+      const float val = cell_field_at(density, Vec3(x.x, x.y, x.z - s));
+      if (val >= threshold) {
+        const float t = val > prev ? (threshold - prev) / (val - prev) : 1.f;
+        r = minf(r, s_prev + (s - s_prev) * clampf(t, 0.f, 1.f));
+        break;
+      }
+      prev = val;
+      s_prev = s;
+    }
+  }
+  return clampf(r, 0.f, R);
+}
+
+/// Colour of a batch mix: the sample's own pigment c_self with weight w_self, plus a batch given
+/// by its sums sum_w, sum_w c and sum_w brightness. Linear in RYB, then rescaled to the weighted
+/// mean brightness: the many-colour Algorithm 2 (= color_mix_n over every member), which Eq. 14
+/// applies when several particles join one sample in a step.
+WB_HD WB_INLINE Vec3 mix_batch(Vec3 c_self, float w_self, Vec3 sum_wc, float sum_wb, float sum_w) {
+  const float ws = maxf(w_self, 0.f);
+  const float w = ws + sum_w;
+  if (!(w > 0.f)) return c_self;
+  const Vec3 lin = (c_self * ws + sum_wc) / w;
+  const float b = (ws * pigment_brightness(c_self) + sum_wb) / w;
+  return rescale_to_brightness(lin, b);
+}
+
+/// Colour bleeding (§5.1): a particle of mass m_k within R_j of a sample that does not absorb it
+/// exchanges e = bleed min(m_k, m_j) of colour with the sample; masses are unchanged.
+WB_HD WB_INLINE float bleed_weight(float bleed, float m_k, float m_j) { return bleed * minf(m_k, m_j); }
+
+/// Emission plan (§5.1): when m > (1 + eps) M, n = min(limit, ceil((m - M) / emit_mass))
+/// particles of (m - M) / n each, capped at emit_mass: the load falls to M in one step or by
+/// limit * emit_mass per step. Returns n and sets mass_each.
+WB_HD WB_INLINE int emission_count(float m, float M, float eps, float emit_mass, int limit, float& mass_each) {
+  mass_each = 0.f;
+  if (limit <= 0 || !(m > (1.f + eps) * M) || !(emit_mass > 0.f)) return 0;
+  const float excess = m - M;
+  const float want = ceilf(excess / emit_mass);
+  if (want >= float(limit)) {
+    mass_each = minf(emit_mass, excess / float(limit));
+    return limit;
+  }
+  const int n = want < 1.f ? 1 : int(want);
+  mass_each = excess / float(n);
+  return n;
+}
+
+/// Point s of the fixed emission pattern of P points, uniform in the lower half of the unit
+/// ball (canvas -z, §5.1 "bottom hemisphere", Figure 10): Fibonacci directions over the
+/// hemisphere (uniform in area), radii from a golden-ratio sequence with the cube-root
+/// volume law, kept off the centre (radius fraction in [0.46, 1]).
+WB_HD WB_INLINE Vec3 emission_pattern_point(int s, int P) {
+  const float z = -(float(s) + 0.5f) / float(P);
+  const float rho = sqrtf(maxf(1.f - z * z, 0.f));
+  const float phi = 2.39996323f * float(s);
+  float u = (float(s) + 0.5f) * 0.61803399f;
+  u -= floorf(u);
+  const float radius = cbrtf(0.1f + 0.9f * u);
+  return Vec3(rho * cosf(phi), rho * sinf(phi), z) * radius;
+}
+
+/// Position of the i-th particle emitted by sample j this step: pattern slot (j + step_index *
+/// n + i) mod P so that successive steps fill different slots, scaled by R_j, kept at or above
+/// the canvas (but never above the sample).
+WB_HD WB_INLINE Vec3 emission_position(Vec3 x_j, float R_j, int64_t j, int64_t step_index, int n, int i, int P,
+                                       float floor_z) {
+  const int64_t slot = (j + step_index * int64_t(n) + int64_t(i)) % int64_t(P);
+  Vec3 p = x_j + emission_pattern_point(int(slot), P) * R_j;
+  const float lo = minf(floor_z + 0.01f, x_j.z);
+  if (p.z < lo) p.z = lo;
+  return p;
+}
+
+}  // namespace wb

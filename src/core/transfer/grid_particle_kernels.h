@@ -1,0 +1,218 @@
+// Grid <-> particle liquid transfer (paper §5.2, Eq. 15-16): the per-element physics.
+// Cells within D0 of the bristles turn into particles (27 stratified candidates per cell,
+// kept where the interpolated density is positive); slow particles beyond D0 go back to the
+// cells. Both directions spread a particle's mass over the cells with the kernel W of length
+// h, normalised over the cells it touches, so the grid changes by exactly the particle mass.
+#pragma once
+#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
+#include <cstdint>
+
+#include "core/canvas/window.h"
+#include "core/exec/hd.h"
+#include "core/math/vec.h"
+
+namespace wb {
+
+/// Number of stratified candidates per cell (3 x 3 x 3), §5.2.
+inline constexpr int kCandidatesPerCell = 27;
+/// Squared distance standing for "no sample anywhere" in the distance transform.
+inline constexpr float kFarDistance2 = 1e20f;
+
+WB_HD WB_INLINE int imax_t(int a, int b) { return a > b ? a : b; }
+WB_HD WB_INLINE int imin_t(int a, int b) { return a < b ? a : b; }
+
+/// Dried paint is solid: it neither becomes particles nor receives them (§4.2 "dryness").
+WB_HD WB_INLINE bool cell_is_solid(float density, float dryness, float dry_threshold) {
+  return density > 0.f && dryness >= dry_threshold;
+}
+
+/// A cell-centred window scalar field (cell (i,j,k) centre at (i+1/2, j+1/2, k+1/2)).
+struct CellField {
+  const float* f;
+  int nx, ny, nz;
+  int ox, oy, oz;  ///< canvas cell of the field's (0,0,0)
+};
+
+/// Trilinear value of a cell-centred field at canvas position p; nodes outside the field read 0.
+WB_HD WB_INLINE float cell_field_at(const CellField& g, Vec3 p) {
+  if (g.f == nullptr) return 0.f;
+  const float sx = p.x - float(g.ox) - 0.5f, sy = p.y - float(g.oy) - 0.5f, sz = p.z - float(g.oz) - 0.5f;
+  const float fx = floorf(sx), fy = floorf(sy), fz = floorf(sz);
+  const int i0 = int(fx), j0 = int(fy), k0 = int(fz);
+  const float tx = sx - fx, ty = sy - fy, tz = sz - fz;
+  float acc = 0.f;
+  for (int c = 0; c < 2; ++c)
+    for (int b = 0; b < 2; ++b)
+      for (int a = 0; a < 2; ++a) {
+        const int i = i0 + a, j = j0 + b, k = k0 + c;
+        if (i < 0 || j < 0 || k < 0 || i >= g.nx || j >= g.ny || k >= g.nz) continue;
+        const float w = (a ? tx : 1.f - tx) * (b ? ty : 1.f - ty) * (c ? tz : 1.f - tz);
+        acc += w * g.f[(int64_t(k) * g.ny + j) * g.nx + i];
+      }
+  return acc;
+}
+
+/// Trilinear density of the liquid (non-solid) paint at window position q, constant
+/// extension at the window's edges; solid cells count as empty. Used to keep candidates.
+WB_HD WB_INLINE float liquid_density_at(const PaintWindowView& pw, Vec3 q, float dry_threshold) {
+  const float sx = q.x - 0.5f, sy = q.y - 0.5f, sz = q.z - 0.5f;
+  const float fx = floorf(sx), fy = floorf(sy), fz = floorf(sz);
+  const int i0 = int(fx), j0 = int(fy), k0 = int(fz);
+  const float tx = sx - fx, ty = sy - fy, tz = sz - fz;
+  float acc = 0.f;
+  for (int c = 0; c < 2; ++c)
+    for (int b = 0; b < 2; ++b)
+      for (int a = 0; a < 2; ++a) {
+        const int i = clampi(i0 + a, 0, pw.nx - 1), j = clampi(j0 + b, 0, pw.ny - 1), k = clampi(k0 + c, 0, pw.nz - 1);
+        const int64_t id = pw.index(i, j, k);
+        const float rho = pw.density[id];
+        if (cell_is_solid(rho, pw.dryness[id], dry_threshold)) continue;
+        acc += (a ? tx : 1.f - tx) * (b ? ty : 1.f - ty) * (c ? tz : 1.f - tz) * rho;
+      }
+  return acc;
+}
+
+/// 32-bit integer hash (Wang / Jenkins mix), for the deterministic candidate jitter.
+WB_HD WB_INLINE uint32_t transfer_hash(uint32_t x) {
+  x = (x ^ 61u) ^ (x >> 16);
+  x *= 9u;
+  x ^= x >> 4;
+  x *= 0x27d4eb2du;
+  x ^= x >> 15;
+  return x;
+}
+
+/// Candidate s (0..26) of the canvas cell (cx, cy, cz): the centre of sub-cell (s%3, s/3%3, s/9)
+/// of the 3x3x3 split, jittered within the sub-cell by up to +-1/3 of its size, deterministically
+/// from the canvas cell and s (§5.2 "stratified sampling ... 27 particle candidates"). Returns
+/// the offset inside the cell, in [0,1)^3.
+WB_HD WB_INLINE Vec3 candidate_offset(int cx, int cy, int cz, int s) {
+  const uint32_t seed = transfer_hash(uint32_t(cx) * 73856093u ^ uint32_t(cy) * 19349663u ^ uint32_t(cz) * 83492791u ^
+                                      uint32_t(s) * 2654435761u);
+  const float jx = float(seed & 1023u) / 1023.f - 0.5f;
+  const float jy = float((seed >> 10) & 1023u) / 1023.f - 0.5f;
+  const float jz = float((seed >> 20) & 1023u) / 1023.f - 0.5f;
+  const float third = 1.f / 3.f;
+  return Vec3((float(s % 3) + 0.5f + jx * 0.666f) * third, (float((s / 3) % 3) + 0.5f + jy * 0.666f) * third,
+              (float(s / 9) + 0.5f + jz * 0.666f) * third);
+}
+
+/// Tent weight of one axis: max(1 - |d| / h, 0).
+WB_HD WB_INLINE float tent(float d, float h) { return maxf(1.f - fabsf(d) / h, 0.f); }
+
+/// The kernel W(p - x_c, h) of Eq. 15-16 at window position q over the liquid cells of the
+/// window: a separable tent of half-width h around q, normalised so that its weights over the
+/// cells it touches (inside the window, not solid) sum to one. Calls f(cell index, weight) for
+/// each such cell and returns the number of cells (0: none, q cannot exchange with the grid).
+template <typename F>
+WB_HD WB_INLINE int for_each_kernel_cell(const PaintWindowView& pw, Vec3 q, float h, float dry_threshold, F f) {
+  const int i0 = imax_t(int(ceilf(q.x - 0.5f - h)), 0), i1 = imin_t(int(floorf(q.x - 0.5f + h)), pw.nx - 1);
+  const int j0 = imax_t(int(ceilf(q.y - 0.5f - h)), 0), j1 = imin_t(int(floorf(q.y - 0.5f + h)), pw.ny - 1);
+  const int k0 = imax_t(int(ceilf(q.z - 0.5f - h)), 0), k1 = imin_t(int(floorf(q.z - 0.5f + h)), pw.nz - 1);
+  float sum = 0.f;
+  int n = 0;
+  for (int k = k0; k <= k1; ++k)
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        const float w = tent(q.x - (float(i) + 0.5f), h) * tent(q.y - (float(j) + 0.5f), h) *
+                        tent(q.z - (float(k) + 0.5f), h);
+        if (!(w > 0.f)) continue;
+        const int64_t id = pw.index(i, j, k);
+        if (cell_is_solid(pw.density[id], pw.dryness[id], dry_threshold)) continue;
+        sum += w;
+        ++n;
+      }
+  if (!(sum > 0.f)) return 0;
+  const float inv = 1.f / sum;
+  for (int k = k0; k <= k1; ++k)
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        const float w = tent(q.x - (float(i) + 0.5f), h) * tent(q.y - (float(j) + 0.5f), h) *
+                        tent(q.z - (float(k) + 0.5f), h);
+        if (!(w > 0.f)) continue;
+        const int64_t id = pw.index(i, j, k);
+        if (cell_is_solid(pw.density[id], pw.dryness[id], dry_threshold)) continue;
+        f(id, w * inv);
+      }
+  return n;
+}
+
+/// Eq. 15 with the clamp kept exact: a cell asked for `demand` (density units) by the new
+/// particles' kernels gives removed = min(demand, available); every particle then keeps
+/// ratio = removed / demand of what it asked from that cell, so the particles' mass equals
+/// the removed density and the clamp creates no paint. Returns ratio (1 when demand is 0).
+WB_HD WB_INLINE float clamp_ratio(float demand, float available, float& removed) {
+  if (!(demand > 0.f)) {
+    removed = 0.f;
+    return 1.f;
+  }
+  removed = minf(demand, maxf(available, 0.f));
+  return removed >= demand ? 1.f : removed / demand;
+}
+
+// --- coarse distance to the bristles (decides "within D0", §5.2) ---------------------
+
+/// One line of the exact squared Euclidean distance transform (Felzenszwalb & Huttenlocher
+/// 2012): out[q] = min_p (f[p] + (q - p)^2) over n entries at `stride`; v (n ints) and z
+/// (n + 1 floats) are scratch. f entries of kFarDistance2 or more mean "no site".
+WB_HD WB_INLINE void edt_line(const float* f, float* out, int n, int64_t stride, int* v, float* z) {
+  int k = -1;
+  for (int q = 0; q < n; ++q) {
+    const float fq = f[q * stride];
+    if (fq >= kFarDistance2) continue;
+    float s = 0.f;
+    while (k >= 0) {
+      const int p = v[k];
+      const float fp = f[p * stride];
+      s = ((fq + float(q) * float(q)) - (fp + float(p) * float(p))) / (2.f * float(q - p));
+      if (s <= z[k]) {
+        --k;
+      } else {
+        break;
+      }
+    }
+    ++k;
+    v[k] = q;
+    z[k] = k == 0 ? -1e30f : s;
+    z[k + 1] = 1e30f;
+  }
+  if (k < 0) {
+    for (int q = 0; q < n; ++q) out[q * stride] = kFarDistance2;
+    return;
+  }
+  int j = 0;
+  for (int q = 0; q < n; ++q) {
+    while (z[j + 1] < float(q)) ++j;
+    const float d = float(q - v[j]);
+    out[q * stride] = d * d + f[v[j] * stride];
+  }
+}
+
+/// Coarse block grid of the bristle distance field: blocks of `block` cells over the window,
+/// extended by `margin` blocks on every side so that samples outside the window still count.
+struct DistanceBlocks {
+  float* d2;  ///< squared distance to the nearest occupied block, in blocks^2
+  int bx, by, bz;
+  int block;
+  int margin;
+  float D0;  ///< cells
+  WB_HD int64_t index(int i, int j, int k) const { return (int64_t(k) * by + j) * bx + i; }
+  /// Block of window position q (may fall outside: then -1).
+  WB_HD int64_t block_of(Vec3 q) const {
+    const int i = int(floorf(q.x / float(block))) + margin, j = int(floorf(q.y / float(block))) + margin,
+              k = int(floorf(q.z / float(block))) + margin;
+    if (i < 0 || j < 0 || k < 0 || i >= bx || j >= by || k >= bz) return -1;
+    return index(i, j, k);
+  }
+  /// Distance from the block of window position q to the bristles, cells (block-centre
+  /// to block-centre, so within +-block*sqrt(3) of the true distance); huge when none.
+  WB_HD float distance(Vec3 q) const {
+    const int64_t b = block_of(q);
+    if (b < 0) return 1e30f;
+    const float v = d2[b];
+    return v >= kFarDistance2 ? 1e30f : sqrtf(v) * float(block);
+  }
+  WB_HD bool near(Vec3 q) const { return distance(q) <= D0; }
+};
+
+}  // namespace wb

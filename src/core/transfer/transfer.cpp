@@ -1,0 +1,357 @@
+// Liquid transfer stage (paper §5, Eq. 12-16): validation, scratch, the order of the passes
+// and the books of each transfer. Dispatches every pass to wb::cpu or wb::cuda.
+#include "core/transfer/transfer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "core/exec/algorithms.h"
+#include "core/exec/dispatch.h"
+#include "core/exec/error.h"
+#include "core/exec/profile.h"
+
+namespace wb {
+namespace {
+
+// One dispatcher per backend pass (WB_DISPATCH returns from the function it is in).
+void d_absorb(const Device& d, ParticleView p, SampleView s, BristleLoadView l, AbsorbScratch a, TransferParams prm) {
+  WB_DISPATCH(d, transfer_absorb(p, s, l, a, prm));
+}
+void d_absorb_apply(const Device& d, BristleLoadView l, AbsorbScratch a) { WB_DISPATCH(d, transfer_absorb_apply(l, a)); }
+void d_occupancy(const Device& d, SampleView s, DistanceBlocks db, int32_t* occ, int ox, int oy, int oz) {
+  WB_DISPATCH(d, transfer_distance_occupancy(s, db, occ, ox, oy, oz));
+}
+void d_distance_init(const Device& d, const int32_t* occ, float* d2, int64_t n) {
+  WB_DISPATCH(d, transfer_distance_init(occ, d2, n));
+}
+void d_distance_pass(const Device& d, DistanceBlocks db, int axis, const float* src, float* dst, int32_t* v, float* z) {
+  WB_DISPATCH(d, transfer_distance_pass(db, axis, src, dst, v, z));
+}
+void d_to_grid_mark(const Device& d, ParticleView p, PaintWindowView pw, DistanceBlocks db, DepositScratch acc,
+                    TransferParams prm, float dry) {
+  WB_DISPATCH(d, transfer_to_grid_mark(p, pw, db, acc, prm, dry));
+}
+void d_to_grid_apply(const Device& d, PaintWindowView pw, DepositScratch acc) {
+  WB_DISPATCH(d, transfer_to_grid_apply(pw, acc));
+}
+void d_emit_count(const Device& d, BristleLoadView l, TransferParams prm, uint32_t* count, float* mass_each) {
+  WB_DISPATCH(d, transfer_emit_count(l, prm, count, mass_each));
+}
+void d_emit_fill(const Device& d, SampleView s, BristleLoadView l, ParticleView p, const uint32_t* offset,
+                 const uint32_t* count, const float* mass_each, int64_t first, int64_t room, int64_t step_index,
+                 TransferParams prm, float floor_z, float* emitted) {
+  WB_DISPATCH(d, transfer_emit_fill(s, l, p, offset, count, mass_each, first, room, step_index, prm, floor_z, emitted));
+}
+void d_grid_count(const Device& d, PaintWindowView pw, DistanceBlocks db, TransferParams prm, float dry,
+                  uint32_t* count) {
+  WB_DISPATCH(d, transfer_grid_count(pw, db, prm, dry, count));
+}
+void d_grid_emit(const Device& d, PaintWindowView pw, MacView vel, ParticleView p, const uint32_t* count,
+                 const uint32_t* offset, int64_t first, int64_t room, TransferParams prm, float dry, float* demand) {
+  WB_DISPATCH(d, transfer_grid_emit(pw, vel, p, count, offset, first, room, prm, dry, demand));
+}
+void d_grid_clamp(const Device& d, PaintWindowView pw, float* demand_ratio, float* removed) {
+  WB_DISPATCH(d, transfer_grid_clamp(pw, demand_ratio, removed));
+}
+void d_grid_finish(const Device& d, ParticleView p, int64_t first, int64_t n, PaintWindowView pw, const float* ratio,
+                   TransferParams prm, float dry) {
+  WB_DISPATCH(d, transfer_grid_finish(p, first, n, pw, ratio, prm, dry));
+}
+
+void validate(const TransferParams& p) {
+  auto in = [](float v, float lo, float hi) { return std::isfinite(v) && v >= lo && v <= hi; };
+  WB_REQUIRE(in(p.rho0, 1.f, 1e5f), "TransferParams: rho0 must lie in [1, 1e5] kg/m^3");
+  WB_REQUIRE(in(p.cell_size, 1e-6f, 1.f), "TransferParams: cell_size must lie in [1e-6, 1] m");
+  WB_REQUIRE(in(p.mu, 0.f, 1.f), "TransferParams: mu must lie in [0, 1] (Eq. 12)");
+  WB_REQUIRE(in(p.M_max, 1e-20f, 1e-5f), "TransferParams: M_max must lie in (0, 1e-5] kg (Eq. 12)");
+  WB_REQUIRE(in(p.M_min, 0.f, p.M_max), "TransferParams: M_min must lie in [0, M_max] (Eq. 12)");
+  WB_REQUIRE(in(p.epsilon, 0.f, 10.f), "TransferParams: epsilon must lie in [0, 10]");
+  WB_REQUIRE(in(p.surface_density, 1e-6f, 1.f), "TransferParams: surface_density must lie in (0, 1]");
+  WB_REQUIRE(in(p.march_step, 0.05f, 1.f), "TransferParams: march_step must lie in [0.05, 1] cells");
+  WB_REQUIRE(p.absorb_limit >= 0 && p.absorb_limit <= 1024, "TransferParams: absorb_limit must lie in [0, 1024]");
+  WB_REQUIRE(p.emit_limit >= 0 && p.emit_limit <= 64, "TransferParams: emit_limit must lie in [0, 64]");
+  WB_REQUIRE(in(p.emit_mass, 1e-20f, p.M_max), "TransferParams: emit_mass must lie in (0, M_max] kg");
+  WB_REQUIRE(p.emit_pattern >= 1 && p.emit_pattern <= 64, "TransferParams: emit_pattern must lie in [1, 64]");
+  WB_REQUIRE(in(p.bleed, 0.f, 1.f), "TransferParams: bleed must lie in [0, 1]");
+  WB_REQUIRE(in(p.kernel_h, 0.5f, 2.f), "TransferParams: kernel_h must lie in [0.5, 2] cells");
+  WB_REQUIRE(in(p.slow_speed, 0.f, 1e4f), "TransferParams: slow_speed must lie in [0, 1e4] cells/s");
+  WB_REQUIRE(in(p.min_cell_density, 0.f, 1.f), "TransferParams: min_cell_density must lie in [0, 1]");
+  WB_REQUIRE(p.distance_block >= 1 && p.distance_block <= 16, "TransferParams: distance_block must lie in [1, 16]");
+}
+
+void validate(const TransferEnv& env) {
+  const PaintWindowView& pw = env.paint;
+  WB_REQUIRE(pw.density && pw.pigment_r && pw.pigment_y && pw.pigment_b && pw.oil && pw.dryness,
+             "Transfer: the window's paint fields are missing");
+  WB_REQUIRE(pw.nx > 0 && pw.ny > 0 && pw.nz > 0, "Transfer: empty window");
+  WB_REQUIRE(std::isfinite(env.floor_z) && std::isfinite(env.D0) && env.D0 >= 0.f,
+             "Transfer: floor_z and D0 must be finite, D0 >= 0");
+  WB_REQUIRE(std::isfinite(env.dry_threshold) && env.dry_threshold > 0.f && env.dry_threshold <= 1.f,
+             "Transfer: dry_threshold must lie in (0, 1]");
+  if (env.velocity.u != nullptr)
+    WB_REQUIRE(env.velocity.v && env.velocity.w && env.velocity.nx == pw.nx && env.velocity.ny == pw.ny &&
+                   env.velocity.nz == pw.nz && env.velocity.ox == pw.ox && env.velocity.oy == pw.oy &&
+                   env.velocity.oz == pw.oz,
+               "Transfer: the velocity field must cover the paint window");
+}
+
+double rel_gap(double a, double b) {
+  const double s = std::max(std::fabs(a), std::fabs(b));
+  return s > 0 ? std::fabs(a - b) / s : 0.0;
+}
+
+}  // namespace
+
+double TransferRecord::max_closure_error() const {
+  return std::max({rel_gap(absorbed_from_particles, absorbed_into_bristles),
+                   rel_gap(emitted_from_bristles, emitted_into_particles),
+                   rel_gap(to_particles_from_grid, to_particles_into_particles),
+                   rel_gap(to_grid_from_particles, to_grid_into_grid)});
+}
+
+void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadView& load, const CellField& psi,
+                       const CellField& density, const TransferParams& prm, float floor_z) {
+  WB_REQUIRE(s.count() == load.count, "transfer_capacity: " + std::to_string(s.count()) + " samples but a load of " +
+                                          std::to_string(load.count));
+  validate(prm);
+  WB_DISPATCH(d, transfer_capacity(s, load, psi, density, prm, floor_z));
+}
+
+Transfer::Transfer(const Device& device, const TransferParams& params)
+    : device_(device), params_(params), ws_(device) {
+  validate(params_);
+  for (auto& b : s_u32_) b.set_device(device);
+  for (auto& b : s_f32_) b.set_device(device);
+  for (auto& b : c_u32_) b.set_device(device);
+  for (auto& b : c_f32_) b.set_device(device);
+  p_moved_.set_device(device);
+  occ_.set_device(device);
+  d2_.set_device(device);
+  d2_tmp_.set_device(device);
+  edt_z_.set_device(device);
+  edt_v_.set_device(device);
+  counters_ = DeviceBuffer<int32_t>(device, 8);
+}
+
+void Transfer::ensure_samples(int64_t n) {
+  for (auto& b : s_u32_) b.resize(size_t(n));
+  for (auto& b : s_f32_) b.resize(size_t(n));
+}
+void Transfer::ensure_cells(int64_t n) {
+  for (auto& b : c_u32_) b.resize(size_t(n));
+  for (auto& b : c_f32_) b.resize(size_t(n));
+}
+void Transfer::ensure_particles(int64_t n) { p_moved_.resize(size_t(n)); }
+
+TransferRecord Transfer::step(const SampleView& samples, BristleLoad& load, ParticleStore& particles,
+                              const TransferEnv& env) {
+  WB_PROFILE_SCOPE("transfer");
+  TransferRecord rec;
+  rec.step = step_index_;
+  {
+    WB_PROFILE_SCOPE("transfer.capacity");
+    update_capacity(samples, load, env);
+  }
+  {
+    WB_PROFILE_SCOPE("transfer.absorb");
+    absorb(samples, load, particles, rec);
+  }
+  {
+    WB_PROFILE_SCOPE("transfer.distance");
+    update_distance(samples, env);
+  }
+  {
+    WB_PROFILE_SCOPE("transfer.to_grid");
+    particles_to_grid(particles, env, rec);
+  }
+  {
+    WB_PROFILE_SCOPE("transfer.compact");
+    particles.compact(ws_);
+  }
+  {
+    WB_PROFILE_SCOPE("transfer.emit");
+    emit(samples, load, particles, env, rec);
+  }
+  {
+    WB_PROFILE_SCOPE("transfer.to_particles");
+    grid_to_particles(particles, env, rec);
+  }
+  ++step_index_;
+  return rec;
+}
+
+void Transfer::update_capacity(const SampleView& samples, BristleLoad& load, const TransferEnv& env) {
+  validate(env);
+  WB_REQUIRE(load.device() == device_, "Transfer: the bristle load lives on another device");
+  const PaintWindowView& pw = env.paint;
+  const CellField psi{env.psi, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
+  const CellField density{pw.density, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
+  transfer_capacity(device_, samples, load.view(), psi, density, params_, env.floor_z);
+}
+
+void Transfer::absorb(const SampleView& samples, BristleLoad& load, ParticleStore& particles, TransferRecord& rec) {
+  const int64_t ns = samples.count(), np = particles.size();
+  WB_REQUIRE(ns == load.size(), "Transfer::absorb: " + std::to_string(ns) + " samples but a load of " +
+                                    std::to_string(load.size()));
+  WB_REQUIRE(particles.device() == device_, "Transfer: the particles live on another device");
+  ensure_samples(ns);
+  ensure_particles(np);
+  for (auto& b : s_f32_) b.fill_zero();
+  s_u32_[0].fill_zero();
+  p_moved_.fill_zero();
+  counters_.fill_zero();
+  AbsorbScratch a{};
+  a.ticket = s_u32_[0].data();
+  a.claimed = s_f32_[0].data();
+  a.acc_m = s_f32_[1].data();
+  for (int c = 0; c < 3; ++c) a.acc_c[c] = s_f32_[2 + c].data();
+  a.acc_b = s_f32_[5].data();
+  a.acc_oil = s_f32_[6].data();
+  a.bl_w = s_f32_[7].data();
+  for (int c = 0; c < 3; ++c) a.bl_c[c] = s_f32_[8 + c].data();
+  a.bl_b = s_f32_[11].data();
+  a.moved = p_moved_.data();
+  a.counters = counters_.data();
+  const BristleLoadView lv = load.view();
+  if (np > 0 && ns > 0) {
+    d_absorb(device_, particles.view(), samples, lv, a, params_);
+    d_absorb_apply(device_, lv, a);
+  }
+  int32_t counts[8];
+  counters_.copy_to_host(counts, 8);
+  rec.absorbed_count = counts[0];
+  rec.bleeding_count = counts[1];
+  rec.absorbed_from_particles = reduce_sum(device_, p_moved_.data(), np, ws_);
+  rec.absorbed_into_bristles = reduce_sum(device_, a.acc_m, ns, ws_);
+}
+
+void Transfer::update_distance(const SampleView& samples, const TransferEnv& env) {
+  validate(env);
+  const PaintWindowView& pw = env.paint;
+  const int B = params_.distance_block;
+  const int margin = int(std::ceil(env.D0 / float(B))) + 1;
+  DistanceBlocks db{};
+  db.bx = (pw.nx + B - 1) / B + 2 * margin;
+  db.by = (pw.ny + B - 1) / B + 2 * margin;
+  db.bz = (pw.nz + B - 1) / B + 2 * margin;
+  db.block = B;
+  db.margin = margin;
+  db.D0 = env.D0;
+  const int64_t total = int64_t(db.bx) * db.by * db.bz;
+  WB_REQUIRE(total < (int64_t(1) << 28), "Transfer: the distance field would need " + std::to_string(total) +
+                                             " blocks; raise distance_block or lower D0");
+  occ_.resize(size_t(total));
+  d2_.resize(size_t(total));
+  d2_tmp_.resize(size_t(total));
+  edt_v_.resize(size_t(total));
+  edt_z_.resize(size_t(2 * total));
+  occ_.fill_zero();
+  db.d2 = d2_.data();
+  d_occupancy(device_, samples, db, occ_.data(), pw.ox, pw.oy, pw.oz);
+  d_distance_init(device_, occ_.data(), d2_.data(), total);
+  // Separable exact squared distance transform: x (d2 -> tmp), y (tmp -> d2), z (d2 -> tmp).
+  d_distance_pass(device_, db, 0, d2_.data(), d2_tmp_.data(), edt_v_.data(), edt_z_.data());
+  d_distance_pass(device_, db, 1, d2_tmp_.data(), d2_.data(), edt_v_.data(), edt_z_.data());
+  d_distance_pass(device_, db, 2, d2_.data(), d2_tmp_.data(), edt_v_.data(), edt_z_.data());
+  d2_.swap(d2_tmp_);
+  db.d2 = d2_.data();
+  blocks_ = db;
+}
+
+DistanceBlocks Transfer::distance_view() {
+  WB_REQUIRE(blocks_.d2 != nullptr, "Transfer: update_distance has not run");
+  return blocks_;
+}
+
+std::vector<float> Transfer::distance_to_host() {
+  const DistanceBlocks db = distance_view();
+  std::vector<float> d = d2_.to_host();
+  for (float& v : d) v = v >= kFarDistance2 ? 1e30f : std::sqrt(v) * float(db.block);
+  return d;
+}
+
+void Transfer::particles_to_grid(ParticleStore& particles, const TransferEnv& env, TransferRecord& rec) {
+  validate(env);
+  const DistanceBlocks db = distance_view();
+  WB_REQUIRE(db.D0 == env.D0, "Transfer: the distance field was built for another D0");
+  const int64_t np = particles.size(), nc = env.paint.size();
+  ensure_cells(nc);
+  ensure_particles(np);
+  for (auto& b : c_f32_) b.fill_zero();
+  p_moved_.fill_zero();
+  counters_.fill_zero();
+  DepositScratch acc{};
+  acc.rho = c_f32_[0].data();
+  for (int c = 0; c < 3; ++c) acc.c[c] = c_f32_[1 + c].data();
+  acc.b = c_f32_[4].data();
+  acc.oil = c_f32_[5].data();
+  acc.dryness = c_f32_[6].data();
+  acc.moved = p_moved_.data();
+  acc.counter = counters_.data();
+  if (np > 0) {
+    d_to_grid_mark(device_, particles.view(), env.paint, db, acc, params_, env.dry_threshold);
+    d_to_grid_apply(device_, env.paint, acc);
+  }
+  int32_t count = 0;
+  counters_.copy_to_host(&count, 1);
+  rec.to_grid_count = count;
+  rec.to_grid_from_particles = reduce_sum(device_, p_moved_.data(), np, ws_);
+  rec.to_grid_into_grid = reduce_sum(device_, acc.rho, nc, ws_) * double(params_.cell_mass());
+}
+
+void Transfer::emit(const SampleView& samples, BristleLoad& load, ParticleStore& particles, const TransferEnv& env,
+                    TransferRecord& rec) {
+  const int64_t ns = samples.count();
+  WB_REQUIRE(ns == load.size(), "Transfer::emit: " + std::to_string(ns) + " samples but a load of " +
+                                    std::to_string(load.size()));
+  if (ns == 0) return;
+  ensure_samples(ns);
+  const BristleLoadView lv = load.view();
+  uint32_t* count = s_u32_[0].data();
+  uint32_t* offset = s_u32_[1].data();
+  float* mass_each = s_f32_[0].data();
+  float* emitted = s_f32_[1].data();
+  d_emit_count(device_, lv, params_, count, mass_each);
+  const int64_t total = int64_t(exclusive_scan(device_, count, offset, ns, ws_));
+  const int64_t room = std::max<int64_t>(particles.limit() - particles.size(), 0);
+  const int64_t n_new = std::min(total, room);
+  rec.emission_dropped = total - n_new;
+  if (n_new == 0) return;
+  const int64_t first = particles.append_uninitialised(n_new);
+  const ParticleView pv = particles.view();
+  d_emit_fill(device_, samples, lv, pv, offset, count, mass_each, first, n_new, step_index_, params_, env.floor_z,
+              emitted);
+  rec.emitted_count = n_new;
+  rec.emitted_from_bristles = reduce_sum(device_, emitted, ns, ws_);
+  rec.emitted_into_particles = reduce_sum(device_, pv.m + first, n_new, ws_);
+}
+
+void Transfer::grid_to_particles(ParticleStore& particles, const TransferEnv& env, TransferRecord& rec) {
+  validate(env);
+  const DistanceBlocks db = distance_view();
+  WB_REQUIRE(db.D0 == env.D0, "Transfer: the distance field was built for another D0");
+  const int64_t nc = env.paint.size();
+  ensure_cells(nc);
+  uint32_t* count = c_u32_[0].data();
+  uint32_t* offset = c_u32_[1].data();
+  d_grid_count(device_, env.paint, db, params_, env.dry_threshold, count);
+  const int64_t total = int64_t(exclusive_scan(device_, count, offset, nc, ws_));
+  const int64_t room = std::max<int64_t>(particles.limit() - particles.size(), 0);
+  const int64_t n_new = std::min(total, room);
+  rec.to_particles_dropped = total - n_new;
+  if (n_new == 0) return;
+  const int64_t first = particles.append_uninitialised(n_new);
+  const ParticleView pv = particles.view();
+  float* demand = c_f32_[0].data();
+  float* removed = c_f32_[1].data();
+  c_f32_[0].fill_zero();
+  d_grid_emit(device_, env.paint, env.velocity, pv, count, offset, first, n_new, params_, env.dry_threshold, demand);
+  d_grid_clamp(device_, env.paint, demand, removed);
+  d_grid_finish(device_, pv, first, n_new, env.paint, demand, params_, env.dry_threshold);
+  rec.to_particles_count = n_new;
+  rec.to_particles_from_grid = reduce_sum(device_, removed, nc, ws_) * double(params_.cell_mass());
+  rec.to_particles_into_particles = reduce_sum(device_, pv.m + first, n_new, ws_);
+}
+
+}  // namespace wb

@@ -1,0 +1,197 @@
+// Liquid transfer stage (paper §5, Eq. 12-16; DESIGN step 8). Transfer::step runs, in order:
+//   update_capacity (Eq. 12-13) -> absorb (Eq. 14, colour bleeding) -> update_distance ->
+//   particles_to_grid (Eq. 16) -> compact -> emit (§5.1) -> grid_to_particles (Eq. 15)
+// and returns what each transfer moved (TransferRecord; PaintBooks keeps the budget).
+// The stage functions validate their input and dispatch to wb::cpu or wb::cuda (transfer_impl.h).
+#pragma once
+#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
+#include <cstdint>
+#include <vector>
+
+#include "core/brush/bristle_fields.h"
+#include "core/canvas/window.h"
+#include "core/exec/buffer.h"
+#include "core/exec/device.h"
+#include "core/exec/workspace.h"
+#include "core/particles/mac_sample.h"
+#include "core/particles/particle_fields.h"
+#include "core/particles/particle_store.h"
+#include "core/transfer/bristle_load.h"
+#include "core/transfer/bristle_particle_kernels.h"
+#include "core/transfer/grid_particle_kernels.h"
+#include "core/transfer/transfer_params.h"
+
+namespace wb {
+
+/// What the transfer reads besides the samples, the load and the particles.
+struct TransferEnv {
+  PaintWindowView paint{};     ///< the active window's paint; §5.2 changes density, pigment, oil, dryness
+  const float* psi = nullptr;  ///< bristle density psi on the same window (Brush::rasterize); null: psi = 0
+  MacView velocity{};          ///< window MAC velocity for new grid particles; u == nullptr: at rest
+  float floor_z = 0.f;         ///< canvas surface height, cells (ParticleParams::floor_z)
+  float dry_threshold = 0.95f; ///< dryness at which paint is solid (GridParams::dry_threshold)
+  float D0 = 50.f;             ///< particle range around the bristles, cells (ParticleParams::D0)
+};
+
+/// What one step's transfers moved, kg, each measured on both sides (source / destination),
+/// so that the books close per transfer.
+struct TransferRecord {
+  int64_t step = 0;
+  // Bristle <- particle (Eq. 14).
+  int64_t absorbed_count = 0;
+  double absorbed_from_particles = 0;
+  double absorbed_into_bristles = 0;
+  int64_t bleeding_count = 0;  ///< particles that exchanged colour only (saturated sample or limit)
+  // Bristle -> particle (§5.1 emission).
+  int64_t emitted_count = 0;
+  double emitted_from_bristles = 0;
+  double emitted_into_particles = 0;
+  int64_t emission_dropped = 0;  ///< particles not emitted because the store was at its limit
+  // Grid -> particle (Eq. 15).
+  int64_t to_particles_count = 0;
+  double to_particles_from_grid = 0;
+  double to_particles_into_particles = 0;
+  int64_t to_particles_dropped = 0;  ///< candidates not created because the store was at its limit
+  // Particle -> grid (Eq. 16).
+  int64_t to_grid_count = 0;
+  double to_grid_from_particles = 0;
+  double to_grid_into_grid = 0;
+
+  /// Largest relative mismatch |source - destination| / max(source, destination) of the four.
+  double max_closure_error() const;
+  /// Net change of each reservoir this step, kg.
+  double bristle_change() const { return absorbed_into_bristles - emitted_from_bristles; }
+  double particle_change() const {
+    return emitted_into_particles + to_particles_into_particles - absorbed_from_particles - to_grid_from_particles;
+  }
+  double grid_change() const { return to_grid_into_grid - to_particles_from_grid; }
+};
+
+/// Scratch of the absorption pass, per sample (accumulators) and per particle (moved mass).
+struct AbsorbScratch {
+  uint32_t* ticket;  ///< particles that asked sample j this step
+  float* claimed;    ///< mass claimed from sample j this step (capacity test)
+  float* acc_m;      ///< absorbed mass
+  float* acc_c[3];   ///< sum m_k c_k of absorbed particles
+  float* acc_b;      ///< sum m_k brightness(c_k)
+  float* acc_oil;    ///< sum m_k oil_k
+  float* bl_w;       ///< sum of bleeding weights e
+  float* bl_c[3];    ///< sum e c_k
+  float* bl_b;       ///< sum e brightness(c_k)
+  float* moved;      ///< per particle: mass absorbed (0 otherwise)
+  int32_t* counters; ///< [0] absorbed, [1] bleeding
+};
+
+/// Per-cell accumulators of Eq. 16 (density units = cell fractions).
+struct DepositScratch {
+  float* rho;      ///< sum m_k W / cell_mass
+  float* c[3];     ///< sum (m_k W / cell_mass) c_k
+  float* b;        ///< sum (m_k W / cell_mass) brightness(c_k)
+  float* oil;
+  float* dryness;
+  float* moved;    ///< per particle: mass sent to the grid
+  int32_t* counter;
+};
+
+class Transfer {
+ public:
+  explicit Transfer(const Device& device, const TransferParams& params = {});
+
+  const Device& device() const { return device_; }
+  TransferParams& params() { return params_; }
+  const TransferParams& params() const { return params_; }
+  int64_t steps() const { return step_index_; }
+
+  /// One transfer step (§5): every stage below in order, with one compaction of the particle
+  /// store. The particles' `nearest` must come from SampleHashGrid::query_nearest on these
+  /// samples this step (the absorption candidate; the distance is re-measured here).
+  TransferRecord step(const SampleView& samples, BristleLoad& load, ParticleStore& particles, const TransferEnv& env);
+
+  // --- stages (public for tests and profiling; step() calls them in this order) ---
+  /// Eq. 12-13 for every sample: load.potential, load.capacity, load.radius.
+  void update_capacity(const SampleView& samples, BristleLoad& load, const TransferEnv& env);
+  /// Eq. 14: particles within R_j of their nearest sample j join it while m_j < M_j (at most
+  /// absorb_limit per sample), else bleed colour. Absorbed particles are flagged dead.
+  void absorb(const SampleView& samples, BristleLoad& load, ParticleStore& particles, TransferRecord& rec);
+  /// The coarse distance from every window block to the bristles (decides "within D0").
+  void update_distance(const SampleView& samples, const TransferEnv& env);
+  /// Eq. 16: live particles slower than slow_speed in blocks farther than D0 go to the grid.
+  void particles_to_grid(ParticleStore& particles, const TransferEnv& env, TransferRecord& rec);
+  /// §5.1: samples above (1 + epsilon) M_j emit particles in their lower hemisphere.
+  void emit(const SampleView& samples, BristleLoad& load, ParticleStore& particles, const TransferEnv& env,
+            TransferRecord& rec);
+  /// Eq. 15: cells within D0 of the bristles become particles (27 stratified candidates).
+  void grid_to_particles(ParticleStore& particles, const TransferEnv& env, TransferRecord& rec);
+
+  /// The distance field of the last update_distance (device pointers valid until the next).
+  DistanceBlocks distance_view();
+  /// Host copy of the block distances (cells) of the last update_distance, for tests and images.
+  std::vector<float> distance_to_host();
+
+ private:
+  void ensure_samples(int64_t n);
+  void ensure_cells(int64_t n);
+  void ensure_particles(int64_t n);
+
+  Device device_;
+  TransferParams params_;
+  Workspace ws_;
+  int64_t step_index_ = 0;
+  // Per sample.
+  DeviceBuffer<uint32_t> s_u32_[2];
+  DeviceBuffer<float> s_f32_[12];
+  // Per particle.
+  DeviceBuffer<float> p_moved_;
+  // Per cell.
+  DeviceBuffer<uint32_t> c_u32_[2];
+  DeviceBuffer<float> c_f32_[7];
+  // Distance blocks.
+  DeviceBuffer<int32_t> occ_;
+  DeviceBuffer<float> d2_, d2_tmp_, edt_z_;
+  DeviceBuffer<int32_t> edt_v_;
+  DistanceBlocks blocks_{};
+  // Counters.
+  DeviceBuffer<int32_t> counters_;
+};
+
+/// Validates and runs Eq. 12-13 for every sample (the dispatcher behind Transfer::update_capacity).
+void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadView& load, const CellField& psi,
+                       const CellField& density, const TransferParams& prm, float floor_z);
+
+#define WB_TRANSFER_BACKEND_DECLS                                                                                  \
+  void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellField density, TransferParams prm,   \
+                         float floor_z);                                                                           \
+  void transfer_absorb(ParticleView p, SampleView s, BristleLoadView load, AbsorbScratch a, TransferParams prm);    \
+  void transfer_absorb_apply(BristleLoadView load, AbsorbScratch a);                                               \
+  void transfer_distance_occupancy(SampleView s, DistanceBlocks db, int32_t* occ, int ox, int oy, int oz);         \
+  void transfer_distance_init(const int32_t* occ, float* d2, int64_t n);                                           \
+  void transfer_distance_pass(DistanceBlocks db, int axis, const float* src, float* dst, int32_t* v, float* z);    \
+  void transfer_to_grid_mark(ParticleView p, PaintWindowView pw, DistanceBlocks db, DepositScratch acc,            \
+                             TransferParams prm, float dry_threshold);                                              \
+  void transfer_to_grid_apply(PaintWindowView pw, DepositScratch acc);                                             \
+  void transfer_emit_count(BristleLoadView load, TransferParams prm, uint32_t* count, float* mass_each);            \
+  void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, const uint32_t* offset,               \
+                          const uint32_t* count, const float* mass_each, int64_t first, int64_t room,              \
+                          int64_t step_index, TransferParams prm, float floor_z, float* emitted);                  \
+  void transfer_grid_count(PaintWindowView pw, DistanceBlocks db, TransferParams prm, float dry_threshold,          \
+                           uint32_t* count);                                                                        \
+  void transfer_grid_emit(PaintWindowView pw, MacView vel, ParticleView p, const uint32_t* count,                   \
+                          const uint32_t* offset, int64_t first, int64_t room, TransferParams prm,                 \
+                          float dry_threshold, float* demand);                                                      \
+  void transfer_grid_clamp(PaintWindowView pw, float* demand_ratio, float* removed);                               \
+  void transfer_grid_finish(ParticleView p, int64_t first, int64_t n, PaintWindowView pw, const float* ratio,       \
+                            TransferParams prm, float dry_threshold);                                               \
+  void transfer_product(const float* a, const float* b, float* out, int64_t n);                                   \
+  void transfer_load_brightness(BristleLoadView load, float* out);                                                 \
+  void transfer_load_dip(BristleLoadView load, Vec3 ryb, float oil, float level, int replace, float* added);       \
+  void transfer_load_scale(BristleLoadView load, float keep, float* removed);
+
+namespace cpu {
+WB_TRANSFER_BACKEND_DECLS
+}  // namespace cpu
+namespace cuda {
+WB_TRANSFER_BACKEND_DECLS
+}  // namespace cuda
+#undef WB_TRANSFER_BACKEND_DECLS
+
+}  // namespace wb

@@ -1,0 +1,362 @@
+// Transfer stage drivers (paper §5.1-5.2, Eq. 12-16), compiled once per backend: one
+// parallel_for per pass over samples, particles, cells or distance-field lines; the physics
+// is in bristle_particle_kernels.h and grid_particle_kernels.h. Race-free by construction:
+// a particle has one candidate absorber (its nearest sample), per-sample and per-cell
+// accumulation goes through atomics, and new particles get slots from an exclusive scan.
+#pragma once
+#include "core/exec/atomics.h"
+#include "core/exec/parallel_for.h"
+#include "core/transfer/transfer.h"
+
+namespace wb::WB_BACKEND_NS {
+
+// --- Eq. 12-13: capacity ----------------------------------------------------------------
+
+void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellField density, TransferParams prm,
+                       float floor_z) {
+  const float mu = prm.mu, M_max = prm.M_max, M_min = prm.M_min, cm = prm.cell_mass();
+  const float thr = prm.surface_density, step = prm.march_step;
+  parallel_for(s.count(), [=] WB_HD(int64_t j) {
+    const Vec3 x = s.x[j];
+    const float psi_j = clampf(cell_field_at(psi, x), 0.f, 1.f);
+    const float Mp = potential_capacity(psi_j, mu, M_max, M_min);
+    const float R = load_radius(Mp, cm);
+    const float r = surface_distance(x, R, floor_z, density, thr, step);
+    load.potential[j] = Mp;
+    load.capacity[j] = surface_capacity(Mp, R, r, cm);
+    load.radius[j] = R;
+  });
+}
+
+// --- Eq. 14: absorption and colour bleeding ----------------------------------------------
+
+void transfer_absorb(ParticleView p, SampleView s, BristleLoadView load, AbsorbScratch a, TransferParams prm) {
+  const int64_t ns = load.count;
+  const float bleed = prm.bleed;
+  const uint32_t limit = uint32_t(prm.absorb_limit > 0 ? prm.absorb_limit : 0);
+  parallel_for(p.count, [=] WB_HD(int64_t k) {
+    if (p.dead[k]) return;
+    const int32_t j = p.nearest[k];
+    if (j < 0 || j >= ns) return;
+    const float mk = p.m[k];
+    if (!(mk > 0.f)) return;
+    const float R = load.radius[j];
+    if (!(length2(p.x[k] - s.x[j]) < R * R)) return;
+    const float mj = load.m[j], Mj = load.capacity[j];
+    const Vec3 ck(p.pigment_r[k], p.pigment_y[k], p.pigment_b[k]);
+    if (mj < Mj && limit > 0) {
+      // Tickets enforce the per-step limit; the claimed mass reproduces the sequential test
+      // "m_j < M_j before this particle" of §5.1 (a rejected claim only makes later ones stricter).
+      const uint32_t t = atomic_add(&a.ticket[j], 1u);
+      if (t < limit) {
+        const float before = atomic_add(&a.claimed[j], mk);
+        if (mj + before < Mj) {
+          p.dead[k] = 1u;
+          a.moved[k] = mk;
+          atomic_add(&a.acc_m[j], mk);
+          atomic_add(&a.acc_c[0][j], mk * ck.x);
+          atomic_add(&a.acc_c[1][j], mk * ck.y);
+          atomic_add(&a.acc_c[2][j], mk * ck.z);
+          atomic_add(&a.acc_b[j], mk * pigment_brightness(ck));
+          atomic_add(&a.acc_oil[j], mk * p.oil[k]);
+          atomic_add(&a.counters[0], int32_t(1));
+          return;
+        }
+      }
+    }
+    // Colour bleeding: the sample's colour as it was at the start of the pass (the sample is
+    // updated in the next launch), the particle's mass unchanged.
+    const float e = bleed_weight(bleed, mk, mj);
+    if (!(e > 0.f)) return;
+    const Vec3 cj(load.pigment_r[j], load.pigment_y[j], load.pigment_b[j]);
+    const Vec3 cn = color_mix(ck, cj, mk, e);
+    p.pigment_r[k] = cn.x;
+    p.pigment_y[k] = cn.y;
+    p.pigment_b[k] = cn.z;
+    atomic_add(&a.bl_w[j], e);
+    atomic_add(&a.bl_c[0][j], e * ck.x);
+    atomic_add(&a.bl_c[1][j], e * ck.y);
+    atomic_add(&a.bl_c[2][j], e * ck.z);
+    atomic_add(&a.bl_b[j], e * pigment_brightness(ck));
+    atomic_add(&a.counters[1], int32_t(1));
+  });
+}
+
+void transfer_absorb_apply(BristleLoadView load, AbsorbScratch a) {
+  parallel_for(load.count, [=] WB_HD(int64_t j) {
+    const float am = a.acc_m[j], bw = a.bl_w[j];
+    if (!(am > 0.f) && !(bw > 0.f)) return;
+    const float mj = load.m[j];
+    const Vec3 cj(load.pigment_r[j], load.pigment_y[j], load.pigment_b[j]);
+    const Vec3 sum_c(a.acc_c[0][j] + a.bl_c[0][j], a.acc_c[1][j] + a.bl_c[1][j], a.acc_c[2][j] + a.bl_c[2][j]);
+    const Vec3 cn = mix_batch(cj, mj, sum_c, a.acc_b[j] + a.bl_b[j], am + bw);  // Eq. 14, Algorithm 2
+    load.pigment_r[j] = cn.x;
+    load.pigment_y[j] = cn.y;
+    load.pigment_b[j] = cn.z;
+    if (am > 0.f) {
+      const float m_new = mj + am;  // Eq. 14: m_j + sum m_k
+      load.oil[j] = (maxf(mj, 0.f) * load.oil[j] + a.acc_oil[j]) / maxf(m_new, 1e-30f);
+      load.m[j] = m_new;
+    }
+  });
+}
+
+// --- coarse distance to the bristles (§5.2 "within D0") ------------------------------------
+
+void transfer_distance_occupancy(SampleView s, DistanceBlocks db, int32_t* occ, int ox, int oy, int oz) {
+  parallel_for(s.count(), [=] WB_HD(int64_t j) {
+    const Vec3 x = s.x[j];
+    const int64_t b = db.block_of(Vec3(x.x - float(ox), x.y - float(oy), x.z - float(oz)));
+    if (b >= 0) atomic_max(&occ[b], int32_t(1));
+  });
+}
+
+void transfer_distance_init(const int32_t* occ, float* d2, int64_t n) {
+  parallel_for(n, [=] WB_HD(int64_t b) { d2[b] = occ[b] ? 0.f : kFarDistance2; });
+}
+
+void transfer_distance_pass(DistanceBlocks db, int axis, const float* src, float* dst, int32_t* v, float* z) {
+  const int n = axis == 0 ? db.bx : (axis == 1 ? db.by : db.bz);
+  const int64_t total = int64_t(db.bx) * db.by * db.bz;
+  const int64_t lines = total / n;
+  parallel_for(lines, [=] WB_HD(int64_t L) {
+    int64_t base, stride;
+    if (axis == 0) {
+      base = db.index(0, int(L % db.by), int(L / db.by));
+      stride = 1;
+    } else if (axis == 1) {
+      base = db.index(int(L % db.bx), 0, int(L / db.bx));
+      stride = db.bx;
+    } else {
+      base = db.index(int(L % db.bx), int(L / db.bx), 0);
+      stride = int64_t(db.bx) * db.by;
+    }
+    edt_line(src + base, dst + base, n, stride, v + L * n, z + L * (n + 1));
+  });
+}
+
+// --- Eq. 16: particles back to the grid -----------------------------------------------------
+
+void transfer_to_grid_mark(ParticleView p, PaintWindowView pw, DistanceBlocks db, DepositScratch acc,
+                           TransferParams prm, float dry_threshold) {
+  const float slow2 = prm.slow_speed * prm.slow_speed, h = prm.kernel_h, inv_cm = 1.f / prm.cell_mass();
+  parallel_for(p.count, [=] WB_HD(int64_t k) {
+    if (p.dead[k]) return;
+    const float mk = p.m[k];
+    if (!(mk > 0.f) || !(length2(p.v[k]) < slow2)) return;
+    const Vec3 x = p.x[k];
+    const Vec3 q(x.x - float(pw.ox), x.y - float(pw.oy), x.z - float(pw.oz));
+    if (!(q.x >= 0.f && q.y >= 0.f && q.z >= 0.f && q.x < float(pw.nx) && q.y < float(pw.ny) && q.z < float(pw.nz)))
+      return;
+    if (db.near(q)) return;
+    const Vec3 ck(p.pigment_r[k], p.pigment_y[k], p.pigment_b[k]);
+    const float bk = pigment_brightness(ck), oil = p.oil[k], dry = p.dryness[k];
+    const float a = mk * inv_cm;  // density units
+    const int cells = for_each_kernel_cell(pw, q, h, dry_threshold, [&](int64_t id, float w) {
+      const float add = a * w;  // Eq. 16: m_k W(p_k - x_c, h)
+      atomic_add(&acc.rho[id], add);
+      atomic_add(&acc.c[0][id], add * ck.x);
+      atomic_add(&acc.c[1][id], add * ck.y);
+      atomic_add(&acc.c[2][id], add * ck.z);
+      atomic_add(&acc.b[id], add * bk);
+      atomic_add(&acc.oil[id], add * oil);
+      atomic_add(&acc.dryness[id], add * dry);
+    });
+    if (cells > 0) {
+      p.dead[k] = 1u;
+      acc.moved[k] = mk;
+      atomic_add(acc.counter, int32_t(1));
+    }
+  });
+}
+
+void transfer_to_grid_apply(PaintWindowView pw, DepositScratch acc) {
+  parallel_for(pw.size(), [=] WB_HD(int64_t c) {
+    const float add = acc.rho[c];
+    if (!(add > 0.f)) return;
+    const float rho = maxf(pw.density[c], 0.f);
+    const float tot = rho + add;
+    const Vec3 cold(pw.pigment_r[c], pw.pigment_y[c], pw.pigment_b[c]);
+    // Pigment: Algorithm 2 with weights = the cell's mass and the added mass; oil and
+    // dryness: mass-weighted (the "linear interpolation" of §5.2).
+    const Vec3 cn = mix_batch(cold, rho, Vec3(acc.c[0][c], acc.c[1][c], acc.c[2][c]), acc.b[c], add);
+    pw.pigment_r[c] = cn.x;
+    pw.pigment_y[c] = cn.y;
+    pw.pigment_b[c] = cn.z;
+    pw.oil[c] = (rho * pw.oil[c] + acc.oil[c]) / tot;
+    pw.dryness[c] = (rho * pw.dryness[c] + acc.dryness[c]) / tot;
+    pw.density[c] = pw.density[c] + add;
+  });
+}
+
+// --- §5.1: emission -------------------------------------------------------------------------
+
+void transfer_emit_count(BristleLoadView load, TransferParams prm, uint32_t* count, float* mass_each) {
+  const float eps = prm.epsilon, emit_mass = prm.emit_mass;
+  const int limit = prm.emit_limit;
+  parallel_for(load.count, [=] WB_HD(int64_t j) {
+    float me = 0.f;
+    count[j] = uint32_t(emission_count(load.m[j], load.capacity[j], eps, emit_mass, limit, me));
+    mass_each[j] = me;
+  });
+}
+
+void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, const uint32_t* offset,
+                        const uint32_t* count, const float* mass_each, int64_t first, int64_t room, int64_t step_index,
+                        TransferParams prm, float floor_z, float* emitted) {
+  const int P = prm.emit_pattern;
+  parallel_for(load.count, [=] WB_HD(int64_t j) {
+    emitted[j] = 0.f;
+    const int n = int(count[j]);
+    if (n == 0) return;
+    const int64_t off = int64_t(offset[j]);
+    const int64_t left = room - off;
+    const int n_eff = left <= 0 ? 0 : (left < n ? int(left) : n);
+    if (n_eff == 0) return;
+    const float me = mass_each[j];
+    const Vec3 xj = s.x[j], vj = s.v[j];
+    const float R = load.radius[j];
+    for (int i = 0; i < n_eff; ++i) {
+      const int64_t k = first + off + i;
+      p.x[k] = emission_position(xj, R, j, step_index, n, i, P, floor_z);
+      p.v[k] = vj;  // "the new particles share the same attributes as the sample, including the velocity"
+      p.m[k] = me;
+      p.pigment_r[k] = load.pigment_r[j];
+      p.pigment_y[k] = load.pigment_y[j];
+      p.pigment_b[k] = load.pigment_b[j];
+      p.oil[k] = load.oil[j];
+      p.dryness[k] = 0.f;  // paint on the brush is kept wet
+    }
+    const float m_old = load.m[j];
+    const float m_new = m_old - float(n_eff) * me;
+    load.m[j] = m_new;
+    emitted[j] = m_old - m_new;
+  });
+}
+
+// --- Eq. 15: grid cells to particles ---------------------------------------------------------
+
+void transfer_grid_count(PaintWindowView pw, DistanceBlocks db, TransferParams prm, float dry_threshold,
+                         uint32_t* count) {
+  const float min_rho = prm.min_cell_density;
+  parallel_for(pw.size(), [=] WB_HD(int64_t c) {
+    count[c] = 0u;
+    const float rho = pw.density[c];
+    if (!(rho > 0.f) || rho < min_rho || cell_is_solid(rho, pw.dryness[c], dry_threshold)) return;
+    const int i = int(c % pw.nx), j = int((c / pw.nx) % pw.ny), k = int(c / (int64_t(pw.nx) * pw.ny));
+    if (!db.near(Vec3(float(i) + 0.5f, float(j) + 0.5f, float(k) + 0.5f))) return;
+    uint32_t n = 0;
+    for (int s = 0; s < kCandidatesPerCell; ++s) {
+      const Vec3 q = Vec3(float(i), float(j), float(k)) + candidate_offset(i + pw.ox, j + pw.oy, k + pw.oz, s);
+      if (liquid_density_at(pw, q, dry_threshold) > 0.f) ++n;
+    }
+    count[c] = n;
+  });
+}
+
+void transfer_grid_emit(PaintWindowView pw, MacView vel, ParticleView p, const uint32_t* count, const uint32_t* offset,
+                        int64_t first, int64_t room, TransferParams prm, float dry_threshold, float* demand) {
+  const float h = prm.kernel_h, cm = prm.cell_mass();
+  const float share = 1.f / float(kCandidatesPerCell);
+  parallel_for(pw.size(), [=] WB_HD(int64_t c) {
+    if (count[c] == 0u) return;
+    const int64_t off = int64_t(offset[c]);
+    if (off >= room) return;
+    const int i = int(c % pw.nx), j = int((c / pw.nx) % pw.ny), k = int(c / (int64_t(pw.nx) * pw.ny));
+    const Vec3 cell_c(pw.pigment_r[c], pw.pigment_y[c], pw.pigment_b[c]);
+    const float oil = pw.oil[c], dry = pw.dryness[c];
+    int64_t t = 0;
+    for (int s = 0; s < kCandidatesPerCell && off + t < room; ++s) {
+      const Vec3 q = Vec3(float(i), float(j), float(k)) + candidate_offset(i + pw.ox, j + pw.oy, k + pw.oz, s);
+      const float rho_q = liquid_density_at(pw, q, dry_threshold);
+      if (!(rho_q > 0.f)) continue;
+      const int64_t pk = first + off + t;
+      ++t;
+      const Vec3 x(q.x + float(pw.ox), q.y + float(pw.oy), q.z + float(pw.oz));
+      const float a = rho_q * share;  // the candidate's share of the cell, density units
+      p.x[pk] = x;
+      p.v[pk] = vel.u != nullptr ? vel.sample(x) : Vec3(0.f, 0.f, 0.f);
+      p.m[pk] = a * cm;  // nominal m_k; grid_finish applies the clamp of Eq. 15
+      p.pigment_r[pk] = cell_c.x;
+      p.pigment_y[pk] = cell_c.y;
+      p.pigment_b[pk] = cell_c.z;
+      p.oil[pk] = oil;
+      p.dryness[pk] = dry;
+      for_each_kernel_cell(pw, q, h, dry_threshold, [&](int64_t id, float w) { atomic_add(&demand[id], a * w); });
+    }
+  });
+}
+
+void transfer_grid_clamp(PaintWindowView pw, float* demand_ratio, float* removed) {
+  parallel_for(pw.size(), [=] WB_HD(int64_t c) {
+    float rem = 0.f;
+    const float ratio = clamp_ratio(demand_ratio[c], pw.density[c], rem);  // Eq. 15 with max(., 0)
+    if (rem > 0.f) pw.density[c] = rem >= pw.density[c] ? 0.f : pw.density[c] - rem;
+    demand_ratio[c] = ratio;
+    removed[c] = rem;
+  });
+}
+
+void transfer_grid_finish(ParticleView p, int64_t first, int64_t n, PaintWindowView pw, const float* ratio,
+                          TransferParams prm, float dry_threshold) {
+  const float h = prm.kernel_h;
+  parallel_for(n, [=] WB_HD(int64_t i) {
+    const int64_t k = first + i;
+    const Vec3 x = p.x[k];
+    const Vec3 q(x.x - float(pw.ox), x.y - float(pw.oy), x.z - float(pw.oz));
+    float keep = 0.f;
+    for_each_kernel_cell(pw, q, h, dry_threshold, [&](int64_t id, float w) { keep += w * ratio[id]; });
+    p.m[k] = p.m[k] * keep;
+  });
+}
+
+// --- the load: UI sums, dip / fill / wipe ----------------------------------------------------
+
+void transfer_product(const float* a, const float* b, float* out, int64_t n) {
+  parallel_for(n, [=] WB_HD(int64_t i) { out[i] = a[i] * b[i]; });
+}
+
+void transfer_load_brightness(BristleLoadView load, float* out) {
+  parallel_for(load.count, [=] WB_HD(int64_t j) {
+    out[j] = load.m[j] * pigment_brightness(Vec3(load.pigment_r[j], load.pigment_y[j], load.pigment_b[j]));
+  });
+}
+
+void transfer_load_dip(BristleLoadView load, Vec3 ryb, float oil, float level, int replace, float* added) {
+  parallel_for(load.count, [=] WB_HD(int64_t j) {
+    const float target = level * load.potential[j];
+    const float m = load.m[j];
+    if (replace) {
+      load.m[j] = target;
+      load.pigment_r[j] = ryb.x;
+      load.pigment_y[j] = ryb.y;
+      load.pigment_b[j] = ryb.z;
+      load.oil[j] = oil;
+      added[j] = target - m;
+      return;
+    }
+    const float add = target - m;
+    if (!(add > 0.f)) {
+      added[j] = 0.f;
+      return;
+    }
+    const Vec3 c = color_mix(Vec3(load.pigment_r[j], load.pigment_y[j], load.pigment_b[j]), ryb, maxf(m, 0.f), add);
+    load.pigment_r[j] = c.x;
+    load.pigment_y[j] = c.y;
+    load.pigment_b[j] = c.z;
+    load.oil[j] = (maxf(m, 0.f) * load.oil[j] + add * oil) / (maxf(m, 0.f) + add);
+    load.m[j] = target;
+    added[j] = target - m;
+  });
+}
+
+void transfer_load_scale(BristleLoadView load, float keep, float* removed) {
+  parallel_for(load.count, [=] WB_HD(int64_t j) {
+    const float m = load.m[j];
+    const float m_new = m * keep;
+    load.m[j] = m_new;
+    removed[j] = m - m_new;
+  });
+}
+
+}  // namespace wb::WB_BACKEND_NS

@@ -1,0 +1,79 @@
+// Parameters of the liquid transfer stage (paper §5.1-5.2, Eq. 12-16, Table 1). One POD,
+// passed by value to the stage drivers. Units: lengths in canvas cells (1 cell = 0.2 mm),
+// mass in kg, velocity in cells/s. Grid density is a volume fraction: a cell holding
+// density rho holds rho * rho0 * cell^3 kg (8e-9 kg for a full cell).
+#pragma once
+#include <math.h>
+
+namespace wb {
+
+struct TransferParams {
+  // --- units (§5.1) ---
+  /// Reference paint density rho0. Default 1000 kg/m^3. §5.1 ("rho0 = 1.0e3 kg/m^3").
+  float rho0 = 1000.f;
+  /// Edge of one grid cell. Default 2e-4 m (0.2 mm). DESIGN "Units and scale".
+  float cell_size = 2e-4f;
+
+  // --- bristle capacity (Eq. 12-13) ---
+  /// Compression weight mu of Eq. 12: M' = max((1 - mu psi) M_max, M_min). Default 0.5,
+  /// range [0, 1]. Table 1.
+  float mu = 0.5f;
+  /// Largest capacity of one sample, kg. Default rho0 (4/3) pi (0.75 cells)^3 = 1.4137e-8 kg:
+  /// a sphere of three bristle radii (0.25 cells each, BrushSpec::bristle_radius) around each
+  /// sample; 128 samples x 200 bristles then hold 0.36 ml. Range (0, 1e-5]. Eq. 12.
+  float M_max = 1.4137167e-8f;
+  /// Smallest capacity of one sample, kg. Default M_max / 4; with mu = 0.5 and psi <= 1 it only
+  /// bites for mu > 0.75. Range [0, M_max]. Eq. 12.
+  float M_min = 3.5342917e-9f;
+  /// Emission threshold epsilon: a sample emits once m > (1 + epsilon) M. Default 0.1,
+  /// range [0, 10]. Table 1, §5.1.
+  float epsilon = 0.1f;
+  /// Density (volume fraction) at and above which the window's paint is a surface for r_j of
+  /// Eq. 13 (grid liquid or dried paint). Default 0.5, range (0, 1].
+  float surface_density = 0.5f;
+  /// Step of the downward march that finds r_j, cells. Default 0.25, range [0.05, 1].
+  float march_step = 0.25f;
+
+  // --- bristle <-> particle (§5.1) ---
+  /// Most particles one sample absorbs per step. Default 8, range [0, 1024]. §5.1 ("a limit on
+  /// the maximum number of particles that can be absorbed or emitted by a sample per time step").
+  int absorb_limit = 8;
+  /// Most particles one sample emits per step. Default 4, range [0, 64]. §5.1.
+  int emit_limit = 4;
+  /// Largest mass of one emitted particle, kg: a sample emits ceil(excess / emit_mass) particles
+  /// (at most emit_limit) of excess / n each. Default 1e-9 kg = rho0 (cell/2)^3. Range (0, M_max].
+  float emit_mass = 1e-9f;
+  /// Points in the fixed emission pattern (lower half-ball of radius R_j, canvas -z).
+  /// Default 16, range [1, 64]. §5.1, Figure 10.
+  int emit_pattern = 16;
+  /// Colour bleeding of a particle within R_j that is not absorbed: e = bleed min(m_k, m_j) of
+  /// each one's colour is mixed into the other (Algorithm 2), masses unchanged. Default 0.1 per
+  /// step, range [0, 1]. §5.1 ("colour bleeding").
+  float bleed = 0.1f;
+
+  // --- grid <-> particle (§5.2) ---
+  /// Half-width of the tent kernel W of Eq. 15-16, cells. W is normalised over the liquid cells
+  /// it touches, so the density removed or added equals the particle mass exactly. Default 1
+  /// (cloud-in-cell), range [0.5, 2]. Eq. 15-16.
+  float kernel_h = 1.f;
+  /// A particle moves back to the grid (Eq. 16) when slower than this, cells/s, and farther than
+  /// D0 from the bristles. Default 10 cells/s (2 mm/s), range [0, 1e4]. §5.2.
+  float slow_speed = 10.f;
+  /// Cells with less density than this are not sampled into particles. Default 1e-3, range [0, 1].
+  float min_cell_density = 1e-3f;
+  /// Block size of the coarse bristle distance field that decides "within D0", cells; the
+  /// distance is exact between block centres, so within +-block*sqrt(3) of the true one.
+  /// Default 4, range [1, 16]. §5.2.
+  int distance_block = 4;
+
+  /// Mass of one full cell, kg: rho0 cell^3 (8e-9 kg by default).
+  float cell_mass() const { return rho0 * cell_size * cell_size * cell_size; }
+  /// M_max for a brush: rho0 times the sphere of `radii` bristle radii (cells) around a sample.
+  static float capacity_for(float bristle_radius_cells, float radii = 3.f, float rho0 = 1000.f,
+                            float cell_size = 2e-4f) {
+    const float r = radii * bristle_radius_cells * cell_size;
+    return rho0 * 4.f / 3.f * 3.14159265f * r * r * r;
+  }
+};
+
+}  // namespace wb

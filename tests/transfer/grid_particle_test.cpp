@@ -1,0 +1,281 @@
+// Grid <-> particle transfer (paper §5.2, Eq. 15-16) and the books of a whole transfer step:
+// exact mass conservation (also where the clamp of Eq. 15 bites), cells beyond D0 untouched,
+// brightness-preserving colour mixing into the grid, the coarse distance field.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/color/ryb.h"
+#include "transfer/transfer_fixture.h"
+
+namespace wb::test {
+namespace {
+
+class GridParticleTest : public TransferTest {
+ protected:
+  /// A POD view of host copies of the window (for evaluating kernels on the host).
+  static PaintWindowView host_view(WindowFields& f, const PaintWindow& w) {
+    PaintWindowView v{};
+    v.density = f[0].data();
+    v.pigment_r = f[1].data();
+    v.pigment_y = f[2].data();
+    v.pigment_b = f[3].data();
+    v.oil = f[4].data();
+    v.dryness = f[5].data();
+    v.nx = w.dims().x;
+    v.ny = w.dims().y;
+    v.nz = w.dims().z;
+    v.ox = w.origin().x;
+    v.oy = w.origin().y;
+    v.oz = w.origin().z;
+    return v;
+  }
+  static float min_distance(const HostSamples& h, Vec3 p) {
+    float d = std::numeric_limits<float>::max();
+    for (const Vec3& x : h.x) d = std::min(d, length(x - p));
+    return d;
+  }
+};
+
+TEST_F(GridParticleTest, DistanceFieldMatchesBruteForceOverBlocks) {
+  HostSamples h;
+  h.resize(1, 7);
+  const Vec3 pts[7] = {Vec3(110, 210, 3), Vec3(131, 240, 1), Vec3(100, 200, 0), Vec3(147.5f, 215, 7.9f),
+                       Vec3(125, 225, 30), Vec3(90, 190, 2), Vec3(300, 300, 2)};
+  for (int i = 0; i < 7; ++i) h.x[size_t(i)] = pts[i];
+  DeviceSamples s(device_);
+  s.upload(h);
+  PaintWindow w = make_window({48, 48, 8}, {100, 200, 0}, [](int, int, int) { return 0.f; }, Vec3());
+  TransferParams prm;
+  prm.distance_block = 4;
+  Transfer t(device_, prm);
+  t.update_distance(s.view(), env_for(w, 12.f));
+  const DistanceBlocks db = t.distance_view();
+  const std::vector<float> d = t.distance_to_host();
+  // Brute force: block-centre distances to the blocks holding samples (inside the grid).
+  std::vector<int64_t> occupied;
+  for (const Vec3& x : h.x) {
+    const int64_t b = db.block_of(Vec3(x.x - 100.f, x.y - 200.f, x.z));
+    if (b >= 0) occupied.push_back(b);
+  }
+  ASSERT_FALSE(occupied.empty());
+  auto coords = [&](int64_t b, int& i, int& j, int& k) {
+    i = int(b % db.bx);
+    j = int((b / db.bx) % db.by);
+    k = int(b / (int64_t(db.bx) * db.by));
+  };
+  for (int64_t b = 0; b < int64_t(d.size()); ++b) {
+    int i, j, k;
+    coords(b, i, j, k);
+    double best = 1e30;
+    for (int64_t o : occupied) {
+      int a, c, e;
+      coords(o, a, c, e);
+      best = std::min(best, std::sqrt(double((i - a) * (i - a) + (j - c) * (j - c) + (k - e) * (k - e))) * db.block);
+    }
+    ASSERT_NEAR(d[size_t(b)], best, 1e-3 * (1 + best)) << "block " << b;
+  }
+}
+
+TEST_F(GridParticleTest, LayerNearTheBristlesBecomesParticlesWithExactMass) {
+  const Int3 origin{100, 200, 0};
+  PaintWindow w = make_window({48, 48, 8}, origin, [](int, int, int k) { return k < 2 ? 0.8f : 0.f; },
+                              Vec3(0.f, 1.f, 0.f), 0.2f);
+  HostSamples h = vertical_brush(1, 10, 0.8f, 124.f, 224.f, 3.f, 1.f);
+  DeviceSamples s(device_);
+  s.upload(h);
+  TransferParams prm;
+  prm.distance_block = 2;
+  const float D0 = 12.f;
+  Transfer t(device_, prm);
+  ParticleStore p(device_);
+  WindowFields before = w.to_host();
+  TransferEnv env = env_for(w, D0);
+  t.update_distance(s.view(), env);
+  TransferRecord rec;
+  t.grid_to_particles(p, env, rec);
+  ASSERT_GT(rec.to_particles_count, 0);
+  EXPECT_EQ(p.size(), rec.to_particles_count);
+  EXPECT_EQ(rec.to_particles_dropped, 0);
+  EXPECT_LT(rec.max_closure_error(), 1e-6);
+  WindowFields after = w.to_host();
+  const double cm = prm.cell_mass();
+  double removed = 0;
+  const float slack = 2.f * float(prm.distance_block) * std::sqrt(3.f);
+  int far_cells = 0, near_cells = 0;
+  for (int k = 0; k < 8; ++k)
+    for (int j = 0; j < 48; ++j)
+      for (int i = 0; i < 48; ++i) {
+        const size_t c = (size_t(k) * 48 + j) * 48 + i;
+        EXPECT_GE(after[0][c], 0.f);
+        removed += double(before[0][c]) - double(after[0][c]);
+        const Vec3 centre(float(origin.x + i) + 0.5f, float(origin.y + j) + 0.5f, float(k) + 0.5f);
+        const float dist = min_distance(h, centre);
+        if (dist > D0 + slack + 2.f) {  // +2: the kernel reaches the next cell
+          ++far_cells;
+          EXPECT_EQ(after[0][c], before[0][c]) << "cell beyond D0 changed";
+        }
+        if (k < 2 && dist < D0 - slack - 1.f) {
+          ++near_cells;
+          EXPECT_LT(after[0][c], 0.5f * before[0][c]) << "cell near the bristles kept its paint";
+        }
+      }
+  EXPECT_GT(far_cells, 1000);
+  EXPECT_GT(near_cells, 10);
+  const ParticleHost ph = p.to_host();
+  const double particle_mass = sum(ph.m);
+  EXPECT_NEAR(particle_mass, removed * cm, 1e-6 * particle_mass);
+  EXPECT_NEAR(rec.to_particles_from_grid, removed * cm, 1e-6 * particle_mass);
+  // Each particle: in a cell that was within D0 (up to the block slack), the cell's colour and
+  // oil, and at most its nominal mass rho(p) cell_mass / 27; the clamp bites at the layer's top.
+  PaintWindowView hv = host_view(before, w);
+  int clamped = 0;
+  for (size_t k = 0; k < ph.size(); ++k) {
+    EXPECT_LE(min_distance(h, ph.x[k]), D0 + slack + 1.f);
+    EXPECT_FLOAT_EQ(ph.pigment_y[k], 1.f);
+    EXPECT_FLOAT_EQ(ph.oil[k], 0.2f);
+    const Vec3 q(ph.x[k].x - float(origin.x), ph.x[k].y - float(origin.y), ph.x[k].z);
+    const float nominal = liquid_density_at(hv, q, 0.95f) * float(cm) / 27.f;
+    EXPECT_LE(ph.m[k], nominal * (1.f + 1e-5f));
+    if (ph.m[k] < nominal * (1.f - 1e-3f)) ++clamped;
+  }
+  EXPECT_GT(clamped, 0) << "the max(., 0) of Eq. 15 never bit: the test does not cover it";
+}
+
+TEST_F(GridParticleTest, ClampOnAnIsolatedCellCreatesNoPaint) {
+  PaintWindow w = make_window({16, 16, 8}, {0, 0, 0},
+                              [](int i, int j, int k) { return i == 8 && j == 8 && k == 2 ? 0.3f : 0.f; },
+                              Vec3(1.f, 0.f, 0.f));
+  HostSamples h = vertical_brush(1, 4, 0.8f, 8.5f, 8.5f, 3.f, 1.f);
+  DeviceSamples s(device_);
+  s.upload(h);
+  TransferParams prm;
+  Transfer t(device_, prm);
+  ParticleStore p(device_);
+  TransferEnv env = env_for(w, 10.f);
+  t.update_distance(s.view(), env);
+  TransferRecord rec;
+  t.grid_to_particles(p, env, rec);
+  EXPECT_EQ(rec.to_particles_count, 27);
+  const WindowFields after = w.to_host();
+  const size_t c = (size_t(2) * 16 + 8) * 16 + 8;
+  const double removed = (0.3 - double(after[0][c])) * prm.cell_mass();
+  const double created = p.total_mass(ws_);
+  EXPECT_NEAR(created, removed, 1e-6 * created);
+  EXPECT_LT(rec.max_closure_error(), 1e-6);
+  EXPECT_GT(after[0][c], 0.f) << "most of the demand fell on empty neighbours: the cell keeps paint";
+  for (size_t i = 0; i < after[0].size(); ++i)
+    if (i != c) EXPECT_EQ(after[0][i], 0.f);
+}
+
+TEST_F(GridParticleTest, SlowFarParticlesReturnAndMixColour) {
+  // Yellow paint, half full, in k = 0..1; blue particles at rest at the centres of k = 1 cells.
+  PaintWindow w = make_window({16, 16, 8}, {0, 0, 0}, [](int, int, int k) { return k < 2 ? 0.5f : 0.f; },
+                              Vec3(0.f, 1.f, 0.f), 0.2f, 0.1f);
+  TransferParams prm;
+  prm.kernel_h = 0.5f;  // each particle falls into its own cell only
+  const double cm = prm.cell_mass();
+  std::vector<Vec3> xs;
+  for (int j = 4; j < 12; ++j)
+    for (int i = 4; i < 12; ++i) xs.push_back(Vec3(float(i) + 0.5f, float(j) + 0.5f, 1.5f));
+  ParticleStore p(device_);
+  p.append(particles_at(xs, float(0.5 * cm), Vec3(0.f, 0.f, 1.f), 0.8f));
+  // One fast particle stays a particle.
+  p.append(particles_at({Vec3(2.5f, 2.5f, 1.5f)}, float(0.5 * cm), Vec3(0.f, 0.f, 1.f), 0.8f, Vec3(0.f, 500.f, 0.f)));
+  HostSamples none;
+  none.resize(0, 0);
+  DeviceSamples s(device_);
+  s.upload(none);
+  Transfer t(device_, prm);
+  TransferEnv env = env_for(w, 10.f);
+  const double grid_before = w.total_density(ws_) * cm, part_before = p.total_mass(ws_);
+  t.update_distance(s.view(), env);
+  TransferRecord rec;
+  t.particles_to_grid(p, env, rec);
+  EXPECT_EQ(rec.to_grid_count, int64_t(xs.size()));
+  EXPECT_LT(rec.max_closure_error(), 1e-6);
+  p.compact(ws_);
+  EXPECT_EQ(p.size(), 1);
+  EXPECT_NEAR(w.total_density(ws_) * cm + p.total_mass(ws_), grid_before + part_before, 1e-6 * grid_before);
+  const WindowFields after = w.to_host();
+  for (int j = 4; j < 12; ++j)
+    for (int i = 4; i < 12; ++i) {
+      const size_t c = (size_t(1) * 16 + j) * 16 + i;
+      EXPECT_NEAR(after[0][c], 1.f, 1e-6f);
+      const Vec3 ryb(after[1][c], after[2][c], after[3][c]);
+      const Vec3 rgb = ryb_to_rgb(ryb);
+      EXPECT_GT(rgb.y, rgb.x) << "blue into yellow: green dominates";
+      EXPECT_GT(rgb.y, rgb.z);
+      const Vec3 ref = color_mix(Vec3(0.f, 1.f, 0.f), Vec3(0.f, 0.f, 1.f), 0.5f, 0.5f);
+      EXPECT_NEAR(ryb.y, ref.y, 1e-4f);
+      EXPECT_NEAR(ryb.z, ref.z, 1e-4f);
+      EXPECT_NEAR(after[4][c], 0.5f, 1e-6f) << "oil: (0.5 * 0.2 + 0.5 * 0.8) / 1";
+      EXPECT_NEAR(after[5][c], 0.05f, 1e-6f) << "dryness: (0.5 * 0.1 + 0.5 * 0) / 1";
+    }
+}
+
+TEST_F(GridParticleTest, ParticlesNearTheBristlesStay) {
+  PaintWindow w = make_window({32, 32, 8}, {0, 0, 0}, [](int, int, int) { return 0.f; }, Vec3());
+  HostSamples h = vertical_brush(1, 8, 0.8f, 16.f, 16.f, 2.f, 1.f);
+  DeviceSamples s(device_);
+  s.upload(h);
+  ParticleStore p(device_);
+  p.append(particles_at({Vec3(17.f, 16.f, 1.f), Vec3(20.f, 16.f, 1.f), Vec3(30.5f, 30.5f, 0.5f)}, 1e-10f,
+                        Vec3(0.f, 0.f, 1.f)));
+  TransferParams prm;
+  Transfer t(device_, prm);
+  TransferEnv env = env_for(w, 8.f);
+  t.update_distance(s.view(), env);
+  TransferRecord rec;
+  t.particles_to_grid(p, env, rec);
+  EXPECT_EQ(rec.to_grid_count, 1) << "only the particle 20 cells away goes back";
+  const std::vector<uint32_t> dead = p.dead.to_host();
+  EXPECT_EQ(dead[0], 0u);
+  EXPECT_EQ(dead[1], 0u);
+  EXPECT_EQ(dead[2], 1u);
+}
+
+TEST_F(GridParticleTest, WholeStepsKeepTheBooks) {
+  const Int3 origin{0, 0, 0};
+  PaintWindow w = make_window({48, 48, 12}, origin, [](int i, int, int k) { return k < 2 && i > 20 ? 0.9f : 0.f; },
+                              Vec3(0.f, 1.f, 0.f), 0.3f);
+  HostSamples h = vertical_brush(3, 24, 0.8f, 22.f, 24.f, 1.2f, 2.f, Vec3(40.f, 0.f, 0.f));
+  DeviceSamples s(device_);
+  s.upload(h);
+  TransferParams prm;
+  BristleLoad load(device_, s.view().count(), prm);
+  PaintLoad paint;  // default: deep blue, 0.8 of the capacity
+  load.fill(paint);
+  ParticleStore p(device_);
+  // A few slow particles far from the brush (they go back) and near it (absorbed or kept).
+  std::vector<Vec3> xs;
+  for (int i = 0; i < 30; ++i) xs.push_back(Vec3(40.f + 0.2f * i, 40.f, 2.5f));
+  for (int i = 0; i < 30; ++i) xs.push_back(Vec3(22.f + 0.1f * i, 24.3f, 1.5f + 0.3f * i));
+  p.append(particles_at(xs, 2e-10f, Vec3(1.f, 0.f, 0.f)));
+  Transfer t(device_, prm);
+  PaintBooks books;
+  auto census = [&] { return PaintBooks::census(load, p, w.total_density(ws_), prm, ws_); };
+  books.open(census());
+  const double start = books.initial_total();
+  ASSERT_GT(start, 0.0);
+  int64_t moved_any = 0;
+  for (int step = 0; step < 6; ++step) {
+    query_nearest(s, p, 12.f);
+    const TransferRecord rec = t.step(s.view(), load, p, env_for(w, 12.f));
+    EXPECT_LT(rec.max_closure_error(), 1e-6) << "step " << step;
+    moved_any += rec.absorbed_count + rec.emitted_count + rec.to_grid_count + rec.to_particles_count;
+    const double drift = books.record(rec, census());
+    EXPECT_LT(std::fabs(drift), 1e-5) << "step " << step;
+  }
+  EXPECT_GT(books.totals().to_particles_count, 0);
+  EXPECT_GT(books.totals().to_grid_count, 0);
+  EXPECT_GT(books.totals().emitted_count + books.totals().absorbed_count, 0);
+  EXPECT_GT(moved_any, 0);
+  EXPECT_LT(books.max_drift(), 1e-5);
+  EXPECT_EQ(books.steps().size(), 6u);
+}
+
+}  // namespace
+}  // namespace wb::test
