@@ -197,6 +197,11 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   cls_.set_device(d);
   cls_.resize(size_t(g.cells()));
   cls_.fill_zero();
+  for (int c = 0; c < 3; ++c) {
+    fluid_[c].set_device(d);
+    fluid_[c].resize(size_t(g.faces(c)));
+    fluid_[c].fill_zero();
+  }
   for (auto* b : {&pressure_, &rhs_, &cell_tmp_}) {
     b->set_device(d);
     b->resize(size_t(g.cells()));
@@ -216,6 +221,7 @@ GridView Grid::view() {
     v.vel[c] = window_.velocity(c).data();
     v.theta[c] = theta_[c].data();
     v.solid_vel[c] = solid_vel_[c].data();
+    v.fluid[c] = fluid_[c].data();
   }
   v.cls = cls_.data();
   v.pressure = pressure_.data();

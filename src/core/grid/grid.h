@@ -113,7 +113,7 @@ class Grid {
   ActiveWindow window_;
   BristleField bristles_{};
   DeviceBuffer<float> theta_[3], solid_vel_[3], vel_pre_[3], vel_tmp_[3];
-  DeviceBuffer<uint8_t> cls_;
+  DeviceBuffer<uint8_t> cls_, fluid_[3];
   DeviceBuffer<float> pressure_, rhs_, cell_tmp_, face_tmp_;
   PaintWindow paint_tmp_;
   SolverScratch scratch_;

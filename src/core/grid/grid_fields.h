@@ -81,6 +81,7 @@ struct GridView {
   float* theta[3];       ///< open fraction of each face, 0 = closed (solid), 1 = open
   float* solid_vel[3];   ///< velocity of the solid part of each face (bristles; 0 for dried paint)
   uint8_t* cls;          ///< CellClass per cell
+  uint8_t* fluid[3];     ///< 1 where the face is open and touches a liquid cell (set by classify)
   float* pressure;       ///< projected pressure (scaled so that u -= grad p), cells^2/s
   WB_HD PoissonView poisson() const {
     PoissonView p;

@@ -48,6 +48,13 @@ void grid_classify(GridView g, PaintWindowView pw, BristleField br, int canvas_w
     g.theta[c][f] = theta;
     g.solid_vel[c][f] = us;
   });
+  parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
+    int c, i, j, k;
+    int64_t f;
+    detail::split_face(d, t, c, f);
+    d.decompose_face(c, f, i, j, k);
+    g.fluid[c][f] = face_is_fluid(d, g.cls, g.theta[c], c, i, j, k) ? 1 : 0;
+  });
 }
 
 void grid_advect_paint(GridView g, const float* u, const float* v, const float* w, PaintWindowView src,
@@ -135,11 +142,11 @@ void grid_viscosity_sweep(GridView g, const float* oil, const float* cur_u, cons
     const float* cur = c == 0 ? cur_u : (c == 1 ? cur_v : cur_w);
     const float* old = c == 0 ? old_u : (c == 1 ? old_v : old_w);
     float* out = c == 0 ? out_u : (c == 1 ? out_v : out_w);
-    d.decompose_face(c, f, i, j, k);
-    if (!face_is_fluid(d, g.cls, g.theta[c], c, i, j, k)) {
+    if (!g.fluid[c][f]) {
       out[f] = cur[f];
       return;
     }
+    d.decompose_face(c, f, i, j, k);
     const float nu = viscosity_from_oil(face_oil(d, oil, c, i, j, k), nu_thick, nu_thin);
     out[f] = viscosity_jacobi_face(g, cur, old, c, i, j, k, nu * dt);
   });
@@ -225,8 +232,8 @@ void grid_extrapolate(GridView g) {
       g.vel[c][f] = g.solid_vel[c][f];
       return;
     }
+    if (g.fluid[c][f]) return;
     d.decompose_face(c, f, i, j, k);
-    if (face_is_fluid(d, g.cls, g.theta[c], c, i, j, k)) return;
     g.vel[c][f] = extrapolated_face_velocity(g, c, i, j, k);
   });
 }
@@ -252,8 +259,7 @@ void grid_max_abs_fluid_velocity(GridView g, float* out) {
     int c, i, j, k;
     int64_t f;
     detail::split_face(d, t, c, f);
-    d.decompose_face(c, f, i, j, k);
-    out[t] = face_is_fluid(d, g.cls, g.theta[c], c, i, j, k) ? fabsf(g.vel[c][f]) : 0.f;
+    out[t] = g.fluid[c][f] ? fabsf(g.vel[c][f]) : 0.f;
   });
 }
 

@@ -164,8 +164,9 @@ WB_HD WB_INLINE float extrapolated_face_velocity(const GridView& g, int c, int i
   for (int q = 0; q < 6; ++q) {
     const int ii = i + di[q], jj = j + dj[q], kk = k + dk[q];
     if (ii < 0 || jj < 0 || kk < 0 || ii >= ex || jj >= ey || kk >= ez) continue;
-    if (!face_is_fluid(d, g.cls, g.theta[c], c, ii, jj, kk)) continue;
-    acc += g.vel[c][d.fidx(c, ii, jj, kk)];
+    const int64_t nf = d.fidx(c, ii, jj, kk);
+    if (!g.fluid[c][nf]) continue;
+    acc += g.vel[c][nf];
     ++n;
   }
   return n ? acc / float(n) : 0.f;

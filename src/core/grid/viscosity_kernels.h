@@ -51,7 +51,7 @@ WB_HD WB_INLINE float viscosity_jacobi_face(const GridView& g, const float* cur,
     if (g.theta[c][nf] <= 0.f) {
       acc += g.solid_vel[c][nf];
       ++n;
-    } else if (face_is_fluid(d, g.cls, g.theta[c], c, ii, jj, kk)) {
+    } else if (g.fluid[c][nf]) {
       acc += cur[nf];
       ++n;
     }
