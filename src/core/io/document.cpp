@@ -128,8 +128,7 @@ std::vector<uint8_t> encode_volume(const TileStore& canvas) {
   const std::vector<int> ids = canvas.allocated_tile_ids();
   std::vector<std::vector<uint8_t>> blobs;
   blobs.reserve(ids.size());
-  std::vector<uint8_t> head;
-  head.insert(head.end(), kVolumeMagic, kVolumeMagic + 8);
+  std::vector<uint8_t> head(kVolumeMagic, kVolumeMagic + 8);
   put_u32(head, kVolumeFormatVersion);
   put_u32(head, 0);  // flags
   put_u32(head, uint32_t(d.width));

@@ -40,23 +40,15 @@ void png_read_mem(png_structp png, png_bytep data, png_size_t n) {
 void png_warning_fn(png_structp, png_const_charp) {}
 
 // Shared writer: rows of bytes (8-bit) or big-endian 16-bit samples.
-std::vector<uint8_t> encode(const std::vector<const uint8_t*>& rows, int width, int height, int color_type,
-                            int bit_depth, int level, const std::vector<std::pair<std::string, std::string>>& text) {
-  WB_REQUIRE(width > 0 && height > 0, "PNG: image size must be positive");
-  std::vector<uint8_t> out;
+// The libpng part: no object with a destructor is created between setjmp and the longjmp.
+void encode_into(std::vector<uint8_t>& out, std::vector<png_text>& texts, const std::vector<const uint8_t*>& rows,
+                 int width, int height, int color_type, int bit_depth, int level) {
   std::string err;
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &err, png_error_fn, png_warning_fn);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (!png || !info) {
     png_destroy_write_struct(&png, &info);
     WB_THROW("PNG: out of memory");
-  }
-  std::vector<png_text> texts(text.size());  // before setjmp: no destructor is skipped
-  for (size_t i = 0; i < text.size(); ++i) {
-    texts[i].compression = PNG_TEXT_COMPRESSION_NONE;
-    texts[i].key = const_cast<char*>(text[i].first.c_str());
-    texts[i].text = const_cast<char*>(text[i].second.c_str());
-    texts[i].text_length = text[i].second.size();
   }
   WriteCtx ctx{&out};
   if (setjmp(png_jmpbuf(png))) {
@@ -72,6 +64,20 @@ std::vector<uint8_t> encode(const std::vector<const uint8_t*>& rows, int width, 
   for (int y = 0; y < height; ++y) png_write_row(png, const_cast<png_bytep>(rows[size_t(y)]));
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
+}
+
+std::vector<uint8_t> encode(const std::vector<const uint8_t*>& rows, int width, int height, int color_type,
+                            int bit_depth, int level, const std::vector<std::pair<std::string, std::string>>& text) {
+  WB_REQUIRE(width > 0 && height > 0, "PNG: image size must be positive");
+  std::vector<uint8_t> out;
+  std::vector<png_text> texts(text.size());
+  for (size_t i = 0; i < text.size(); ++i) {
+    texts[i].compression = PNG_TEXT_COMPRESSION_NONE;
+    texts[i].key = const_cast<char*>(text[i].first.c_str());
+    texts[i].text = const_cast<char*>(text[i].second.c_str());
+    texts[i].text_length = text[i].second.size();
+  }
+  encode_into(out, texts, rows, width, height, color_type, bit_depth, level);
   return out;
 }
 }  // namespace
