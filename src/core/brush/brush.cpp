@@ -245,10 +245,11 @@ void Brush::step(const BrushPose& pose, float dt, const BrushEnvironment& env) {
     brush_inextensible_on(device_, s, r, f, env.solid);
   }
   {
-    // Last, so that bristles pressed together keep apart; its corrections are lateral and
-    // carried down each bristle, so they leave the segment lengths intact to second order.
+    // Last but for a length-exact pass, so that bristles pressed together keep apart: its
+    // corrections are lateral and carried down each bristle, which that pass leaves intact.
     WB_PROFILE_SCOPE("brush.min_density");
     apply_min_density(params_.density_iterations);
+    brush_inextensible_on(device_, s, r, f, env.solid);
   }
   brush_velocities_on(device_, s, f, env.solid, dt);
   // Containment: a non-finite vertex never propagates; the step is undone.

@@ -160,7 +160,9 @@ void brush_density_delta(BristleState s, MinDensityGrid grid, const float* lambd
       const Vec3 u = r > 1e-6f ? d / r : brush::separation_dir(g, j);
       dx += u * (lsum * brush::density_kernel_dr(r, grid.h) / grid.rho0);  // Macklin & Müller 2013 Eq. 12
     });
-    s.delta[g] = dx;
+    // One Jacobi step moves a vertex by at most s_min / 2: a crowd's summed pushes would
+    // otherwise throw it across its neighbours.
+    s.delta[g] = brush::clamp_length(dx, 0.25f * grid.h);
   });
 }
 

@@ -75,7 +75,7 @@ BrushSpec default_brush(BrushShape shape) {
       break;
     case BrushShape::Mop:  // big, soft, slightly splayed
       b.bristles = 600;
-      b.length = 110.f;
+      b.length = 100.f;
       b.width = b.thickness = 70.f;
       b.stiffness = 0.3f;
       b.stiffness_variation = 0.25f;
