@@ -256,7 +256,7 @@ void grid_shift_lattice(const float* src, float* dst, int ex, int ey, int ez, in
 void grid_max_abs_fluid_velocity(GridView g, float* out) {
   const GridDims d = g.d;
   parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
-    int c, i, j, k;
+    int c;
     int64_t f;
     detail::split_face(d, t, c, f);
     out[t] = g.fluid[c][f] ? fabsf(g.vel[c][f]) : 0.f;
