@@ -71,7 +71,7 @@ void brush_solve(BristleState s, BristleRest r, BrushFrame f, SolidField solid, 
         s.xb[g] = xi;
       }
     }
-  });
+  }, kMinParallelHeavy);  // one bristle per element
 }
 
 void brush_grid_keys(BristleState s, float h, uint32_t mask, uint32_t* keys, uint32_t* ids) {
@@ -181,7 +181,7 @@ void brush_density_apply(BristleState s) {
       carried += d - t * dot(t, d);
       s.xb[g] = s.xb[g] + carried;
     }
-  });
+  }, kMinParallelHeavy);  // one bristle per element
 }
 
 void brush_inextensible(BristleState s, BristleRest r, BrushFrame f, SolidField solid) {
@@ -199,7 +199,7 @@ void brush_inextensible(BristleState s, BristleRest r, BrushFrame f, SolidField 
       if (brush::collide_vertex(xc, f.R * xp + f.p, l0, solid, splay)) xi = f.R_B * (xc - f.p);
       s.xb[g] = xi;
     }
-  });
+  }, kMinParallelHeavy);  // one bristle per element
 }
 
 void brush_velocities(BristleState s, BrushFrame f, SolidField solid, float dt) {
@@ -299,7 +299,7 @@ void samples_frames(SampleView sv, BrushFrame f) {
       sv.n[base + j] = n;
       sv.b[base + j] = cross(t, n);
     }
-  });
+  }, kMinParallelHeavy);  // one bristle per element
 }
 
 void samples_motion(SampleView sv, SamplePrev prev, float dt, int history) {

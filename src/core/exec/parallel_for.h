@@ -13,8 +13,10 @@
 
 namespace wb {
 
-/// Below this many elements the CPU backend runs serially.
+/// Below this many elements the CPU backend runs serially (cheap per-element work).
 inline constexpr int64_t kMinParallelSize = 2048;
+/// For loops whose elements are heavy (a whole bristle per element): thread from a few on.
+inline constexpr int64_t kMinParallelHeavy = 4;
 
 #if defined(__CUDACC__)
 namespace detail {
@@ -29,7 +31,7 @@ __global__ void parallel_for_kernel(int64_t n, F fn) {
 namespace WB_BACKEND_NS {
 
 template <typename F>
-void parallel_for(int64_t n, F fn) {
+void parallel_for(int64_t n, F fn, int64_t serial_below = kMinParallelSize) {
   if (n <= 0) return;
 #if defined(__CUDACC__)
   static_assert(__nv_is_extended_host_device_lambda_closure_type(F) || !__nv_is_extended_device_lambda_closure_type(F),
@@ -40,7 +42,7 @@ void parallel_for(int64_t n, F fn) {
   detail::parallel_for_kernel<<<unsigned(blocks), kBlock, 0, ::wb::cuda_stream()>>>(n, fn);
   WB_CUDA_CHECK_LAUNCH();
 #else
-  if (n < kMinParallelSize) {
+  if (n < serial_below) {
     for (int64_t i = 0; i < n; ++i) fn(i);
     return;
   }

@@ -15,8 +15,9 @@ namespace wb {
 
 namespace {
 // One wrapper per backend driver: the only place that switches on the device.
-void classify_d(const Device& d, GridView g, PaintWindowView pw, BristleField br, CanvasDims cd, float lt, float dt) {
-  WB_DISPATCH(d, grid_classify(g, pw, br, cd.width, cd.height, cd.depth, lt, dt));
+void classify_d(const Device& d, GridView g, PaintWindowView pw, BristleField br, const float* pd, CanvasDims cd,
+                float lt, float dt) {
+  WB_DISPATCH(d, grid_classify(g, pw, br, pd, cd.width, cd.height, cd.depth, lt, dt));
 }
 void advect_paint_d(const Device& d, GridView g, const float* u, const float* v, const float* w, PaintWindowView s,
                     PaintWindowView t, float dt) {
@@ -240,7 +241,7 @@ bool Grid::recentre_on(Vec3 brush) { return move_window(window_.origin_for(brush
 
 void Grid::classify() {
   WB_PROFILE_SCOPE("grid.classify");
-  classify_d(device(), view(), window_.paint().view(), bristles_, window_.canvas().dims(), params_.liquid_threshold,
+  classify_d(device(), view(), window_.paint().view(), bristles_, particle_density_, window_.canvas().dims(), params_.liquid_threshold,
              params_.dry_threshold);
 }
 

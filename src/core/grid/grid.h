@@ -69,6 +69,9 @@ class Grid {
   /// Rasterised bristles for this step (cell-centred on the window; nullable = no brush).
   /// The pointers must stay valid until the next call.
   void set_bristles(const BristleField& b) { bristles_ = b; }
+  /// Rasterised particle volume (cell-centred volume fraction, device; nullable) that joins the
+  /// grid density when cells are classified (the joint density of §4.3). Valid until the next call.
+  void set_particle_density(const float* density) { particle_density_ = density; }
 
   // --- stages (call in this order; step() does) ---
   /// Window to `new_origin` (scatter, shift velocity, gather). Returns whether it moved.
@@ -112,6 +115,7 @@ class Grid {
   GridParams params_;
   ActiveWindow window_;
   BristleField bristles_{};
+  const float* particle_density_ = nullptr;
   DeviceBuffer<float> theta_[3], solid_vel_[3], vel_pre_[3], vel_tmp_[3];
   DeviceBuffer<uint8_t> cls_, fluid_[3];
   DeviceBuffer<float> pressure_, rhs_, cell_tmp_, face_tmp_;
@@ -122,7 +126,7 @@ class Grid {
 };
 
 #define WB_GRID_BACKEND_DECLS                                                                                        \
-  void grid_classify(GridView g, PaintWindowView pw, BristleField br, int canvas_w, int canvas_h, int canvas_d,     \
+  void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float* particle_density, int canvas_w, int canvas_h, int canvas_d,     \
                      float liquid_threshold, float dry_threshold);                                                   \
   void grid_advect_paint(GridView g, const float* u, const float* v, const float* w, PaintWindowView src,            \
                          PaintWindowView dst, float dt);                                                             \

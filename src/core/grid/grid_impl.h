@@ -28,15 +28,17 @@ WB_HD WB_INLINE void split_face(const GridDims& d, int64_t t, int& c, int64_t& f
 WB_HD WB_INLINE int64_t all_faces(const GridDims& d) { return d.nu() + d.nv() + d.nw(); }
 }  // namespace detail
 
-void grid_classify(GridView g, PaintWindowView pw, BristleField br, int canvas_w, int canvas_h, int canvas_d,
-                   float liquid_threshold, float dry_threshold) {
+void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float* particle_density, int canvas_w,
+                   int canvas_h, int canvas_d, float liquid_threshold, float dry_threshold) {
   const GridDims d = g.d;
   parallel_for(d.cells(), [=] WB_HD(int64_t c) {
     int i, j, k;
     d.decompose_cell(c, i, j, k);
     const int cx = i + pw.ox, cy = j + pw.oy, cz = k + pw.oz;
     const bool on = cx >= 0 && cy >= 0 && cz >= 0 && cx < canvas_w && cy < canvas_h && cz < canvas_d;
-    g.cls[c] = classify_cell(pw.density[c], pw.dryness[c], on, liquid_threshold, dry_threshold);
+    // Joint density (§4.3): the particles' rasterised volume counts as liquid too.
+    const float joint = pw.density[c] + (particle_density ? particle_density[c] : 0.f);
+    g.cls[c] = classify_cell(joint, pw.dryness[c], on, liquid_threshold, dry_threshold);
   });
   parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
     int c, i, j, k;
