@@ -1,7 +1,9 @@
 // `wetbrush replay STROKES`: runs a stroke file (JSON or MyPaint dump) through the
-// simulator headless, writes the image, optional frames and a stats JSON.
+// simulator headless; writes the rendered painting, optional frames, the brush trace,
+// an OpenRaster painting and a stats JSON (docs/FORMATS.md, "Replay statistics").
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -11,8 +13,11 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
+#include "core/io/document.h"
 #include "core/io/png.h"
 #include "core/io/stroke.h"
+#include "core/params/param_table.h"
+#include "core/render/renderer.h"
 #include "core/sim/replay.h"
 
 namespace wb::cli {
@@ -21,11 +26,21 @@ namespace {
 struct ReplayArgs {
   std::string strokes;
   std::string image;
+  std::string brush_image;
+  std::string save;
   std::string stats;
   std::string frames_dir;
   int every = 10;
   std::string device = "auto";
   std::string brush_shape;
+  std::vector<float> color;
+  float oil = -1.f;
+  float load = -1.f;
+  bool no_reload = false;
+  bool grid_only = false;
+  std::vector<int> window;
+  std::vector<std::string> sets;
+  std::string params_file;
   bool quiet = false;
 };
 
@@ -45,27 +60,76 @@ void write_text_file(const std::string& path, const std::string& text) {
   if (!f.flush()) WB_THROW("failed writing '" + path + "'");
 }
 
+/// Applies the command-line overrides of the stroke's brush and paint (MyPaint dumps carry neither).
+void apply_overrides(const ReplayArgs& a, Stroke& stroke) {
+  if (!a.brush_shape.empty()) {
+    const uint32_t seed = stroke.brush.seed;
+    stroke.brush = default_brush(brush_shape_from_string(a.brush_shape));
+    stroke.brush.seed = seed;
+  }
+  if (!a.color.empty()) {
+    WB_REQUIRE(a.color.size() == 3, "--color takes three RYB components, e.g. --color 0.1,0.8,0.1");
+    for (int i = 0; i < 3; ++i) {
+      WB_REQUIRE(std::isfinite(a.color[i]) && a.color[i] >= 0.f && a.color[i] <= 1.f,
+                 "--color components must be in [0, 1]");
+      stroke.paint.ryb[i] = a.color[i];
+    }
+  }
+  if (a.oil >= 0.f) {
+    WB_REQUIRE(a.oil <= 1.f, "--oil must be in [0, 1]");
+    stroke.paint.oil = a.oil;
+  }
+  if (a.load >= 0.f) {
+    WB_REQUIRE(a.load <= 1.f, "--load must be in [0, 1]");
+    stroke.paint.load = a.load;
+  }
+  if (a.no_reload) stroke.paint.reload_on_pen_down = false;
+}
+
 int run_replay(const ReplayArgs& a) {
   const Device device = resolve_device(a.device);
   Stroke stroke = load_stroke(a.strokes);
-  if (!a.brush_shape.empty()) {
-    const BrushSpec old = stroke.brush;
-    stroke.brush = default_brush(brush_shape_from_string(a.brush_shape));
-    stroke.brush.seed = old.seed;
-  }
+  apply_overrides(a, stroke);
   for (const std::string& w : stroke.warnings) std::fprintf(stderr, "wetbrush: warning: %s\n", w.c_str());
   if (!a.frames_dir.empty()) {
     WB_REQUIRE(a.every > 0, "--every must be at least 1");
     std::filesystem::create_directories(a.frames_dir);
   }
 
-  StrokePlayer player(stroke);
   SimConfig cfg;
   cfg.device = device;
   cfg.canvas = stroke.canvas;
   cfg.brush = stroke.brush;
+  cfg.particles = !a.grid_only;
+  if (!a.window.empty()) {
+    WB_REQUIRE(a.window.size() == 3 && a.window[0] >= 16 && a.window[1] >= 16 && a.window[2] >= 8 &&
+                   a.window[0] <= 1024 && a.window[1] <= 1024 && a.window[2] <= 256,
+               "--window takes X,Y,Z cells (16..1024, 16..1024, 8..256)");
+    cfg.window = Int3{a.window[0], a.window[1], std::min(a.window[2], stroke.canvas.depth)};
+  }
+  if (!a.params_file.empty()) {
+    std::ifstream f(a.params_file);
+    WB_REQUIRE(f.good(), "cannot read parameter file '" + a.params_file + "'");
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(f);
+    } catch (const nlohmann::json::exception& e) {
+      WB_THROW(a.params_file + ": " + e.what());
+    }
+    std::vector<std::string> warnings;
+    params_from_json(cfg.params, j, warnings);
+    for (const auto& w : warnings) std::fprintf(stderr, "wetbrush: warning: %s: %s\n", a.params_file.c_str(), w.c_str());
+  }
+  for (const std::string& s : a.sets) apply_param_assignment(cfg.params, s);
+
+  StrokePlayer player(stroke);
   Simulator sim(cfg, player.pose_at(player.t_begin()));
   Replay replay(sim, player);
+  Renderer renderer(device);
+  renderer.params() = cfg.params.render;
+  if (stroke.paper_rgb) renderer.params().paper_rgb = Vec3((*stroke.paper_rgb)[0], (*stroke.paper_rgb)[1], (*stroke.paper_rgb)[2]);
+  const CanvasRect& r = replay.region();
+  const Camera camera = Camera::top_region(float(r.x0), float(r.y0), float(r.width), float(r.height), 1.f);
 
   const bool progress = !a.quiet && isatty(STDERR_FILENO);
   const auto t0 = std::chrono::steady_clock::now();
@@ -76,56 +140,98 @@ int run_replay(const ReplayArgs& a) {
     if (!a.frames_dir.empty() && done % a.every == 0) {
       char name[64];
       std::snprintf(name, sizeof name, "/frame_%06lld.png", static_cast<long long>(done));
-      const auto img = replay.brush_image();
-      write_png8(a.frames_dir + name, img.data(), replay.region().width, replay.region().height, 3);
+      const ParticleOverlay overlay = sim.particle_overlay();
+      const Image img = renderer.render(sim.canvas(), camera, sim.live_window(), &overlay);
+      write_png8(a.frames_dir + name, img.rgba.data(), img.width, img.height, 4);
     }
     if (progress && (elapsed() - last_print > 0.25 || done == replay.step_count())) {
       last_print = elapsed();
       const double rate = done / std::max(1e-9, elapsed());
       const double eta = (replay.step_count() - done) / std::max(1e-9, rate);
-      std::fprintf(stderr, "\rstep %lld/%lld  %.2f s simulated  %.1f steps/s  ETA %.0f s   ",
+      std::fprintf(stderr, "\rstep %lld/%lld  %.2f s simulated  %.2f steps/s  %lld particles  ETA %.0f s   ",
                    static_cast<long long>(done), static_cast<long long>(replay.step_count()), replay.sim_time(), rate,
-                   eta);
+                   static_cast<long long>(sim.particles().size()), eta);
     }
   }
   if (progress) std::fprintf(stderr, "\n");
   const double wall_ms = elapsed() * 1e3;
+  const int64_t particles_final = sim.particles().size();
 
-  if (!a.image.empty()) {
+  // The stroke is over: particles settle into the grid and the canvas holds the painting.
+  sim.settle();
+  double render_ms = 0.0;
+  Image painting;
+  if (!a.image.empty() || !a.save.empty()) {
+    const auto tr = std::chrono::steady_clock::now();
+    painting = renderer.render(sim.canvas(), camera);
+    render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tr).count();
+  }
+  if (!a.image.empty()) write_png8(a.image, painting.rgba.data(), painting.width, painting.height, 4);
+  if (!a.brush_image.empty()) {
     const auto img = replay.brush_image();
-    write_png8(a.image, img.data(), replay.region().width, replay.region().height, 3);
+    write_png8(a.brush_image, img.data(), r.width, r.height, 3);
+  }
+  if (!a.save.empty()) {
+    const Image full = renderer.render(sim.canvas(), Camera::top(sim.canvas().dims()));
+    save_painting(a.save, sim.canvas(), full,
+                  nlohmann::json{{"generator", "wetbrush replay"}, {"stroke", a.strokes}, {"device", device.to_string()}});
   }
 
   const Profiler& prof = sim.profiler();
+  const PaintBooks& books = sim.books();
+  const PaintCensus census = books.steps().empty() ? PaintCensus{} : books.steps().back().census;
   const int64_t nonfinite = sim.counters().nonfinite_events;
+  const double drift = books.max_drift();
   if (!a.stats.empty()) {
     nlohmann::json j;
     j["steps"] = replay.steps_done();
-    j["substeps"] = sim.counters().steps;
+    j["substeps"] = sim.counters().substeps;
     j["device"] = device.to_string();
     j["wall_ms"] = wall_ms;
     j["sim_time_s"] = replay.sim_time();
     j["stroke"] = a.strokes;
-    j["region"] = {{"x0", replay.region().x0}, {"y0", replay.region().y0}, {"width", replay.region().width},
-                   {"height", replay.region().height}};
+    j["mode"] = cfg.particles ? "hybrid" : "grid-only";
+    j["window"] = {cfg.window.x, cfg.window.y, cfg.window.z};
+    j["region"] = {{"x0", r.x0}, {"y0", r.y0}, {"width", r.width}, {"height", r.height}};
     j["brush"] = {{"shape", to_string(stroke.brush.shape)},
                   {"bristles", stroke.brush.bristles},
                   {"vertices_per_bristle", stroke.brush.vertices_per_bristle},
                   {"samples_per_bristle", stroke.brush.samples_per_bristle},
                   {"max_stretch", replay.max_stretch()},
                   {"contact_cells_max", replay.contact_cells_max()}};
+    j["paint"] = {{"mass_initial", books.initial_total()},
+                  {"mass_loaded", books.external_total()},
+                  {"mass_final", census.total()},
+                  {"mass_drift", drift},
+                  {"bristles", census.bristles},
+                  {"particles", census.particles},
+                  {"grid", census.grid}};
+    j["particles"] = {{"max", sim.counters().particles_max}, {"final", particles_final}};
+    const TransferTotals& t = books.totals();
+    j["transfer"] = {{"absorbed", t.absorbed},         {"emitted", t.emitted},
+                     {"to_particles", t.to_particles}, {"to_grid", t.to_grid},
+                     {"absorbed_count", t.absorbed_count}, {"emitted_count", t.emitted_count},
+                     {"to_particles_count", t.to_particles_count}, {"to_grid_count", t.to_grid_count},
+                     {"max_closure_error", t.max_closure_error}};
     j["timing_ms"] = {
         {"brush", median_of_differences(prof.samples("brush.step"), prof.samples("brush.samples"))},
         {"samples", prof.median_ms("brush.samples")},
+        {"window", prof.median_ms("window")},
+        {"particles", prof.median_ms("particles")},
+        {"grid", prof.median_ms("grid")},
+        {"flip", prof.median_ms("particles.flip")},
+        {"transfer", prof.median_ms("transfer")},
+        {"books", prof.median_ms("books")},
+        {"render", render_ms},
         {"step_median", prof.median_ms("sim.step")}};
     j["nonfinite_events"] = nonfinite;
     j["warnings"] = stroke.warnings;
     write_text_file(a.stats, j.dump(2) + "\n");
   }
   if (!a.quiet)
-    std::printf("replayed %lld steps (%.2f s of stroke) on %s in %.0f ms%s\n",
+    std::printf("replayed %lld steps (%.2f s of stroke) on %s in %.0f ms; paint drift %.3g%%%s\n",
                 static_cast<long long>(replay.steps_done()), replay.sim_time(), device.to_string().c_str(), wall_ms,
-                nonfinite ? " (non-finite steps contained)" : "");
+                100.0 * drift, nonfinite ? " (non-finite steps contained)" : "");
   return nonfinite ? 3 : 0;
 }
 
@@ -137,13 +243,24 @@ void register_replay(CLI::App& app) {
   sub->add_option("STROKES", args->strokes, "Stroke file: wetbrush JSON or MyPaint 't x y pressure' dump")
       ->required()
       ->check(CLI::ExistingFile);
-  sub->add_option("-o,--output", args->image, "Write the final image (PNG)");
+  sub->add_option("-o,--output", args->image, "Write the painting, top view of the stroke's region (PNG)");
+  sub->add_option("--save", args->save, "Save the painting as OpenRaster (.ora) with its paint volume");
   sub->add_option("--stats", args->stats, "Write replay statistics (JSON)");
-  sub->add_option("--frames", args->frames_dir, "Write a PNG frame every --every steps into this folder");
+  sub->add_option("--brush-image", args->brush_image,
+                  "Write the brush picture: bristles of the final pose over every cell they touched (PNG)");
+  sub->add_option("--frames", args->frames_dir, "Write a rendered PNG frame every --every steps into this folder");
   sub->add_option("--every", args->every, "Frame interval in steps")->capture_default_str();
   sub->add_option("--brush", args->brush_shape,
                   "Replace the stroke's brush by the default brush of this shape "
                   "(round, flat, fan, filbert, angular, mop, rigger)");
+  sub->add_option("--color", args->color, "Paint colour on the brush, RYB in [0, 1]: R,Y,B")->delimiter(',');
+  sub->add_option("--oil", args->oil, "Oil fraction of the paint on the brush, [0, 1]");
+  sub->add_option("--load", args->load, "How full the brush is loaded, fraction of capacity [0, 1]");
+  sub->add_flag("--no-reload", args->no_reload, "Load the brush once, not at every pen-down (it runs dry)");
+  sub->add_flag("--grid-only", args->grid_only, "No particles: paint lives on the grid only (paper Fig. 7a/c)");
+  sub->add_option("--window", args->window, "Active window size X,Y,Z in cells (default 128,128,32)")->delimiter(',');
+  sub->add_option("--set", args->sets, "Set a parameter, id=value (see `wetbrush params`); repeatable");
+  sub->add_option("--params", args->params_file, "Read parameters from a JSON file (`wetbrush params --json`)");
   sub->add_flag("-q,--quiet", args->quiet, "No progress or summary output");
   add_device_option(sub, args->device);
   set_action(sub, [args]() { return run_replay(*args); });

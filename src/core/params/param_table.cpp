@@ -48,6 +48,8 @@ std::vector<ParamInfo> build_table() {
                "Fraction of the brush-frame velocity removed per step"),
       WB_PARAM(brush_solver.min_spacing, "Minimum bristle spacing", "cells", "§4.1", -1, 10,
                "Spacing the minimum-density constraint keeps; negative = twice the bristle radius"),
+      WB_PARAM(bristle_drag, "Paint drag on bristles", "1/s", "Eq. 2", 0, 1000,
+               "How fast bristles take the velocity of the paint they move through"),
       // Grid (§4.2, Algorithm 1).
       WB_PARAM(grid.solver, "Pressure solver", "", "§4.2", 0, 3,
                "0 fixed-point (Alg. 1), 1 Jacobi, 2 weighted Jacobi, 3 Chebyshev"),

@@ -14,6 +14,9 @@ struct SimParams {
   GridParams grid{};
   ParticleParams particles{};
   RenderParams render{};
+  /// Drag of the paint flow on the bristles (Eq. 2's a_i, kept grid velocity of §4.3):
+  /// velocity relaxes towards the flow at this rate times the paint density, 1/s.
+  float bristle_drag = 20.f;
 };
 
 }  // namespace wb

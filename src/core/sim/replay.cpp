@@ -31,20 +31,39 @@ Replay::Replay(Simulator& sim, StrokePlayer& player)
   trace_.resize(size_t(region_.width) * region_.height);
   trace_.fill_zero();
   sim_.reset_brush(player_.pose_at(player_.t_begin()));
+  // A brush that is not refilled at every pen-down carries one load for the whole stroke.
+  if (!player_.stroke().paint.reload_on_pen_down) sim_.load_paint(player_.stroke().paint);
+  poses_.reserve(size_t(std::max(1, player_.stroke().max_substeps)));
+}
+
+void Replay::apply_event(const StrokeEvent& e) {
+  PaintLoad well;
+  switch (e.kind) {
+    case StrokeEventKind::Dip:
+      well.ryb[0] = e.ryb[0], well.ryb[1] = e.ryb[1], well.ryb[2] = e.ryb[2];
+      well.oil = e.oil;
+      well.load = e.load;
+      sim_.dip(well);
+      break;
+    case StrokeEventKind::Wipe: sim_.wipe(e.fraction); break;
+    case StrokeEventKind::Clean: sim_.clean(); break;
+    case StrokeEventKind::Dry: sim_.dry_canvas(); break;
+  }
 }
 
 bool Replay::advance() {
   PlayerStep step;
   if (!player_.next(step)) return false;
-  const float dt_sub = float(step.dt / step.substeps);
-  for (int k = 1; k <= step.substeps; ++k) {
-    sim_.step(player_.pose_at(StrokePlayer::substep_time(step, k)), dt_sub);
-    // A bristle is in contact when a sample is within one cell of the canvas or dried paint.
-    const int64_t touched = sim_.brush().mark_contacts(trace_.data(), region_.width, region_.height, region_.x0,
-                                                       region_.y0, 1.0f);
-    contact_cells_max_ = std::max(contact_cells_max_, touched);
-    max_stretch_ = std::max(max_stretch_, sim_.brush().stats().max_stretch);
-  }
+  for (const StrokeEvent& e : step.events) apply_event(e);
+  if (step.pen_down_edge && player_.stroke().paint.reload_on_pen_down) sim_.load_paint(player_.stroke().paint);
+  poses_.clear();
+  for (int k = 1; k <= step.substeps; ++k) poses_.push_back(player_.pose_at(StrokePlayer::substep_time(step, k)));
+  sim_.step(poses_.data(), step.substeps, float(step.dt));
+  // A bristle is in contact when a sample is within one cell of the canvas or dried paint.
+  const int64_t touched =
+      sim_.brush().mark_contacts(trace_.data(), region_.width, region_.height, region_.x0, region_.y0, 1.0f);
+  contact_cells_max_ = std::max(contact_cells_max_, touched);
+  max_stretch_ = std::max(max_stretch_, sim_.brush().stats().max_stretch);
   last_t_ = step.t;
   return true;
 }

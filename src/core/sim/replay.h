@@ -41,6 +41,8 @@ class Replay {
   std::vector<uint8_t> brush_image() const;
 
  private:
+  void apply_event(const StrokeEvent& e);
+
   Simulator& sim_;
   StrokePlayer& player_;
   CanvasRect region_;
@@ -48,6 +50,7 @@ class Replay {
   int64_t contact_cells_max_ = 0;
   float max_stretch_ = 0.f;
   double last_t_ = 0.0;
+  std::vector<BrushPose> poses_;  ///< sub-step poses of the current step (reserved once)
 };
 
 }  // namespace wb

@@ -1,31 +1,278 @@
 #include "core/sim/simulator.h"
 
+#include <cmath>
+#include <limits>
+
+#include "core/exec/algorithms.h"
+#include "core/particles/particles.h"
+#include "core/sim/joint_fields.h"
+
 namespace wb {
+namespace {
+
+/// Where the bristles meet the canvas: the rest tip under the handle (window centre).
+Vec3 footprint_centre(const BrushPose& pose, float length) {
+  return pose.position + pose.rotation * Vec3(0.f, 0.f, -length);
+}
+
+MacView mac_view(const float* u, const float* v, const float* w, const ActiveWindow& win) {
+  const Int3 n = win.dims(), o = win.origin();
+  return MacView{u, v, w, n.x, n.y, n.z, o.x, o.y, o.z};
+}
+
+}  // namespace
 
 Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
     : config_(config), profiler_(config.device), ws_(config.device) {
-  config_.device.activate();
-  canvas_ = std::make_unique<TileStore>(config_.device, config_.canvas);
-  brush_ = std::make_unique<Brush>(config_.device, config_.brush, initial_pose, config_.brush_solver);
+  const Device& d = config_.device;
+  d.activate();
+  canvas_ = std::make_unique<TileStore>(d, config_.canvas);
+  brush_ = std::make_unique<Brush>(d, config_.brush, initial_pose, config_.params.brush_solver);
+  const Vec3 centre = footprint_centre(initial_pose, config_.brush.length);
+  grid_ = std::make_unique<Grid>(*canvas_, config_.params.grid, config_.window, Int3{});
+  grid_->recentre_on(centre);
+  particles_ = ParticleStore(d, config_.params.particles.max_particles);
+  hash_ = SampleHashGrid(d);
+  load_ = std::make_unique<BristleLoad>(d, brush_->sample_count(), config_.transfer);
+  transfer_ = std::make_unique<Transfer>(d, config_.transfer);
+  if (!config_.particles) {
+    // Grid-only paint (Fig. 7a/c): emitted paint goes straight to the grid on the next step.
+    transfer_->params().slow_speed = std::numeric_limits<float>::infinity();
+  }
+
+  const GridDims g = grid_->dims();
+  auto cells = [&](DeviceBuffer<float>& b) {
+    b.set_device(d);
+    b.resize(size_t(g.cells()));
+    b.fill_zero();
+  };
+  cells(psi_);
+  cells(raster_mass_);
+  cells(raster_density_);
+  cells(overlay_mass_);
+  for (int c = 0; c < 3; ++c) {
+    cells(bristle_v_[c]);
+    cells(cell_v_[c]);
+    raster_mom_[c].set_device(d);
+    raster_mom_[c].resize(size_t(g.faces(c)));
+    raster_w_[c].set_device(d);
+    raster_w_[c].resize(size_t(g.faces(c)));
+  }
+  books_.open(census());
 }
 
 void Simulator::reset_brush(const BrushPose& pose) { brush_->reset(pose); }
 
-void Simulator::step(const BrushPose& pose, float dt) {
+PaintCensus Simulator::census() {
+  return PaintBooks::census(*load_, particles_, grid_->window().total_mass(ws_), transfer_->params(), ws_);
+}
+
+void Simulator::load_paint(const PaintLoad& paint) { books_.external(load_->fill(paint)); }
+void Simulator::dip(const PaintLoad& paint) { books_.external(load_->dip(paint)); }
+void Simulator::wipe(float fraction) { books_.external(-load_->wipe(fraction)); }
+void Simulator::clean() { books_.external(-load_->clean()); }
+
+void Simulator::dry_canvas() {
+  settle();
+  canvas_->dry_all();
+  grid_->window().reload();
+}
+
+void Simulator::settle() {
+  if (particles_.size() > 0) {
+    // Every particle, slow or not and near the bristles or not, goes back by Eq. 16.
+    TransferParams& tp = transfer_->params();
+    const float slow = tp.slow_speed;
+    tp.slow_speed = std::numeric_limits<float>::infinity();
+    TransferEnv env = transfer_env();
+    env.D0 = 0.f;
+    SampleView none = brush_->samples();
+    none.bristles = 0;  // no bristles: every particle is far from them
+    TransferRecord rec;
+    transfer_->update_distance(none, env);
+    transfer_->particles_to_grid(particles_, env, rec);
+    particles_.compact(ws_);
+    tp.slow_speed = slow;
+    books_.record(rec, census());
+  }
+  grid_->window().flush();
+}
+
+TransferEnv Simulator::transfer_env() {
+  ActiveWindow& win = grid_->window();
+  TransferEnv env;
+  env.paint = win.paint().view();
+  env.psi = psi_.data();
+  env.velocity = mac_view(win.velocity(0).data(), win.velocity(1).data(), win.velocity(2).data(), win);
+  env.floor_z = config_.params.particles.floor_z;
+  env.dry_threshold = config_.params.grid.dry_threshold;
+  env.D0 = config_.particles ? config_.params.particles.D0 : 0.f;
+  return env;
+}
+
+ParticleOverlay Simulator::particle_overlay() {
+  ParticleOverlay o{};
+  const int64_t n = particles_.size();
+  if (overlay_mass_.size() < size_t(n)) overlay_mass_.grow_keep(size_t(n));
+  // The renderer splats volume (cell fractions); particle mass is kg.
+  if (n) joint_scale(device(), particles_.m.data(), overlay_mass_.data(), n, 1.f / transfer_->params().cell_mass());
+  o.x = particles_.x.data();
+  o.mass = overlay_mass_.data();
+  o.r = particles_.pigment_r.data();
+  o.y = particles_.pigment_y.data();
+  o.b = particles_.pigment_b.data();
+  o.oil = particles_.oil.data();
+  o.n = n;
+  o.origin = grid_->window().origin();
+  o.dims = grid_->window().dims();
+  return o;
+}
+
+void Simulator::step(const BrushPose* poses, int substeps, float dt) {
+  WB_REQUIRE(substeps >= 1 && dt > 0.f && std::isfinite(dt), "Simulator::step: bad sub-step count or dt");
   ProfilerGuard guard(&profiler_);
   WB_PROFILE_SCOPE("sim.step");
-  const int64_t rollbacks_before = brush_->stats().nonfinite;
+  grid_->set_particle_density(nullptr);  // last step's raster is stale
 
-  // --- 1-2. Brush (§4.1): Eq. 2 in the brush frame, PBD constraints, collisions,
-  //          minimum density; then Hermite samples with Bishop frames. ----------------
-  BrushEnvironment env;
-  env.solid.tiles = canvas_->view();
-  env.solid.dryness_threshold = config_.dry_threshold;
-  env.solid.valid = canvas_->allocated_tiles() > 0;  // an empty canvas has no dried paint
-  brush_->step(pose, dt, env);
+  // --- 1-2. Brush (§4.1) in sub-steps, then its samples ------------------------------------
+  brush_stage(poses, substeps, dt);
 
+  // --- 3. Window: follow the brush; rasterise the bristles into it (boundary of §4.2) -----
+  {
+    WB_PROFILE_SCOPE("window");
+    grid_->recentre_on(footprint_centre(brush_->pose(), config_.brush.length));
+    brush_->rasterize(grid_->window().origin(), grid_->window().dims(), psi_.data(), bristle_v_[0].data(),
+                      bristle_v_[1].data(), bristle_v_[2].data());
+    grid_->set_bristles(BristleField{psi_.data(), bristle_v_[0].data(), bristle_v_[1].data(), bristle_v_[2].data()});
+  }
+
+  // --- 4. Particles (§4.3): nearest sample, two-step adhesion (Eq. 8-10) -------------------
+  if (config_.particles) particle_stage(dt);
+
+  // --- 5-6. Grid (§4.2) on the joint fields: advect, + particles, forces, viscosity,
+  //          fixed-point projection (Alg. 1), drying ---------------------------------------
+  {
+    WB_PROFILE_SCOPE("grid");
+    grid_->classify();
+    grid_->advect(dt);
+    if (config_.particles && particles_.size() > 0) joint_fields_stage();
+    grid_->classify();
+    grid_->add_external_forces(dt);
+    grid_->apply_viscosity(dt);
+    grid_->project();
+    grid_->dry(dt);
+  }
+
+  // --- 7. FLIP/PIC (Eq. 11): the grid keeps its velocity for the next step ---------------
+  if (config_.particles && particles_.size() > 0) {
+    WB_PROFILE_SCOPE("particles.flip");
+    ActiveWindow& win = grid_->window();
+    const MacView before = mac_view(grid_->velocity_before_projection(0).data(),
+                                    grid_->velocity_before_projection(1).data(),
+                                    grid_->velocity_before_projection(2).data(), win);
+    const MacView after = mac_view(win.velocity(0).data(), win.velocity(1).data(), win.velocity(2).data(), win);
+    particles_flip_pic(device(), particles_.view(), before, after, config_.params.particles.gamma);
+  }
+
+  // --- 8. Transfer (§5): bristle <-> particle, grid <-> particle ---------------------------
+  TransferRecord rec;
+  {
+    WB_PROFILE_SCOPE("transfer");
+    if (config_.particles) {
+      // The emission and absorption candidates are found against this step's samples.
+      hash_.build(brush_->samples(), config_.params.particles.hash_cell, ws_, 0.f);
+      hash_.query_nearest(particles_.view(), config_.params.particles.D0);
+    }
+    rec = transfer_->step(brush_->samples(), *load_, particles_, transfer_env());
+  }
+
+  contain_nonfinite();
+  {
+    WB_PROFILE_SCOPE("books");
+    books_.record(rec, census());
+  }
   ++counters_.steps;
+  counters_.substeps += substeps;
+  counters_.particles_max = std::max(counters_.particles_max, particles_.size());
+}
+
+void Simulator::brush_stage(const BrushPose* poses, int substeps, float dt) {
+  const float dt_sub = dt / float(substeps);
+  ActiveWindow& win = grid_->window();
+  const int64_t rollbacks_before = brush_->stats().nonfinite;
+  // The grid velocity kept from the last step drags the bristles (Eq. 2's a_i, §4.3).
+  joint_cell_velocity(device(), grid_->view(), cell_v_[0].data(), cell_v_[1].data(), cell_v_[2].data());
+  const Int3 n = win.dims(), o = win.origin();
+  DragField drag{cell_v_[0].data(), cell_v_[1].data(), cell_v_[2].data(), win.paint().density.data(),
+                 n.x, n.y, n.z, o.x, o.y, o.z, config_.params.bristle_drag};
+  BrushEnvironment env;
+  env.drag = config_.params.bristle_drag > 0.f ? &drag : nullptr;
+  env.solid.tiles = canvas_->view();
+  env.solid.dryness_threshold = config_.params.grid.dry_threshold;
+  env.solid.valid = canvas_->allocated_tiles() > 0;  // an empty canvas has no dried paint
+  for (int k = 0; k < substeps; ++k) brush_->step(poses[k], dt_sub, env);
   counters_.nonfinite_events += brush_->stats().nonfinite - rollbacks_before;
+}
+
+void Simulator::particle_stage(float dt) {
+  if (particles_.size() == 0) return;
+  WB_PROFILE_SCOPE("particles");
+  const ParticleParams& prm = config_.params.particles;
+  // Samples are at t + dt, particles at t: hash the samples rewound to t (hash_grid.h).
+  hash_.build(brush_->samples(), prm.hash_cell, ws_, dt);
+  hash_.query_nearest(particles_.view(), prm.D0);
+  SolidView solid;
+  solid.floor_z = prm.floor_z;
+  particles_adhesion_step(device(), particles_.view(), brush_->samples(), solid, prm, dt);
+}
+
+void Simulator::joint_fields_stage() {
+  WB_PROFILE_SCOPE("particles.rasterise");
+  ActiveWindow& win = grid_->window();
+  const Int3 n = win.dims(), o = win.origin();
+  raster_mass_.fill_zero();
+  for (int c = 0; c < 3; ++c) {
+    raster_mom_[c].fill_zero();
+    raster_w_[c].fill_zero();
+  }
+  ParticleRasterView rv{raster_mass_.data(),
+                        {raster_mom_[0].data(), raster_mom_[1].data(), raster_mom_[2].data()},
+                        {raster_w_[0].data(), raster_w_[1].data(), raster_w_[2].data()},
+                        n.x, n.y, n.z, o.x, o.y, o.z};
+  particles_rasterise(device(), particles_.view(), rv);
+  const float cell_mass = transfer_->params().cell_mass();
+  joint_scale(device(), raster_mass_.data(), raster_density_.data(), int64_t(raster_mass_.size()), 1.f / cell_mass);
+  grid_->set_particle_density(raster_density_.data());
+  joint_blend_velocity(device(), grid_->view(), win.paint().view(), rv, cell_mass);
+}
+
+void Simulator::contain_nonfinite() {
+  // A non-finite value anywhere in the live state is zeroed (grid) or removed (particles)
+  // before anything renders or scatters it; the event is counted and the books show the loss.
+  ActiveWindow& win = grid_->window();
+  PaintWindow& paint = win.paint();
+  int64_t bad = 0;
+  std::vector<std::pair<float*, int64_t>> arrays;
+#define WB_X(name, doc) arrays.emplace_back(paint.name.data(), paint.cell_count());
+  WB_PAINT_FIELDS(WB_X)
+#undef WB_X
+  for (int c = 0; c < 3; ++c) arrays.emplace_back(win.velocity(c).data(), int64_t(win.velocity(c).size()));
+  for (auto& [p, n] : arrays) {
+    const int64_t k = count_nonfinite(device(), p, n, ws_);
+    if (k) joint_zero_nonfinite(device(), p, n);
+    bad += k;
+  }
+  if (particles_.size() > 0) {
+    const int64_t k = count_nonfinite(device(), reinterpret_cast<const float*>(particles_.x.data()),
+                                      3 * particles_.size(), ws_) +
+                      count_nonfinite(device(), particles_.m.data(), particles_.size(), ws_);
+    if (k) {
+      joint_kill_nonfinite(device(), particles_.view());
+      particles_.compact(ws_);
+      bad += k;
+    }
+  }
+  if (bad) ++counters_.nonfinite_events;
 }
 
 }  // namespace wb

@@ -9,15 +9,26 @@
 #include "core/exec/device.h"
 #include "core/exec/profile.h"
 #include "core/exec/workspace.h"
+#include "core/grid/grid.h"
+#include "core/io/stroke.h"
+#include "core/params/sim_params.h"
+#include "core/particles/hash_grid.h"
+#include "core/particles/particle_store.h"
+#include "core/render/renderer.h"
+#include "core/transfer/paint_books.h"
+#include "core/transfer/transfer.h"
 
 namespace wb {
 
 struct SimConfig {
   Device device{};
   CanvasDims canvas{};
+  Int3 window{128, 128, 32};  ///< active window, cells (§4.2: 128 x 128 x 32)
   BrushSpec brush{};
-  BrushSolverParams brush_solver{};
-  float dry_threshold = 0.9f;  ///< dryness at and above which paint is solid
+  SimParams params{};
+  TransferParams transfer{};
+  /// false: grid-only paint (no particles, no bristle-particle transfer), the paper's Fig. 7a/c.
+  bool particles = true;
 };
 
 /// Counters a replay reports (stats JSON) and the studio shows.
@@ -25,6 +36,7 @@ struct SimCounters {
   int64_t steps = 0;
   int64_t substeps = 0;
   int64_t nonfinite_events = 0;  ///< steps whose state went non-finite and were contained
+  int64_t particles_max = 0;
 };
 
 class Simulator {
@@ -35,21 +47,64 @@ class Simulator {
   const Device& device() const { return config_.device; }
   TileStore& canvas() { return *canvas_; }
   Brush& brush() { return *brush_; }
+  Grid& grid() { return *grid_; }
+  ParticleStore& particles() { return particles_; }
+  BristleLoad& load() { return *load_; }
+  Transfer& transfer() { return *transfer_; }
+  const PaintBooks& books() const { return books_; }
   Profiler& profiler() { return profiler_; }
   const SimCounters& counters() const { return counters_; }
+  Workspace& workspace() { return ws_; }
 
-  /// One time step of length dt ending at `pose` (Figure 4).
-  void step(const BrushPose& pose, float dt);
+  /// One time step of length dt (Figure 4): the brush runs `substeps` sub-steps ending at
+  /// poses[0..substeps), then the paint (window, particles, joint fields, grid, FLIP/PIC,
+  /// transfer) runs once over the whole step.
+  void step(const BrushPose* poses, int substeps, float dt);
+  void step(const BrushPose& pose, float dt) { step(&pose, 1, dt); }
   /// Puts the brush at rest at `pose` (a new stroke after a lift, or a teleport).
   void reset_brush(const BrushPose& pose);
 
+  // --- paint on the brush (books record what enters and leaves) ---
+  void load_paint(const PaintLoad& paint);  ///< a freshly loaded brush
+  void dip(const PaintLoad& paint);         ///< dip a dirty brush into a well
+  void wipe(float fraction);
+  void clean();
+
+  /// "Let it dry": flushes the window, dries every painted cell of the canvas, reloads.
+  void dry_canvas();
+  /// Puts every particle back into the grid (Eq. 16 for all) and writes the window to the
+  /// canvas, so that the canvas alone holds the painting (before saving or a final render).
+  void settle();
+  /// Where the paint is now, kg.
+  PaintCensus census();
+  /// The live window and the particles, for the renderer.
+  PaintWindow* live_window() { return &grid_->window().paint(); }
+  ParticleOverlay particle_overlay();
+
  private:
+  void brush_stage(const BrushPose* poses, int substeps, float dt);
+  void particle_stage(float dt);
+  void joint_fields_stage();
+  void contain_nonfinite();
+  TransferEnv transfer_env();
+
   SimConfig config_;
-  std::unique_ptr<TileStore> canvas_;
-  std::unique_ptr<Brush> brush_;
   Profiler profiler_;
   Workspace ws_;
   SimCounters counters_;
+  std::unique_ptr<TileStore> canvas_;
+  std::unique_ptr<Brush> brush_;
+  std::unique_ptr<Grid> grid_;
+  ParticleStore particles_;
+  SampleHashGrid hash_;
+  std::unique_ptr<BristleLoad> load_;
+  std::unique_ptr<Transfer> transfer_;
+  PaintBooks books_;
+  // Window-sized scratch, allocated once: bristle psi and velocity, the grid's cell velocity
+  // for the drag, the particles' raster (mass, face momentum and weight) and their density.
+  DeviceBuffer<float> psi_, bristle_v_[3], cell_v_[3];
+  DeviceBuffer<float> raster_mass_, raster_density_, raster_mom_[3], raster_w_[3];
+  DeviceBuffer<float> overlay_mass_;
 };
 
 }  // namespace wb

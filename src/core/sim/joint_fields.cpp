@@ -1,0 +1,22 @@
+#include "core/sim/joint_fields.h"
+
+#include "core/exec/dispatch.h"
+
+namespace wb {
+
+void joint_scale(const Device& d, const float* in, float* out, int64_t n, float scale) {
+  WB_DISPATCH(d, joint_scale(in, out, n, scale));
+}
+void joint_blend_velocity(const Device& d, GridView g, PaintWindowView paint, ParticleRasterView raster,
+                          float cell_mass) {
+  WB_REQUIRE(raster.nx == g.d.nx && raster.ny == g.d.ny && raster.nz == g.d.nz,
+             "joint_blend_velocity: particle raster and grid differ in size");
+  WB_DISPATCH(d, joint_blend_velocity(g, paint, raster, cell_mass));
+}
+void joint_cell_velocity(const Device& d, GridView g, float* vx, float* vy, float* vz) {
+  WB_DISPATCH(d, joint_cell_velocity(g, vx, vy, vz));
+}
+void joint_zero_nonfinite(const Device& d, float* v, int64_t n) { WB_DISPATCH(d, joint_zero_nonfinite(v, n)); }
+void joint_kill_nonfinite(const Device& d, ParticleView p) { WB_DISPATCH(d, joint_kill_nonfinite(p)); }
+
+}  // namespace wb

@@ -1,0 +1,42 @@
+// Joint fields (paper §4.3, DESIGN step 5): the particles' rasterised mass and momentum
+// join the grid liquid before viscosity and projection; the grid velocity, kept between
+// steps, is what drags the bristles (Eq. 2). Also the containment of non-finite state.
+#pragma once
+#include <cstdint>
+
+#include "core/canvas/window.h"
+#include "core/exec/device.h"
+#include "core/grid/grid_fields.h"
+#include "core/particles/flip_kernels.h"
+#include "core/particles/particle_fields.h"
+
+namespace wb {
+
+/// out[i] = in[i] * scale (kg to cell-volume fractions and back).
+void joint_scale(const Device& d, const float* in, float* out, int64_t n, float scale);
+/// Blends the particles' face momentum into the grid's face velocity, per face:
+/// u = (w_g u + P) / (w_g + W), w_g = cell_mass * mean density of the two cells (Eq. 11's u).
+void joint_blend_velocity(const Device& d, GridView g, PaintWindowView paint, ParticleRasterView raster,
+                          float cell_mass);
+/// Cell-centred velocity (mean of the two faces) for the bristles' drag (Eq. 2's a_i).
+void joint_cell_velocity(const Device& d, GridView g, float* vx, float* vy, float* vz);
+/// Replaces non-finite values by 0 in [n] floats; returns nothing (count them first).
+void joint_zero_nonfinite(const Device& d, float* v, int64_t n);
+/// Flags particles with any non-finite state as dead.
+void joint_kill_nonfinite(const Device& d, ParticleView p);
+
+#define WB_JOINT_BACKEND_DECLS                                                                          \
+  void joint_scale(const float* in, float* out, int64_t n, float scale);                               \
+  void joint_blend_velocity(GridView g, PaintWindowView paint, ParticleRasterView raster, float cell_mass); \
+  void joint_cell_velocity(GridView g, float* vx, float* vy, float* vz);                                \
+  void joint_zero_nonfinite(float* v, int64_t n);                                                       \
+  void joint_kill_nonfinite(ParticleView p);
+namespace cpu {
+WB_JOINT_BACKEND_DECLS
+}
+namespace cuda {
+WB_JOINT_BACKEND_DECLS
+}
+#undef WB_JOINT_BACKEND_DECLS
+
+}  // namespace wb

@@ -1,0 +1,64 @@
+// Joint-field kernels (§4.3), compiled once per backend.
+#pragma once
+#include "core/exec/parallel_for.h"
+#include "core/sim/joint_fields.h"
+
+namespace wb::WB_BACKEND_NS {
+
+void joint_scale(const float* in, float* out, int64_t n, float scale) {
+  parallel_for(n, [=] WB_HD(int64_t i) { out[i] = in[i] * scale; });
+}
+
+void joint_blend_velocity(GridView g, PaintWindowView paint, ParticleRasterView raster, float cell_mass) {
+  const GridDims d = g.d;
+  for (int c = 0; c < 3; ++c) {
+    float* u = g.vel[c];
+    const float* mom = raster.mom[c];
+    const float* wgt = raster.weight[c];
+    const float* rho = paint.density;
+    const int ex = d.nx + (c == 0), ey = d.ny + (c == 1);
+    const int64_t faces = int64_t(ex) * ey * (d.nz + (c == 2));
+    parallel_for(faces, [=] WB_HD(int64_t f) {
+      const float wp = wgt[f];
+      if (!(wp > 0.f)) return;
+      const int i = int(f % ex), j = int((f / ex) % ey), k = int(f / (int64_t(ex) * ey));
+      // Grid paint on the two sides of the face, as mass.
+      const int ia = i - (c == 0), ja = j - (c == 1), ka = k - (c == 2);
+      float rg = 0.f;
+      int n = 0;
+      if (ia >= 0 && ja >= 0 && ka >= 0) rg += rho[(int64_t(ka) * d.ny + ja) * d.nx + ia], ++n;
+      if (i < d.nx && j < d.ny && k < d.nz) rg += rho[(int64_t(k) * d.ny + j) * d.nx + i], ++n;
+      const float wg = n ? cell_mass * rg / float(n) : 0.f;
+      u[f] = (wg * u[f] + mom[f]) / (wg + wp);
+    });
+  }
+}
+
+void joint_cell_velocity(GridView g, float* vx, float* vy, float* vz) {
+  const GridDims d = g.d;
+  const float* u = g.vel[0];
+  const float* v = g.vel[1];
+  const float* w = g.vel[2];
+  parallel_for(d.cells(), [=] WB_HD(int64_t c) {
+    const int i = int(c % d.nx), j = int((c / d.nx) % d.ny), k = int(c / (int64_t(d.nx) * d.ny));
+    vx[c] = 0.5f * (u[(int64_t(k) * d.ny + j) * (d.nx + 1) + i] + u[(int64_t(k) * d.ny + j) * (d.nx + 1) + i + 1]);
+    vy[c] = 0.5f * (v[(int64_t(k) * (d.ny + 1) + j) * d.nx + i] + v[(int64_t(k) * (d.ny + 1) + j + 1) * d.nx + i]);
+    vz[c] = 0.5f * (w[(int64_t(k) * d.ny + j) * d.nx + i] + w[(int64_t(k + 1) * d.ny + j) * d.nx + i]);
+  });
+}
+
+void joint_zero_nonfinite(float* v, int64_t n) {
+  parallel_for(n, [=] WB_HD(int64_t i) {
+    if (!isfinite(v[i])) v[i] = 0.f;
+  });
+}
+
+void joint_kill_nonfinite(ParticleView p) {
+  parallel_for(p.count, [=] WB_HD(int64_t k) {
+    const bool ok = isfinite3(p.x[k]) && isfinite3(p.v[k]) && isfinite(p.m[k]) && isfinite(p.pigment_r[k]) &&
+                    isfinite(p.pigment_y[k]) && isfinite(p.pigment_b[k]);
+    if (!ok) p.dead[k] = 1u;
+  });
+}
+
+}  // namespace wb::WB_BACKEND_NS
