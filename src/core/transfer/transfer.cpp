@@ -289,6 +289,9 @@ void Transfer::particles_to_grid(ParticleStore& particles, const TransferEnv& en
   acc.dryness = c_f32_[6].data();
   acc.moved = p_moved_.data();
   acc.counter = counters_.data();
+  acc.keep_on = env.keep_box ? 1 : 0;
+  acc.keep_lo[0] = env.keep_lo.x, acc.keep_lo[1] = env.keep_lo.y, acc.keep_lo[2] = env.keep_lo.z;
+  acc.keep_hi[0] = env.keep_hi.x, acc.keep_hi[1] = env.keep_hi.y, acc.keep_hi[2] = env.keep_hi.z;
   if (np > 0) {
     d_to_grid_mark(device_, particles.view(), env.paint, db, acc, params_, env.dry_threshold);
     d_to_grid_apply(device_, env.paint, acc);

@@ -31,6 +31,11 @@ struct TransferEnv {
   float floor_z = 0.f;         ///< canvas surface height, cells (ParticleParams::floor_z)
   float dry_threshold = 0.95f; ///< dryness at which paint is solid (GridParams::dry_threshold)
   float D0 = 50.f;             ///< particle range around the bristles, cells (ParticleParams::D0)
+  /// Window box (window cells, [keep_lo, keep_hi)) the particles may stay in: with keep_box on,
+  /// particles outside it go to the grid by Eq. 16 whatever their speed or distance to the
+  /// bristles, because the window is about to move and leave them outside (docs/TRANSFER.md).
+  bool keep_box = false;
+  Int3 keep_lo{}, keep_hi{};
 };
 
 /// What one step's transfers moved, kg, each measured on both sides (source / destination),
@@ -91,6 +96,8 @@ struct DepositScratch {
   float* dryness;
   float* moved;    ///< per particle: mass sent to the grid
   int32_t* counter;
+  int keep_on;              ///< 1: particles outside [keep_lo, keep_hi) are deposited regardless
+  int keep_lo[3], keep_hi[3];
 };
 
 class Transfer {
