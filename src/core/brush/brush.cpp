@@ -198,7 +198,7 @@ void Brush::reset(const BrushPose& pose) {
   const BrushFrame f = frame_for(pose);
   brush_place_on(device_, state_view(), rest_view(), f);
   sample_history_ = 0;
-  update_samples(1.f, f, last_solid_);
+  update_samples(1.f, f, SolidField{});  // at rest: the canvas plane only
 }
 
 void Brush::step(const BrushPose& pose, float dt, const BrushEnvironment& env) {
@@ -267,7 +267,6 @@ void Brush::step(const BrushPose& pose, float dt, const BrushEnvironment& env) {
     frame_omega_B_ = omega_B;
   }
   pose_ = pose;
-  last_solid_ = env.solid;
   WB_PROFILE_SCOPE("brush.samples");
   update_samples(dt, f, env.solid);
 }
@@ -315,14 +314,15 @@ void Brush::rasterize(Int3 window_origin, Int3 window_dims, float* psi, float* v
   samples_rasterize_finish_on(device_, cells, psi, vx, vy, vz);
 }
 
-int64_t Brush::mark_contacts(int32_t* trace, int trace_w, int trace_h, int ox, int oy, float contact_height) {
+int64_t Brush::mark_contacts(int32_t* trace, int trace_w, int trace_h, int ox, int oy, float contact_height,
+                             const SolidField& solid) {
   WB_PROFILE_SCOPE("brush.contacts");
   WB_REQUIRE(trace && trace_w > 0 && trace_h > 0, "Brush::mark_contacts: empty trace");
   WB_REQUIRE(uint64_t(trace_w) * uint64_t(trace_h) < (uint64_t(1) << 31), "Brush::mark_contacts: trace too large");
   WB_REQUIRE(std::isfinite(contact_height) && contact_height >= 0.f, "Brush::mark_contacts: bad contact height");
   const int64_t S = sample_count();
   const uint32_t sentinel = uint32_t(trace_w) * uint32_t(trace_h);
-  samples_contact_keys_on(device_, samples(), last_solid_, contact_height, trace, trace_w, trace_h, ox, oy,
+  samples_contact_keys_on(device_, samples(), solid, contact_height, trace, trace_w, trace_h, ox, oy,
                           contact_keys_.data(), contact_vals_.data());
   sort_by_key(device_, contact_keys_.data(), contact_vals_.data(), S, bit_width(sentinel), ws_);
   count_distinct_flags_on(device_, contact_keys_.data(), S, sentinel, scratch_a_.data());

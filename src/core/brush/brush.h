@@ -74,8 +74,11 @@ class Brush {
 
   /// Sets trace[(y - oy) * trace_w + (x - ox)] = 1 (device pointer) for every canvas cell
   /// (x, y) holding a sample less than contact_height above the canvas or the dried paint
-  /// of the last step's environment; returns how many distinct cells of the trace this step touches.
-  int64_t mark_contacts(int32_t* trace, int trace_w, int trace_h, int ox, int oy, float contact_height);
+  /// given (solid.valid = false: the canvas plane only); returns how many distinct cells of the
+  /// trace this step touches. The solid field is passed, not kept: the canvas pool it points
+  /// into may have grown since the last step.
+  int64_t mark_contacts(int32_t* trace, int trace_w, int trace_h, int ox, int oy, float contact_height,
+                        const SolidField& solid = {});
 
   BrushStats stats();
   /// Device view of the samples; valid until the brush is destroyed (the buffers never move).
@@ -110,7 +113,6 @@ class Brush {
   Vec3 frame_omega_B_{};
   int pose_history_ = 0;
   int sample_history_ = 0;
-  SolidField last_solid_{};
   int64_t rollbacks_ = 0;
 
   // Per vertex.

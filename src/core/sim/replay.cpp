@@ -61,7 +61,8 @@ bool Replay::advance() {
   sim_.step(poses_.data(), step.substeps, float(step.dt));
   // A bristle is in contact when a sample is within one cell of the canvas or dried paint.
   const int64_t touched =
-      sim_.brush().mark_contacts(trace_.data(), region_.width, region_.height, region_.x0, region_.y0, 1.0f);
+      sim_.brush().mark_contacts(trace_.data(), region_.width, region_.height, region_.x0, region_.y0, 1.0f,
+                                 sim_.solid_field());
   contact_cells_max_ = std::max(contact_cells_max_, touched);
   max_stretch_ = std::max(max_stretch_, sim_.brush().stats().max_stretch);
   last_t_ = step.t;

@@ -136,11 +136,15 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
 
   // --- 1-2. Brush (§4.1) in sub-steps, then its samples ------------------------------------
   brush_stage(poses, substeps, dt);
+  TransferRecord rec;
 
   // --- 3. Window: follow the brush; rasterise the bristles into it (boundary of §4.2) -----
   {
     WB_PROFILE_SCOPE("window");
-    grid_->recentre_on(footprint_centre(brush_->pose(), config_.brush.length));
+    const Int3 next = grid_->window().origin_for(footprint_centre(brush_->pose(), config_.brush.length),
+                                                 config_.params.grid.window_snap);
+    if (particles_.size() > 0) deposit_leaving_particles(next, rec);
+    grid_->move_window(next);
     brush_->rasterize(grid_->window().origin(), grid_->window().dims(), psi_.data(), bristle_v_[0].data(),
                       bristle_v_[1].data(), bristle_v_[2].data());
     grid_->set_bristles(BristleField{psi_.data(), bristle_v_[0].data(), bristle_v_[1].data(), bristle_v_[2].data()});
@@ -175,7 +179,6 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
   }
 
   // --- 8. Transfer (§5): bristle <-> particle, grid <-> particle ---------------------------
-  TransferRecord rec;
   {
     WB_PROFILE_SCOPE("transfer");
     if (config_.particles) {
@@ -183,7 +186,12 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
       hash_.build(brush_->samples(), config_.params.particles.hash_cell, ws_, 0.f);
       hash_.query_nearest(particles_.view(), config_.params.particles.D0);
     }
-    rec = transfer_->step(brush_->samples(), *load_, particles_, transfer_env());
+    const TransferRecord moved = transfer_->step(brush_->samples(), *load_, particles_, transfer_env());
+    const TransferRecord pre = rec;  // particles deposited before the window moved
+    rec = moved;
+    rec.to_grid_count += pre.to_grid_count;
+    rec.to_grid_from_particles += pre.to_grid_from_particles;
+    rec.to_grid_into_grid += pre.to_grid_into_grid;
   }
 
   contain_nonfinite();
@@ -194,6 +202,30 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
   ++counters_.steps;
   counters_.substeps += substeps;
   counters_.particles_max = std::max(counters_.particles_max, particles_.size());
+}
+
+void Simulator::deposit_leaving_particles(Int3 next, TransferRecord& rec) {
+  // Particles live only inside the window (they are rasterised into it and go back to the
+  // grid through it). Those outside the part of the window that stays, less a margin for
+  // the kernel of Eq. 16, return to the grid before the window moves.
+  ActiveWindow& win = grid_->window();
+  const Int3 cur = win.origin(), n = win.dims();
+  const int m = 3;
+  TransferEnv env = transfer_env();
+  env.keep_box = true;
+  env.keep_lo = Int3{std::max(cur.x, next.x) - cur.x + m, std::max(cur.y, next.y) - cur.y + m, 0};
+  env.keep_hi = Int3{std::min(cur.x, next.x) + n.x - cur.x - m, std::min(cur.y, next.y) + n.y - cur.y - m, n.z - m};
+  transfer_->update_distance(brush_->samples(), env);
+  transfer_->particles_to_grid(particles_, env, rec);
+  particles_.compact(ws_);
+}
+
+SolidField Simulator::solid_field() {
+  SolidField s;
+  s.tiles = canvas_->view();
+  s.dryness_threshold = config_.params.grid.dry_threshold;
+  s.valid = canvas_->allocated_tiles() > 0;  // an empty canvas has no dried paint
+  return s;
 }
 
 void Simulator::brush_stage(const BrushPose* poses, int substeps, float dt) {
@@ -207,9 +239,7 @@ void Simulator::brush_stage(const BrushPose* poses, int substeps, float dt) {
                  n.x, n.y, n.z, o.x, o.y, o.z, config_.params.bristle_drag};
   BrushEnvironment env;
   env.drag = config_.params.bristle_drag > 0.f ? &drag : nullptr;
-  env.solid.tiles = canvas_->view();
-  env.solid.dryness_threshold = config_.params.grid.dry_threshold;
-  env.solid.valid = canvas_->allocated_tiles() > 0;  // an empty canvas has no dried paint
+  env.solid = solid_field();
   for (int k = 0; k < substeps; ++k) brush_->step(poses[k], dt_sub, env);
   counters_.nonfinite_events += brush_->stats().nonfinite - rollbacks_before;
 }

@@ -80,10 +80,13 @@ class Simulator {
   /// The live window and the particles, for the renderer.
   PaintWindow* live_window() { return &grid_->window().paint(); }
   ParticleOverlay particle_overlay();
+  /// Dried paint of the canvas as the brush sees it now (views into the current tile pool).
+  SolidField solid_field();
 
  private:
   void brush_stage(const BrushPose* poses, int substeps, float dt);
   void particle_stage(float dt);
+  void deposit_leaving_particles(Int3 next_origin, TransferRecord& rec);
   void joint_fields_stage();
   void contain_nonfinite();
   TransferEnv transfer_env();
