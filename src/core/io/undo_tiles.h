@@ -1,0 +1,52 @@
+// Tile snapshots for undo (the studio's whole-stroke undo, DESIGN "The canvas: sparse"): the
+// tiles a stroke may touch are captured before it runs, compared after it, and only those
+// that changed are kept, zstd-compressed, as a before/after pair. Qt-free.
+#pragma once
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "core/canvas/tile_store.h"
+
+namespace wb {
+
+/// One tile as it was: absent (never allocated) or its stored fields, zstd-compressed.
+struct TileSnapshot {
+  int tile_id = -1;
+  bool present = false;
+  std::vector<uint8_t> zdata;  ///< compressed TileData fields (empty when absent)
+};
+
+/// Compresses one tile of the store (an unallocated tile gives present = false).
+TileSnapshot snapshot_tile(const TileStore& canvas, int tile_id);
+/// Writes the snapshot back; an absent tile is written as an empty (all-zero) tile when it
+/// is allocated now, and left alone otherwise.
+void restore_tile(TileStore& canvas, const TileSnapshot& snap);
+
+/// Before/after of the tiles one stroke changed.
+struct TileDiff {
+  std::vector<TileSnapshot> before, after;
+  size_t bytes() const;
+  bool empty() const { return before.empty(); }
+  void apply_before(TileStore& canvas) const;
+  void apply_after(TileStore& canvas) const;
+};
+
+/// Collects the "before" of every tile a stroke may touch: call capture_rect() with the
+/// canvas rectangle that the next simulation step may change, before running it; finish()
+/// compares with the canvas now and keeps only the tiles that differ.
+class StrokeTileRecorder {
+ public:
+  /// Captures the tiles overlapping [x0, x1) x [y0, y1) (cells) not captured yet.
+  void capture_rect(const TileStore& canvas, int x0, int y0, int x1, int y1);
+  bool active() const { return !before_.empty(); }
+  size_t captured() const { return before_.size(); }
+  /// The diff of the captured tiles against the canvas now; resets the recorder.
+  TileDiff finish(const TileStore& canvas);
+  void reset() { before_.clear(); }
+
+ private:
+  std::unordered_map<int, TileSnapshot> before_;
+};
+
+}  // namespace wb

@@ -1,0 +1,33 @@
+// Scripted input for the studio: synthesised tablet strokes through the real event path
+// (QTabletEvent -> CanvasView -> session clock -> simulation), used by the tests, by the
+// README screenshot and by the frame-rate measurement.
+#pragma once
+#include <QPointF>
+#include <vector>
+
+namespace wb::studio {
+
+class CanvasView;
+
+struct ScriptPoint {
+  QPointF canvas;        ///< canvas cells
+  float pressure = 0.5f;
+  float tilt_x = 0.f, tilt_y = 0.f, rotation = 0.f;
+};
+
+/// Sends a press, moves and a release as QTabletEvents at the widget positions of the canvas
+/// points, `interval_ms` apart (events are processed between points, so time advances).
+void tablet_stroke(CanvasView* view, const std::vector<ScriptPoint>& points, int interval_ms = 8);
+
+/// A straight line of `n` points from a to b at constant pressure.
+std::vector<ScriptPoint> line_points(QPointF a, QPointF b, int n, float pressure, float tilt_x = 0.f,
+                                     float tilt_y = 0.f);
+
+}  // namespace wb::studio
+
+namespace wb::studio {
+class MainWindow;
+/// A small scripted painting: a few colours dipped from the palette, curved strokes with
+/// varying pressure and tilt (the README screenshot and the frame-rate measurement).
+void run_demo_painting(MainWindow& w);
+}  // namespace wb::studio

@@ -1,0 +1,66 @@
+// wetbrush studio: the desktop painting application (Qt 6 Widgets, OpenGL canvas view).
+#include <QApplication>
+#include <QCommandLineParser>
+#include <QSurfaceFormat>
+#include <QTimer>
+
+#include <cstdio>
+
+#include "core/exec/device.h"
+#include "studio/demo.h"
+#include "studio/main_window.h"
+
+using namespace wb::studio;
+
+int main(int argc, char** argv) {
+  QApplication::setAttribute(Qt::AA_ShareOpenGLContexts);
+  QApplication app(argc, argv);
+  QApplication::setApplicationName("wetbrush-studio");
+  QApplication::setOrganizationName("wetbrush");
+
+  QCommandLineParser cli;
+  cli.setApplicationDescription("wetbrush studio: paint with a simulated bristle brush and 3D oil paint");
+  cli.addHelpOption();
+  QCommandLineOption device_opt("device", "Simulation device: auto, cpu, cuda or cuda:N.", "device", "auto");
+  QCommandLineOption preset_opt("preset", "Quality preset: auto (from the device), cpu or gpu.", "preset", "auto");
+  QCommandLineOption data_opt("data-dir", "Folder for presets, settings and the recovery file.", "dir");
+  QCommandLineOption norecover_opt("no-recovery", "Do not offer to recover an autosaved painting.");
+  QCommandLineOption demo_opt("demo-screenshot",
+                              "Paint a scripted picture with synthesised tablet strokes, save a screenshot of "
+                              "the window to FILE and quit.",
+                              "file");
+  cli.addOptions({device_opt, preset_opt, data_opt, norecover_opt, demo_opt});
+  cli.addPositionalArgument("painting", "OpenRaster painting to open (.ora).", "[painting]");
+  cli.process(app);
+
+  StudioOptions opt;
+  try {
+    opt.device = wb::Device::parse(cli.value(device_opt).toStdString());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "wetbrush-studio: %s\n", e.what());
+    return 2;
+  }
+  const QString preset = cli.value(preset_opt);
+  opt.preset = preset == "gpu"   ? QualityPreset::gpu()
+               : preset == "cpu" ? QualityPreset::cpu()
+                                 : QualityPreset::for_device(opt.device);
+  opt.data_dir = cli.value(data_opt);
+  opt.offer_recovery = !cli.isSet(norecover_opt) && !cli.isSet(demo_opt);
+  if (!cli.positionalArguments().isEmpty()) opt.open_path = cli.positionalArguments().first();
+
+  MainWindow w(opt);
+  w.show();
+  if (cli.isSet(demo_opt)) {
+    const QString out = cli.value(demo_opt);
+    QTimer::singleShot(500, &w, [&w, out] {
+      run_demo_painting(w);
+      w.settle();
+      QApplication::processEvents();
+      w.grab().save(out);
+      std::printf("wrote %s\n", qPrintable(out));
+      w.undo_stack()->setClean();
+      QApplication::quit();
+    });
+  }
+  return app.exec();
+}

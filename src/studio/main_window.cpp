@@ -1,0 +1,663 @@
+#include "studio/main_window.h"
+
+#include <QApplication>
+#include <QCloseEvent>
+#include <QColorDialog>
+#include <QComboBox>
+#include <QDialog>
+#include <QDialogButtonBox>
+#include <QDir>
+#include <QDockWidget>
+#include <QFile>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QFormLayout>
+#include <QMenuBar>
+#include <QMessageBox>
+#include <QPushButton>
+#include <QSettings>
+#include <QSpinBox>
+#include <QStandardPaths>
+#include <QStatusBar>
+#include <QThreadPool>
+#include <QUndoCommand>
+
+#include <chrono>
+#include <cstdio>
+#include <cmath>
+#include <future>
+
+#include "core/io/brush_json.h"
+#include "core/io/document.h"
+#include "core/exec/error.h"
+#include "core/io/png.h"
+#include "studio/sim_paint.h"
+
+namespace wb::studio {
+namespace {
+
+double wall_now() {
+  using namespace std::chrono;
+  return duration<double>(steady_clock::now().time_since_epoch()).count();
+}
+
+/// Canvas rectangle (cells) covered by the tiles of a diff.
+void diff_rect(const TileDiff& d, int tiles_x, int& x0, int& y0, int& x1, int& y1) {
+  x0 = y0 = 1 << 30;
+  x1 = y1 = -1;
+  for (const TileSnapshot& s : d.before) {
+    const int tx = s.tile_id % tiles_x, ty = s.tile_id / tiles_x;
+    x0 = std::min(x0, tx * kTileSize);
+    y0 = std::min(y0, ty * kTileSize);
+    x1 = std::max(x1, (tx + 1) * kTileSize);
+    y1 = std::max(y1, (ty + 1) * kTileSize);
+  }
+}
+
+/// One whole stroke: undo writes back the tiles as they were, redo as they became.
+class StrokeCommand : public QUndoCommand {
+ public:
+  StrokeCommand(SimThread* sim, std::shared_ptr<TileDiff> diff, std::function<void()> on_change)
+      : QUndoCommand("Stroke"), sim_(sim), diff_(std::move(diff)), on_change_(std::move(on_change)) {}
+  void undo() override { apply(false); }
+  void redo() override {
+    if (first_) {  // the stroke is already on the canvas
+      first_ = false;
+      return;
+    }
+    apply(true);
+  }
+
+ private:
+  void apply(bool after) {
+    auto d = diff_;
+    sim_->post([d, after](SimThread& s) {
+      s.restart_recording(false);
+      after ? d->apply_after(s.sim().canvas()) : d->apply_before(s.sim().canvas());
+      reload_window(s.sim());
+      int x0, y0, x1, y1;
+      diff_rect(*d, s.sim().canvas().tiles_x(), x0, y0, x1, y1);
+      s.invalidate_rect(x0, y0, x1, y1);
+    });
+    on_change_();
+  }
+  SimThread* sim_;
+  std::shared_ptr<TileDiff> diff_;
+  std::function<void()> on_change_;
+  bool first_ = true;
+};
+
+}  // namespace
+
+MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
+    : QMainWindow(parent),
+      options_(options),
+      clock_(options.preset.canvas_width, options.preset.canvas_height) {
+  if (options_.data_dir.isEmpty())
+    options_.data_dir = QStandardPaths::writableLocation(QStandardPaths::AppDataLocation);
+  QDir().mkpath(options_.data_dir);
+
+  const QualityPreset& q = options_.preset;
+  SimConfig cfg;
+  cfg.device = options_.device;
+  cfg.canvas = CanvasDims{q.canvas_width, q.canvas_height, q.canvas_depth};
+  cfg.brush = default_brush(BrushShape::Round);
+  cfg.brush.bristles = q.bristles;
+  cfg.brush.samples_per_bristle = q.samples_per_bristle;
+  if (options_.brush) cfg.brush = *options_.brush;
+  RenderParams rp;
+  rp.ao_rays = q.ao_rays;
+  sim_ = std::make_unique<SimThread>(cfg, rp);
+
+  view_ = new CanvasView;
+  view_->set_frame_source([s = sim_.get()](QImage& img) { return s->take_frame(img); });
+  view_->set_canvas_size(cfg.canvas.width, cfg.canvas.height);
+  view_->set_cursor_radius(cfg.brush.width * 0.5f);
+  setCentralWidget(view_);
+  connect(sim_.get(), &SimThread::frameReady, view_, qOverload<>(&QWidget::update));
+  connect(sim_.get(), &SimThread::failed, this, [this](const QString& m) {
+    std::fprintf(stderr, "wetbrush-studio: %s\n", qPrintable(m));
+    statusBar()->showMessage("Error: " + m, 10000);
+  });
+
+  undo_ = new QUndoStack(this);
+  undo_->setUndoLimit(kUndoLimit);
+  connect(undo_, &QUndoStack::cleanChanged, this, [this] { update_title(); });
+  connect(sim_.get(), &SimThread::strokeFinished, this, [this](std::shared_ptr<TileDiff> diff) {
+    undo_->push(new StrokeCommand(sim_.get(), std::move(diff), [this] { clock_.restart(); }));
+    autosave_due_ = true;
+    idle_save_timer_.start();
+  });
+
+  // Pen input -> session clock -> simulation thread.
+  connect(view_, &CanvasView::penPress, this, [this](PenInput p, double t) { push_clock(clock_.press(p, t)); });
+  connect(view_, &CanvasView::penMove, this, [this](PenInput p, double t) { push_clock(clock_.move(p, t)); });
+  connect(view_, &CanvasView::penRelease, this, [this](PenInput p, double t) {
+    push_clock(clock_.release(p, t));
+    for (const StrokeEvent& e : pending_events_) push_clock(clock_.event(e));
+    pending_events_.clear();
+  });
+  hold_timer_.setInterval(8);
+  connect(&hold_timer_, &QTimer::timeout, this, [this] {
+    if (clock_.down()) push_clock(clock_.hold(wall_now()));
+  });
+  hold_timer_.start();
+
+  // Panels.
+  brush_panel_ = new BrushPanel;
+  brush_panel_->set_brush(cfg.brush);
+  brush_panel_->set_preset_dir(options_.data_dir + "/brushes");
+  connect(brush_panel_, &BrushPanel::brushChanged, this, [this](BrushSpec b) {
+    // Sample gap below one cell along the longest bristle (the brush model requires it).
+    const int needed = int(std::ceil(b.length * (1.f + 2.f * b.length_variation) * 1.05f)) + 4;
+    b.samples_per_bristle = std::max(options_.preset.samples_per_bristle, needed);
+    try {
+      validate_brush(b, "brush");
+    } catch (const std::exception& e) {
+      statusBar()->showMessage(QString::fromStdString(e.what()), 5000);
+      return;
+    }
+    view_->set_cursor_radius(b.width * 0.5f);
+    sim_->post([b](SimThread& s) {
+      SimConfig c = s.config();
+      c.brush = b;
+      s.rebuild(c, true);
+    });
+    clock_.restart();
+  });
+  paint_panel_ = new PaintPanel;
+  connect(paint_panel_, &PaintPanel::dip, this, [this](PaintLoad p) { dip(p); });
+  connect(paint_panel_, &PaintPanel::wipe, this, [this](float f) { wipe(f); });
+  connect(paint_panel_, &PaintPanel::clean, this, [this] { clean_brush(); });
+  view_panel_ = new ViewPanel;
+  connect(view_panel_, &ViewPanel::lightingChanged, this, [this](float az, float el, float relief) {
+    const float a = az * 3.14159265f / 180.f, e = el * 3.14159265f / 180.f;
+    const Vec3 dir(std::cos(a) * std::cos(e), std::sin(a) * std::cos(e), std::sin(e));
+    sim_->post([dir, relief](SimThread& s) {
+      s.renderer().params().light_dir = dir;
+      s.renderer().params().diffuse = relief;
+      s.renderer().params().ambient = 1.1f - relief;
+      s.invalidate_all();
+    });
+  });
+  connect(view_panel_, &ViewPanel::pressureChanged, this, [this](float mp, float gamma) {
+    view_->set_mouse_pressure(mp);
+    view_->set_pressure_gamma(gamma);
+  });
+  const auto dock = [this](QWidget* w, const QString& title) {
+    auto* d = new QDockWidget(title, this);
+    d->setObjectName(title);
+    d->setWidget(w);
+    d->setFeatures(QDockWidget::DockWidgetMovable | QDockWidget::DockWidgetFloatable);
+    addDockWidget(Qt::RightDockWidgetArea, d);
+  };
+  dock(brush_panel_, "Brush");
+  dock(paint_panel_, "Paint");
+  dock(view_panel_, "View and input");
+
+  // Status bar.
+  status_sim_ = new QLabel;
+  status_device_ = new QLabel;
+  status_view_ = new QLabel;
+  statusBar()->addPermanentWidget(status_sim_);
+  statusBar()->addPermanentWidget(status_view_);
+  statusBar()->addPermanentWidget(status_device_);
+  status_timer_.setInterval(500);
+  connect(&status_timer_, &QTimer::timeout, this, [this] { update_status(); });
+  status_timer_.start();
+
+  build_menus();
+
+  // Autosave: every few minutes when changed, and a moment after each stroke when idle.
+  autosave_timer_.setInterval(options_.autosave_interval_s * 1000);
+  connect(&autosave_timer_, &QTimer::timeout, this, [this] { autosave(); });
+  autosave_timer_.start();
+  idle_save_timer_.setSingleShot(true);
+  idle_save_timer_.setInterval(3000);
+  connect(&idle_save_timer_, &QTimer::timeout, this, [this] {
+    if (sim_->status().idle && !clock_.down())
+      autosave();
+    else
+      idle_save_timer_.start();
+  });
+
+  sim_->post([p = paint_panel_->current_paint()](SimThread& s) {
+    s.set_paint(p);
+    s.restart_recording(true);
+  });
+  resize(1400, 900);
+  update_title();
+  if (!options_.open_path.isEmpty())
+    open_from(options_.open_path);
+  else if (options_.offer_recovery)
+    QTimer::singleShot(0, this, [this] { check_recovery(); });
+}
+
+MainWindow::~MainWindow() {
+  QThreadPool::globalInstance()->waitForDone();
+  sim_.reset();
+}
+
+QString MainWindow::recovery_path() const { return options_.data_dir + "/recovery.ora"; }
+
+void MainWindow::build_menus() {
+  QMenu* file = menuBar()->addMenu("&File");
+  file->addAction("&New canvas...", QKeySequence::New, this, [this] {
+    QDialog d(this);
+    d.setWindowTitle("New canvas");
+    auto* form = new QFormLayout(&d);
+    auto* unit = new QComboBox;
+    unit->addItems({"cells (0.2 mm)", "cm"});
+    auto* w = new QSpinBox;
+    auto* h = new QSpinBox;
+    for (auto* s : {w, h}) s->setRange(16, 16384);
+    w->setValue(view_->canvas_size().width());
+    h->setValue(view_->canvas_size().height());
+    QColor paper(237, 232, 219);
+    auto* paper_b = new QPushButton("Paper colour...");
+    connect(paper_b, &QPushButton::clicked, &d, [&] {
+      const QColor c = QColorDialog::getColor(paper, &d, "Paper colour");
+      if (c.isValid()) paper = c;
+    });
+    form->addRow("Unit", unit);
+    form->addRow("Width", w);
+    form->addRow("Height", h);
+    form->addRow(paper_b);
+    auto* bb = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel);
+    form->addRow(bb);
+    connect(bb, &QDialogButtonBox::accepted, &d, &QDialog::accept);
+    connect(bb, &QDialogButtonBox::rejected, &d, &QDialog::reject);
+    if (d.exec() != QDialog::Accepted || !maybe_save()) return;
+    const int k = unit->currentIndex() == 1 ? 50 : 1;  // 1 cm = 50 cells
+    new_canvas(w->value() * k, h->value() * k, paper);
+  });
+  file->addAction("&Open...", QKeySequence::Open, this, [this] {
+    if (!maybe_save()) return;
+    const QString p = QFileDialog::getOpenFileName(this, "Open painting", QString(), "OpenRaster (*.ora)");
+    if (!p.isEmpty()) open_from(p);
+  });
+  recent_menu_ = file->addMenu("Open &recent");
+  rebuild_recent_menu();
+  file->addAction("&Save", QKeySequence::Save, this, [this] {
+    if (path_.isEmpty()) {
+      const QString p = QFileDialog::getSaveFileName(this, "Save painting", "painting.ora", "OpenRaster (*.ora)");
+      if (!p.isEmpty()) save_to(p);
+    } else {
+      save_to(path_);
+    }
+  });
+  file->addAction("Save &as...", QKeySequence::SaveAs, this, [this] {
+    const QString p = QFileDialog::getSaveFileName(this, "Save painting", "painting.ora", "OpenRaster (*.ora)");
+    if (!p.isEmpty()) save_to(p);
+  });
+  file->addSeparator();
+  file->addAction("Export &PNG...", this, [this] {
+    const QString p = QFileDialog::getSaveFileName(this, "Export PNG", "painting.png", "PNG (*.png)");
+    if (!p.isEmpty()) export_png(p);
+  });
+  file->addAction("Export &height and normal maps...", this, [this] {
+    const QString p = QFileDialog::getSaveFileName(this, "Export maps (base name)", "painting", "PNG (*.png)");
+    if (p.isEmpty()) return;
+    QString base = p;
+    if (base.endsWith(".png")) base.chop(4);
+    export_maps(base + "-height.png", base + "-normal.png");
+  });
+  file->addAction("Save &recording...", this, [this] {
+    const QString p = QFileDialog::getSaveFileName(this, "Save recording", "session.json", "Stroke file (*.json)");
+    if (!p.isEmpty()) save_recording(p);
+  });
+  file->addSeparator();
+  file->addAction("&Quit", QKeySequence::Quit, this, &QWidget::close);
+
+  QMenu* edit = menuBar()->addMenu("&Edit");
+  QAction* u = undo_->createUndoAction(this, "&Undo");
+  u->setShortcut(QKeySequence::Undo);
+  QAction* r = undo_->createRedoAction(this, "&Redo");
+  r->setShortcut(QKeySequence::Redo);
+  edit->addAction(u);
+  edit->addAction(r);
+
+  QMenu* canvas = menuBar()->addMenu("&Canvas");
+  canvas->addAction("&Dry canvas", QKeySequence(Qt::CTRL | Qt::Key_D), this, [this] { dry_canvas(); });
+  canvas->addAction("D&ip brush", QKeySequence(Qt::Key_D), this, [this] { dip(paint_panel_->current_paint()); });
+  canvas->addAction("&Wipe brush", QKeySequence(Qt::Key_W), this, [this] { wipe(0.5f); });
+  canvas->addAction("&Clean brush", QKeySequence(Qt::Key_C), this, [this] { clean_brush(); });
+
+  QMenu* view = menuBar()->addMenu("&View");
+  view->addAction("&Fit (0)", this, [this] { view_->fit(); });
+  view->addAction("&1:1 (1)", this, [this] { view_->set_view(view_->center(), 1.f, view_->rotation_deg()); });
+  view->addAction("Zoom &in (+)", this, [this] { view_->zoom_by(1.25f, QPointF(view_->width() / 2.0, view_->height() / 2.0)); });
+  view->addAction("Zoom &out (-)", this, [this] { view_->zoom_by(0.8f, QPointF(view_->width() / 2.0, view_->height() / 2.0)); });
+  view->addAction("&Rotate 15\u00b0 (R)", this, [this] { view_->set_view(view_->center(), view_->zoom(), view_->rotation_deg() + 15.f); });
+  view->addAction("Reset rotation", this, [this] { view_->set_view(view_->center(), view_->zoom(), 0.f); });
+}
+
+void MainWindow::push_clock(const ClockOutput& out) {
+  sim_->push(out);
+  if (!out.samples.empty()) dirty_ = dirty_ || false;
+}
+
+void MainWindow::send_event(StrokeEvent e) {
+  if (clock_.down()) {
+    pending_events_.push_back(e);
+    return;
+  }
+  push_clock(clock_.event(e));
+}
+
+void MainWindow::dip(const PaintLoad& p) {
+  StrokeEvent e;
+  e.kind = StrokeEventKind::Dip;
+  for (int c = 0; c < 3; ++c) e.ryb[c] = p.ryb[c];
+  e.oil = p.oil;
+  e.load = p.load;
+  send_event(e);
+}
+
+void MainWindow::wipe(float fraction) {
+  StrokeEvent e;
+  e.kind = StrokeEventKind::Wipe;
+  e.fraction = fraction;
+  send_event(e);
+}
+
+void MainWindow::clean_brush() {
+  StrokeEvent e;
+  e.kind = StrokeEventKind::Clean;
+  send_event(e);
+}
+
+void MainWindow::dry_canvas() {
+  StrokeEvent e;
+  e.kind = StrokeEventKind::Dry;
+  send_event(e);
+  // Undo records are tiles before and after a stroke: restoring wet tiles over a dried
+  // layer would undo the drying too, so drying starts a new history.
+  undo_->clear();
+  dirty_ = true;
+  update_title();
+}
+
+void MainWindow::new_canvas(int width, int height, QColor paper) {
+  const Vec3 rgb(float(paper.redF()), float(paper.greenF()), float(paper.blueF()));
+  sim_->post([width, height, rgb](SimThread& s) {
+    SimConfig c = s.config();
+    c.canvas.width = width;
+    c.canvas.height = height;
+    s.renderer().params().paper_rgb = rgb;
+    s.rebuild(c, false);
+    s.restart_recording(true);
+  });
+  clock_ = PenClock(width, height);
+  undo_->clear();
+  view_->set_canvas_size(width, height);
+  path_.clear();
+  dirty_ = false;
+  update_title();
+}
+
+void MainWindow::settle() {
+  sim_->wait_idle();
+  QCoreApplication::processEvents();
+  sim_->wait_idle();
+  QCoreApplication::processEvents();
+}
+
+bool MainWindow::write_snapshot(const QString& path, bool wait, bool user_save) {
+  // The snapshot is taken on the simulation thread between two steps (a copy of the tiles and
+  // the rendered image); the file is written on a pool thread, so painting goes on.
+  auto done = std::make_shared<std::promise<std::string>>();
+  std::future<std::string> result = done->get_future();
+  const std::string file = path.toStdString();
+  const bool from_blank = sim_->recording_from_blank();
+  ++saves_in_flight_;
+  sim_->post([done, file, from_blank](SimThread& s) {
+    try {
+      flush_simulation(s.sim());
+      TileStore& live = s.sim().canvas();
+      auto copy = std::make_shared<TileStore>(Device{}, live.dims());
+      for (int id : live.allocated_tile_ids()) copy->write_tile(live.read_tile(id));
+      auto image = std::make_shared<Image>(s.canvas_image());
+      const Vec3 paper = s.renderer().params().paper_rgb;
+      nlohmann::json meta = {{"generator", "wetbrush-studio"},
+                             {"brush", brush_to_json(s.config().brush)},
+                             {"paper_rgb", {paper.x, paper.y, paper.z}},
+                             {"recording_from_blank", from_blank}};
+      QThreadPool::globalInstance()->start([done, file, copy, image, meta] {
+        try {
+          save_painting(file, *copy, *image, meta);
+          done->set_value("");
+        } catch (const std::exception& e) {
+          done->set_value(e.what());
+        }
+      });
+    } catch (const std::exception& e) {
+      done->set_value(e.what());
+    }
+  });
+  const auto finish = [this, path, user_save](const std::string& err) {
+    --saves_in_flight_;
+    if (!err.empty()) {
+      QMessageBox::warning(this, "Save failed", QString::fromStdString(err));
+      return false;
+    }
+    if (user_save) {
+      statusBar()->showMessage("Saved " + path, 4000);
+    }
+    return true;
+  };
+  if (user_save) {
+    path_ = path;
+    undo_->setClean();
+    dirty_ = false;
+    add_recent(path);
+    update_title();
+  }
+  if (wait) return finish(result.get());
+  auto shared = std::make_shared<std::future<std::string>>(std::move(result));
+  auto* poll = new QTimer(this);
+  poll->setInterval(50);
+  connect(poll, &QTimer::timeout, this, [poll, shared, finish] {
+    if (shared->wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+    poll->stop();
+    poll->deleteLater();
+    finish(shared->get());
+  });
+  poll->start();
+  return true;
+}
+
+bool MainWindow::save_to(const QString& path, bool wait) { return write_snapshot(path, wait, true); }
+
+bool MainWindow::open_from(const QString& path) {
+  auto done = std::make_shared<std::promise<std::string>>();
+  auto dims = std::make_shared<CanvasDims>();
+  const std::string file = path.toStdString();
+  sim_->post([done, dims, file](SimThread& s) {
+    try {
+      Painting p = load_painting(file, s.sim().device());
+      if (p.metadata.contains("paper_rgb") && p.metadata["paper_rgb"].is_array() && p.metadata["paper_rgb"].size() == 3)
+        s.renderer().params().paper_rgb =
+            Vec3(p.metadata["paper_rgb"][0].get<float>(), p.metadata["paper_rgb"][1].get<float>(),
+                 p.metadata["paper_rgb"][2].get<float>());
+      SimConfig c = s.config();
+      c.canvas = p.canvas.dims();
+      s.rebuild(c, false);
+      for (int id : p.canvas.allocated_tile_ids()) s.sim().canvas().write_tile(p.canvas.read_tile(id));
+      reload_window(s.sim());
+      s.restart_recording(false);
+      s.invalidate_all();
+      *dims = c.canvas;
+      done->set_value("");
+    } catch (const std::exception& e) {
+      done->set_value(e.what());
+    }
+  });
+  const std::string err = done->get_future().get();
+  if (!err.empty()) {
+    QMessageBox::warning(this, "Open failed", QString::fromStdString(err));
+    return false;
+  }
+  clock_ = PenClock(dims->width, dims->height);
+  view_->set_canvas_size(dims->width, dims->height);
+  undo_->clear();
+  path_ = path;
+  dirty_ = false;
+  add_recent(path);
+  update_title();
+  return true;
+}
+
+bool MainWindow::export_png(const QString& path) {
+  auto done = std::make_shared<std::promise<std::string>>();
+  const std::string file = path.toStdString();
+  sim_->post([done, file](SimThread& s) {
+    try {
+      const Image img = s.canvas_image();
+      write_png8(file, img.rgba.data(), img.width, img.height, 4);
+      done->set_value("");
+    } catch (const std::exception& e) {
+      done->set_value(e.what());
+    }
+  });
+  const std::string err = done->get_future().get();
+  if (!err.empty()) QMessageBox::warning(this, "Export failed", QString::fromStdString(err));
+  return err.empty();
+}
+
+bool MainWindow::export_maps(const QString& height_path, const QString& normal_path) {
+  auto done = std::make_shared<std::promise<std::string>>();
+  const std::string hp = height_path.toStdString(), np = normal_path.toStdString();
+  sim_->post([done, hp, np](SimThread& s) {
+    try {
+      flush_simulation(s.sim());
+      TileStore& canvas = s.sim().canvas();
+      const FloatImage h = s.renderer().render_height_map(canvas);
+      const double scale = 65535.0 / canvas.dims().depth;
+      std::vector<uint16_t> q(h.data.size());
+      for (size_t i = 0; i < q.size(); ++i) q[i] = uint16_t(std::lround(std::clamp(h.data[i] * scale, 0.0, 65535.0)));
+      write_png_gray16(hp, q.data(), h.width, h.height, {{"wetbrush:height_units_per_cell", std::to_string(scale)}});
+      const FloatImage n = s.renderer().render_normal_map(canvas);
+      std::vector<uint8_t> rgb(n.data.size());
+      for (size_t i = 0; i < rgb.size(); ++i)
+        rgb[i] = uint8_t(std::lround(std::clamp(n.data[i] * 0.5f + 0.5f, 0.f, 1.f) * 255.f));
+      write_png8(np, rgb.data(), n.width, n.height, 3);
+      done->set_value("");
+    } catch (const std::exception& e) {
+      done->set_value(e.what());
+    }
+  });
+  const std::string err = done->get_future().get();
+  if (!err.empty()) QMessageBox::warning(this, "Export failed", QString::fromStdString(err));
+  return err.empty();
+}
+
+bool MainWindow::save_recording(const QString& path) {
+  try {
+    Stroke rec = sim_->recording();
+    if (rec.samples.empty()) WB_THROW("nothing painted since the recording started");
+    save_stroke_json(rec, path.toStdString());
+    if (!sim_->recording_from_blank())
+      statusBar()->showMessage("Recording saved; it started on a painted canvas (after undo, open or a brush "
+                               "change), so a replay on a blank canvas shows only the strokes since then",
+                               8000);
+    return true;
+  } catch (const std::exception& e) {
+    QMessageBox::warning(this, "Save recording failed", QString::fromStdString(e.what()));
+    return false;
+  }
+}
+
+void MainWindow::update_status() {
+  const SimStatus st = sim_->status();
+  const double now = wall_now();
+  if (frames_t_ > 0) view_fps_ = (view_->frames_drawn() - frames_at_) / std::max(1e-3, now - frames_t_);
+  frames_at_ = view_->frames_drawn();
+  frames_t_ = now;
+  QString sim = QString("Sim %1 steps/s (%2 ms/step)").arg(st.steps_per_s, 0, 'f', 1).arg(st.step_ms, 0, 'f', 1);
+  if (st.lag_s > 0.05) sim += QString(", %1 s behind").arg(st.lag_s, 0, 'f', 1);
+  sim += st.particles >= 0 ? QString(" \u00b7 %1 particles").arg(st.particles) : QString(" \u00b7 particles: n/a");
+  if (!st.error.empty()) sim += " \u00b7 STOPPED: " + QString::fromStdString(st.error);
+  status_sim_->setText(sim);
+  status_view_->setText(QString("View %1 fps \u00b7 %2% \u00b7 %3\u00b0")
+                            .arg(view_fps_, 0, 'f', 0)
+                            .arg(view_->zoom() * 100.f, 0, 'f', 0)
+                            .arg(view_->rotation_deg(), 0, 'f', 0));
+  status_device_->setText(QString("Device %1 \u00b7 Preset %2")
+                              .arg(QString::fromStdString(st.device), QString::fromStdString(options_.preset.name)));
+  paint_panel_->show_brush(st.brush_ryb, st.brush_amount);
+}
+
+void MainWindow::update_title() {
+  const QString name = path_.isEmpty() ? "Untitled" : QFileInfo(path_).fileName();
+  setWindowTitle(QString("%1%2 \u2014 wetbrush studio").arg(name, modified() ? " *" : ""));
+}
+
+void MainWindow::add_recent(const QString& path) {
+  QSettings s(options_.data_dir + "/studio.ini", QSettings::IniFormat);
+  QStringList list = s.value("recent").toStringList();
+  list.removeAll(path);
+  list.prepend(path);
+  while (list.size() > 8) list.removeLast();
+  s.setValue("recent", list);
+  rebuild_recent_menu();
+}
+
+void MainWindow::rebuild_recent_menu() {
+  if (!recent_menu_) return;
+  recent_menu_->clear();
+  QSettings s(options_.data_dir + "/studio.ini", QSettings::IniFormat);
+  for (const QString& p : s.value("recent").toStringList())
+    recent_menu_->addAction(p, this, [this, p] {
+      if (maybe_save()) open_from(p);
+    });
+  recent_menu_->setEnabled(!recent_menu_->isEmpty());
+}
+
+bool MainWindow::maybe_save() {
+  if (!modified()) return true;
+  const auto b = QMessageBox::question(this, "Unsaved changes", "The painting has unsaved changes. Save them?",
+                                       QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel,
+                                       QMessageBox::Save);
+  if (b == QMessageBox::Cancel) return false;
+  if (b == QMessageBox::Save) {
+    QString p = path_;
+    if (p.isEmpty()) p = QFileDialog::getSaveFileName(this, "Save painting", "painting.ora", "OpenRaster (*.ora)");
+    if (p.isEmpty()) return false;
+    return save_to(p, true);
+  }
+  return true;
+}
+
+void MainWindow::autosave() {
+  if (!autosave_due_ && !dirty_) return;
+  if (!modified()) return;
+  autosave_due_ = false;
+  write_snapshot(recovery_path(), false, false);
+}
+
+void MainWindow::check_recovery() {
+  if (!QFile::exists(recovery_path())) return;
+  const auto b = QMessageBox::question(
+      this, "Recover painting", "wetbrush studio did not close normally. Recover the last autosaved painting?",
+      QMessageBox::Yes | QMessageBox::No, QMessageBox::Yes);
+  if (b == QMessageBox::Yes && open_from(recovery_path())) {
+    path_.clear();
+    dirty_ = true;
+    update_title();
+  } else {
+    QFile::remove(recovery_path());
+  }
+}
+
+void MainWindow::closeEvent(QCloseEvent* e) {
+  if (!maybe_save()) {
+    e->ignore();
+    return;
+  }
+  QThreadPool::globalInstance()->waitForDone();
+  QFile::remove(recovery_path());
+  e->accept();
+}
+
+}  // namespace wb::studio

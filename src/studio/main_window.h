@@ -1,0 +1,105 @@
+// The studio's main window: the canvas view in the middle, brush / paint / view panels,
+// menus (files, undo, canvas, recording), status bar (simulation rate, particles, device,
+// preset, frame rate), autosave and crash recovery.
+#pragma once
+#include <QLabel>
+#include <QMainWindow>
+#include <QTimer>
+#include <QUndoStack>
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "core/io/undo_tiles.h"
+#include "studio/canvas_view.h"
+#include "studio/panels.h"
+#include "studio/pen_clock.h"
+#include "studio/sim_thread.h"
+
+namespace wb::studio {
+
+struct StudioOptions {
+  Device device{};
+  QualityPreset preset = QualityPreset::cpu();
+  std::optional<BrushSpec> brush;  ///< starting brush (default: the preset's round brush)
+  QString open_path;            ///< painting to open at start
+  QString data_dir;             ///< presets, recovery file (default: the platform's app data folder)
+  bool offer_recovery = true;
+  int autosave_interval_s = 180;
+};
+
+/// Undo limit: whole strokes kept (each holds only the tiles it changed, zstd-compressed).
+inline constexpr int kUndoLimit = 64;
+
+class MainWindow : public QMainWindow {
+  Q_OBJECT
+ public:
+  explicit MainWindow(const StudioOptions& options, QWidget* parent = nullptr);
+  ~MainWindow() override;
+
+  CanvasView* view() const { return view_; }
+  SimThread* sim() const { return sim_.get(); }
+  QUndoStack* undo_stack() const { return undo_; }
+  BrushPanel* brush_panel() const { return brush_panel_; }
+  PaintPanel* paint_panel() const { return paint_panel_; }
+  QString current_path() const { return path_; }
+  bool modified() const { return !undo_->isClean() || dirty_; }
+  QString recovery_path() const;
+
+  // Actions (also used by tests). Saves and exports return after the file is written when
+  // `wait` is set; otherwise the write happens on a worker and the UI continues.
+  bool save_to(const QString& path, bool wait = false);
+  bool open_from(const QString& path);
+  bool export_png(const QString& path);
+  bool export_maps(const QString& height_path, const QString& normal_path);
+  bool save_recording(const QString& path);
+  void new_canvas(int width, int height, QColor paper);
+  void dip(const PaintLoad& p);
+  void wipe(float fraction);
+  void clean_brush();
+  void dry_canvas();
+  /// Blocks until the simulation has consumed every input so far and the last stroke's undo
+  /// record has arrived (tests).
+  void settle();
+
+ protected:
+  void closeEvent(QCloseEvent* e) override;
+
+ private:
+  void build_menus();
+  void push_clock(const ClockOutput& out);
+  void send_event(StrokeEvent e);
+  void update_status();
+  void update_title();
+  void add_recent(const QString& path);
+  void rebuild_recent_menu();
+  bool maybe_save();
+  void autosave();
+  void check_recovery();
+  bool write_snapshot(const QString& path, bool wait, bool user_save);
+
+  StudioOptions options_;
+  std::unique_ptr<SimThread> sim_;
+  PenClock clock_;
+  CanvasView* view_ = nullptr;
+  BrushPanel* brush_panel_ = nullptr;
+  PaintPanel* paint_panel_ = nullptr;
+  ViewPanel* view_panel_ = nullptr;
+  QUndoStack* undo_ = nullptr;
+  QMenu* recent_menu_ = nullptr;
+  QLabel* status_sim_ = nullptr;
+  QLabel* status_device_ = nullptr;
+  QLabel* status_view_ = nullptr;
+  QTimer status_timer_, hold_timer_, autosave_timer_, idle_save_timer_;
+  std::vector<StrokeEvent> pending_events_;  ///< palette actions while the pen is down
+  QString path_;
+  bool dirty_ = false;           ///< changes not in the undo stack (dry, open, new)
+  bool autosave_due_ = false;
+  int64_t frames_at_ = 0;
+  double frames_t_ = 0.0;
+  double view_fps_ = 0.0;
+  int saves_in_flight_ = 0;
+};
+
+}  // namespace wb::studio

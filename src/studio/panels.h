@@ -1,0 +1,97 @@
+// Side panels of the studio: the brush (shape, size, bristles, stiffness, length, beta_B,
+// saved presets), the paint (palette wells stored as RYB, oil, amount, dip / wipe / clean,
+// the brush's current colour and load) and the view (relief and lighting). Widgets only:
+// they emit values, the main window passes them to the simulation thread.
+#pragma once
+#include <QColor>
+#include <QWidget>
+
+#include <array>
+#include <vector>
+
+#include "core/brush/brush_spec.h"
+#include "core/io/stroke.h"
+
+class QComboBox;
+class QDoubleSpinBox;
+class QSpinBox;
+class QSlider;
+class QLabel;
+class QToolButton;
+class QButtonGroup;
+
+namespace wb::studio {
+
+class BrushPanel : public QWidget {
+  Q_OBJECT
+ public:
+  explicit BrushPanel(QWidget* parent = nullptr);
+  BrushSpec brush() const;
+  void set_brush(const BrushSpec& b);
+  /// Folder of saved presets (*.json, brush_json format).
+  void set_preset_dir(const QString& dir);
+
+ Q_SIGNALS:
+  void brushChanged(wb::BrushSpec brush);
+
+ private:
+  void reload_presets();
+  void emit_changed();
+  BrushSpec base_{};
+  QString preset_dir_;
+  QComboBox* shape_ = nullptr;
+  QComboBox* presets_ = nullptr;
+  QDoubleSpinBox* size_ = nullptr;
+  QSpinBox* bristles_ = nullptr;
+  QDoubleSpinBox* stiffness_ = nullptr;
+  QDoubleSpinBox* length_ = nullptr;
+  QDoubleSpinBox* beta_ = nullptr;
+  bool updating_ = false;
+};
+
+class PaintPanel : public QWidget {
+  Q_OBJECT
+ public:
+  explicit PaintPanel(QWidget* parent = nullptr);
+  /// The selected well as paint (RYB, oil, amount).
+  PaintLoad current_paint() const;
+  int current_well() const { return current_; }
+  void set_well_color(int i, const QColor& c);
+  QColor well_color(int i) const;
+  int well_count() const { return int(wells_.size()); }
+  /// Shows the brush's paint: mixed colour (RYB) and load in [0, 1].
+  void show_brush(const std::array<float, 3>& ryb, float amount);
+
+ Q_SIGNALS:
+  void dip(wb::PaintLoad paint);
+  void wipe(float fraction);
+  void clean();
+
+ private:
+  void select(int i);
+  std::vector<QToolButton*> wells_;
+  std::vector<std::array<float, 3>> ryb_;
+  int current_ = 0;
+  QSlider* oil_ = nullptr;
+  QSlider* amount_ = nullptr;
+  QLabel* brush_swatch_ = nullptr;
+};
+
+class ViewPanel : public QWidget {
+  Q_OBJECT
+ public:
+  explicit ViewPanel(QWidget* parent = nullptr);
+ Q_SIGNALS:
+  /// Light from `azimuth_deg` (0 = from +x, counter-clockwise), `elevation_deg` above the
+  /// canvas; `relief` scales the diffuse term (0 flat .. 1 strong).
+  void lightingChanged(float azimuth_deg, float elevation_deg, float relief);
+  void pressureChanged(float mouse_pressure, float gamma);
+ private:
+  QSlider *azimuth_, *elevation_, *relief_, *mouse_pressure_, *gamma_;
+};
+
+/// Display colour of an RYB pigment (Gossett-Chen cube, core/color/ryb.h).
+QColor ryb_to_qcolor(const std::array<float, 3>& ryb);
+std::array<float, 3> qcolor_to_ryb(const QColor& c);
+
+}  // namespace wb::studio

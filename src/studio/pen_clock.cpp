@@ -1,0 +1,104 @@
+#include "studio/pen_clock.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace wb::studio {
+
+double ceil_to(double t, double q) { return std::ceil(t / q - 1e-9) * q; }
+
+PenSample PenClock::sample(const PenInput& p, double t, bool down) const {
+  PenSample s;
+  s.t = t;
+  s.x = std::clamp(p.x, 0.f, float(w_));
+  s.y = std::clamp(p.y, 0.f, float(h_));
+  s.pressure = down ? std::clamp(p.pressure, 0.f, 1.f) : 0.f;
+  s.tilt_x = p.tilt_x;
+  s.tilt_y = p.tilt_y;
+  s.twist = p.twist;
+  s.down = down;
+  return s;
+}
+
+double PenClock::stamp(double now) {
+  // Session time of an arrival during a press: time since the press on the session line,
+  // quantised, and always after the previous sample.
+  const double t = press_session_t_ + std::floor((now - press_arrival_) / kTimeQuantum) * kTimeQuantum;
+  return std::max(t, last_t_ + kTimeQuantum);
+}
+
+void PenClock::push(ClockOutput& out, const PenSample& s) {
+  out.samples.push_back(s);
+  last_t_ = s.t;
+  last_ = s;
+  any_ = true;
+}
+
+ClockOutput PenClock::press(const PenInput& p, double now) {
+  ClockOutput out;
+  if (down_) return move(p, now);
+  // The brush hovers above the new spot kLiftGap before touching; a whole kStrokeGap after
+  // the previous stroke's last (lifted, step-aligned) sample.
+  const double s = any_ ? last_t_ + kStrokeGap : kLeadIn;
+  push(out, sample(p, s - kLiftGap, false));
+  push(out, sample(p, s, true));
+  down_ = true;
+  press_session_t_ = s;
+  press_arrival_ = now;
+  last_arrival_ = now;
+  return out;
+}
+
+ClockOutput PenClock::move(const PenInput& p, double now) {
+  ClockOutput out;
+  if (!down_) return out;
+  last_arrival_ = now;
+  push(out, sample(p, stamp(now), true));
+  return out;
+}
+
+ClockOutput PenClock::hold(double now) {
+  ClockOutput out;
+  if (!down_ || now - last_arrival_ < kStepDt) return out;
+  PenSample s = last_;
+  s.t = stamp(now);
+  last_arrival_ = now;
+  push(out, s);
+  return out;
+}
+
+ClockOutput PenClock::release(const PenInput& p, double now) {
+  ClockOutput out;
+  if (!down_) return out;
+  push(out, sample(p, stamp(now), true));
+  // Lifted kLiftGap later, then held still up to a step boundary: the simulation may run
+  // every step up to that sample without knowing what comes next.
+  const double up = last_t_ + kLiftGap;
+  push(out, sample(p, up, false));
+  push(out, sample(p, ceil_to(up + kStepDt, kStepDt), false));
+  down_ = false;
+  return out;
+}
+
+ClockOutput PenClock::event(StrokeEvent e) {
+  ClockOutput out;
+  if (down_) return out;  // the caller queues palette actions until the pen is up
+  PenInput at;
+  if (any_) {
+    at = PenInput{last_.x, last_.y, 0.f, last_.tilt_x, last_.tilt_y, last_.twist};
+  } else {
+    at.x = float(w_) * 0.5f;
+    at.y = float(h_) * 0.5f;
+  }
+  // Before the first stroke: an anchor sample at the start of the line (the lead-in
+  // then ends there); afterwards the event sits inside the next step, closed by a
+  // lifted sample on that step's end.
+  const double t0 = any_ ? last_t_ : kLeadIn - kLiftGap;
+  if (!any_) push(out, sample(at, t0, false));
+  e.t = t0 + 0.5 * kStepDt;
+  out.events.push_back(e);
+  push(out, sample(at, t0 + kStepDt, false));
+  return out;
+}
+
+}  // namespace wb::studio

@@ -1,0 +1,67 @@
+// The studio's session clock: turns pen input (press, move, hold, release) and palette actions
+// into time-stamped PenSamples and StrokeEvents on one session time line that a StrokePlayer
+// replays exactly. Times are multiples of 1/1024 s and every pause between strokes is the same
+// fixed gap, so step boundaries (multiples of the 1/64 s step) are exact in floating point.
+// See docs/STUDIO.md ("Time line and recording").
+#pragma once
+#include <optional>
+#include <vector>
+
+#include "core/io/stroke.h"
+
+namespace wb::studio {
+
+inline constexpr double kStepDt = 1.0 / 64.0;        ///< simulation step, seconds (exact in binary)
+inline constexpr double kTimeQuantum = 1.0 / 1024.0; ///< sample time resolution, seconds
+inline constexpr double kLiftGap = 0.125;             ///< hover before a press / lift after a release
+inline constexpr double kStrokeGap = 0.25;            ///< session time between two strokes
+inline constexpr double kLeadIn = 0.25;               ///< recording lead-in (the player's lead_in)
+
+/// Pen values as the input device gives them (canvas cells, pressure after the curve).
+struct PenInput {
+  float x = 0.f, y = 0.f, pressure = 0.5f, tilt_x = 0.f, tilt_y = 0.f, twist = 0.f;
+};
+
+/// What one input produces: samples to append and events to append (both in time order).
+struct ClockOutput {
+  std::vector<PenSample> samples;
+  std::vector<StrokeEvent> events;
+};
+
+class PenClock {
+ public:
+  PenClock(int canvas_width, int canvas_height) : w_(canvas_width), h_(canvas_height) {}
+
+  /// `now` is the arrival time in seconds on any monotonic clock.
+  ClockOutput press(const PenInput& p, double now);
+  ClockOutput move(const PenInput& p, double now);
+  /// Repeats the last sample when the pen is held still (call from a timer).
+  ClockOutput hold(double now);
+  ClockOutput release(const PenInput& p, double now);
+  /// A palette event (dip, wipe, clean, dry) while the pen is up: fires in the next step.
+  ClockOutput event(StrokeEvent e);
+
+  bool down() const { return down_; }
+  /// Session time of the last sample (0 before any).
+  double last_t() const { return last_t_; }
+  /// Starts a new session time line (a new recording).
+  void restart() { *this = PenClock(w_, h_); }
+
+ private:
+  PenSample sample(const PenInput& p, double t, bool down) const;
+  double stamp(double now);
+  void push(ClockOutput& out, const PenSample& s);
+
+  int w_, h_;
+  bool down_ = false;
+  bool any_ = false;
+  double last_t_ = 0.0;
+  double press_session_t_ = 0.0, press_arrival_ = 0.0;
+  double last_arrival_ = 0.0;
+  PenSample last_{};
+};
+
+/// Rounds t up to the next multiple of q (t itself when it is one).
+double ceil_to(double t, double q);
+
+}  // namespace wb::studio

@@ -1,0 +1,457 @@
+#include "studio/sim_thread.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+#include "core/color/ryb.h"
+#include "core/exec/error.h"
+#include "studio/sim_paint.h"
+
+namespace wb::studio {
+namespace {
+
+double wall_now() {
+  using namespace std::chrono;
+  return duration<double>(steady_clock::now().time_since_epoch()).count();
+}
+
+/// Cells around the brush that one step may change: the brush's reach plus the active window.
+int step_reach(const BrushSpec& b) { return int(b.length + std::max(b.width, b.thickness)) + 80; }
+
+}  // namespace
+
+QualityPreset QualityPreset::cpu() {
+  QualityPreset p;
+  p.name = "CPU (light)";
+  p.bristles = 80;
+  p.samples_per_bristle = 128;
+  p.canvas_width = 1200;
+  p.canvas_height = 900;
+  p.canvas_depth = 32;
+  p.ao_rays = 12;
+  return p;
+}
+
+QualityPreset QualityPreset::gpu() {
+  QualityPreset p;
+  p.name = "GPU (paper)";
+  p.bristles = 400;
+  p.samples_per_bristle = 128;
+  p.canvas_width = 4096;
+  p.canvas_height = 4096;
+  p.canvas_depth = 64;
+  p.ao_rays = 64;
+  return p;
+}
+
+SimThread::SimThread(const SimConfig& config, const RenderParams& render, QObject* parent)
+    : QObject(parent), config_(config), renderer_(config.device) {
+  renderer_.params() = render;
+  status_.device = config.device.to_string();
+  // The simulator and the first full render are built on the worker: a big canvas must not
+  // hold up the window.
+  post([](SimThread& self) { self.rebuild(self.config_, false); });
+  thread_ = std::thread([this] { run(); });
+}
+
+SimThread::~SimThread() {
+  {
+    std::lock_guard lk(in_mu_);
+    quit_ = true;
+  }
+  in_cv_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+void SimThread::push(const ClockOutput& out) {
+  if (out.samples.empty() && out.events.empty()) return;
+  post([out](SimThread& self) {
+    std::lock_guard lk(self.rec_mu_);
+    for (const PenSample& s : out.samples) self.rec_.samples.push_back(s);
+    for (const StrokeEvent& e : out.events) self.rec_.events.push_back(e);
+  });
+}
+
+void SimThread::post(std::function<void(SimThread&)> fn) {
+  {
+    std::lock_guard lk(in_mu_);
+    in_cmds_.push_back(std::move(fn));
+  }
+  in_cv_.notify_all();
+}
+
+void SimThread::wait_idle() {
+  std::unique_lock lk(in_mu_);
+  idle_cv_.wait(lk, [&] { return quit_ || (in_cmds_.empty() && !busy_); });
+}
+
+Stroke SimThread::recording() const {
+  std::lock_guard lk(rec_mu_);
+  return rec_;
+}
+
+SimStatus SimThread::status() const {
+  std::lock_guard lk(status_mu_);
+  return status_;
+}
+
+QRect SimThread::take_frame(QImage& canvas) {
+  std::lock_guard lk(frame_mu_);
+  if (front_.isNull() || front_dirty_.isEmpty()) return {};
+  QRect r = front_dirty_;
+  if (canvas.size() != front_.size() || canvas.format() != front_.format()) {
+    canvas = front_.copy();
+    r = front_.rect();
+  } else {
+    const int bpp = 4;
+    for (int y = r.top(); y <= r.bottom(); ++y)
+      std::memcpy(canvas.scanLine(y) + r.left() * bpp, front_.constScanLine(y) + r.left() * bpp, size_t(r.width()) * bpp);
+  }
+  front_dirty_ = QRect();
+  return r;
+}
+
+// --- simulation thread ------------------------------------------------------------------
+
+void SimThread::rebuild(const SimConfig& config, bool keep_canvas) {
+  // Finish the old time line on the old simulator first.
+  if (sim_ && !failed_) drain();
+  finish_stroke();
+  std::unique_ptr<Simulator> old = std::move(sim_);
+  const bool same_dims = old && old->canvas().dims() == config.canvas;
+  config_ = config;
+  BrushPose rest;
+  rest.position = Vec3(config.canvas.width * 0.5f, config.canvas.height * 0.5f, config.brush.length * 1.5f);
+  sim_ = std::make_unique<Simulator>(config_, rest);
+  if (keep_canvas && same_dims)
+    for (int id : old->canvas().allocated_tile_ids()) sim_->canvas().write_tile(old->canvas().read_tile(id));
+  reload_window(*sim_);
+  old.reset();
+  restart_recording(recording_from_blank_.load() && sim_->canvas().allocated_tiles() == 0);
+  if (!cache_ || !same_dims) {
+    cache_ = std::make_unique<CanvasImageCache>(renderer_, Camera::top(config.canvas), 32);
+    std::lock_guard lk(frame_mu_);
+    front_ = QImage(config.canvas.width, config.canvas.height, QImage::Format_RGBA8888);
+    front_.fill(Qt::black);
+  }
+  {
+    std::lock_guard lk(status_mu_);
+    status_.device = config.device.to_string();
+  }
+  invalidate_all();
+  render(true);
+}
+
+void SimThread::restart_recording(bool from_blank) {
+  // The old time line is simulated to its end first, and its open stroke closed.
+  if (!failed_) drain();
+  finish_stroke();
+  std::lock_guard lk(rec_mu_);
+  rec_ = Stroke{};
+  rec_.canvas = config_.canvas;
+  rec_.brush = config_.brush;
+  rec_.paint = paint_;
+  rec_.paint.reload_on_pen_down = false;  // the studio's brush stays dirty between strokes
+  rec_.paper_rgb = std::array<float, 3>{renderer_.params().paper_rgb.x, renderer_.params().paper_rgb.y,
+                                        renderer_.params().paper_rgb.z};
+  rec_.dt = kStepDt;
+  rec_.lead_in = kLeadIn;
+  rec_.lead_out = 0.0;
+  rec_.source = "studio session";
+  chunk_start_ = 0;
+  player_.reset();
+  player_samples_ = 0;
+  t_done_ = 0.0;
+  started_ = false;
+  next_event_ = 0;
+  prev_contact_ = false;
+  recording_from_blank_ = from_blank;
+}
+
+void SimThread::invalidate_all() {
+  if (!cache_) return;
+  cache_->mark_all_dirty();
+  dirty_x0_ = 0;
+  dirty_y0_ = 0;
+  dirty_x1_ = config_.canvas.width;
+  dirty_y1_ = config_.canvas.height;
+}
+
+void SimThread::invalidate_rect(int x0, int y0, int x1, int y1) {
+  if (!cache_) return;
+  cache_->mark_dirty(x0, y0, x1, y1);
+  dirty_x0_ = std::min(dirty_x0_, x0);
+  dirty_y0_ = std::min(dirty_y0_, y0);
+  dirty_x1_ = std::max(dirty_x1_, x1);
+  dirty_y1_ = std::max(dirty_y1_, y1);
+}
+
+Image SimThread::canvas_image() {
+  if (!cache_ || !sim_) return {};
+  if (dirty_x1_ >= 0) render(true);
+  ParticleOverlay overlay = sim_->particle_overlay();
+  return cache_->update(sim_->canvas(), sim_->live_window(), &overlay);
+}
+
+void SimThread::drain() {
+  PlayerStep step;
+  while (step_available()) {
+    bool found = false;
+    while (player_->next(step))
+      if (!started_ || step.t > t_done_) {
+        found = true;
+        break;
+      }
+    if (!found) break;
+    run_step(step);
+  }
+}
+
+void SimThread::rebuild_player() {
+  Stroke chunk;
+  {
+    std::lock_guard lk(rec_mu_);
+    chunk.canvas = rec_.canvas;
+    chunk.brush = rec_.brush;
+    chunk.paint = rec_.paint;
+    chunk.dt = rec_.dt;
+    chunk.max_move_per_substep = rec_.max_move_per_substep;
+    chunk.max_substeps = rec_.max_substeps;
+    chunk.samples.assign(rec_.samples.begin() + std::ptrdiff_t(chunk_start_), rec_.samples.end());
+    player_samples_ = rec_.samples.size();
+  }
+  // The first chunk has the recording's lead-in; later ones start at a knot on a step
+  // boundary, where the full recording's keys and these agree exactly.
+  chunk.lead_in = chunk_start_ == 0 ? rec_.lead_in : 0.0;
+  chunk.lead_out = 0.0;
+  chunk.source = "studio session";
+  player_ = std::make_unique<StrokePlayer>(std::move(chunk));
+}
+
+bool SimThread::step_available() {
+  if (failed_ || !sim_ || rec_.samples.empty()) return false;
+  if (!player_ || player_samples_ != rec_.samples.size()) rebuild_player();
+  const double horizon = rec_.samples.back().t;
+  if (started_ && t_done_ + kStepDt > horizon) return false;
+  // A long press: put a knot on the last step boundary we can reach, between two pen-down
+  // samples (where it changes no lift of a pen-up key), so the next player starts there.
+  if (started_ && t_done_ - rec_.samples[chunk_start_].t >= 0.5) {
+    const double T = std::floor(horizon / kStepDt) * kStepDt;
+    const auto it = std::upper_bound(rec_.samples.begin(), rec_.samples.end(), T,
+                                     [](double v, const PenSample& s) { return v < s.t; });
+    const size_t j = size_t(it - rec_.samples.begin());  // first sample after T
+    if (T > t_done_ && j > chunk_start_ + 1 && j < rec_.samples.size() && rec_.samples[j - 1].t < T &&
+        rec_.samples[j - 1].down && rec_.samples[j].down) {
+      PenSample knot = player_->pen_at(T);
+      knot.t = T;
+      knot.down = true;
+      {
+        std::lock_guard lk(rec_mu_);
+        rec_.samples.insert(rec_.samples.begin() + std::ptrdiff_t(j), knot);
+      }
+      rebuild_player();
+    }
+  }
+  return player_->t_begin() + kStepDt <= horizon;
+}
+
+void SimThread::run_step(const PlayerStep& step) {
+  Simulator& sim = *sim_;
+  if (!started_) {
+    sim.reset_brush(player_->pose_at(player_->t_begin()));
+    apply_initial_paint(sim, rec_.paint);
+    brush_color_ = Vec3(rec_.paint.ryb[0], rec_.paint.ryb[1], rec_.paint.ryb[2]);
+    brush_amount_ = rec_.paint.load;
+    started_ = true;
+  }
+  // Events first (they fire in the first step ending at or after them), then the pen-down reload.
+  while (next_event_ < rec_.events.size() && rec_.events[next_event_].t <= step.t) apply_event(rec_.events[next_event_++]);
+  const bool edge = step.pen_down && !prev_contact_;
+  prev_contact_ = step.pen_down;
+  if (edge && rec_.paint.reload_on_pen_down) apply_initial_paint(sim, rec_.paint);
+
+  // Undo: capture the tiles this step may touch before it runs.
+  const int reach = step_reach(config_.brush);
+  const PenSample a = player_->pen_at(step.t_begin), b = step.pen;
+  const int x0 = int(std::min(a.x, b.x)) - reach, x1 = int(std::max(a.x, b.x)) + reach;
+  const int y0 = int(std::min(a.y, b.y)) - reach, y1 = int(std::max(a.y, b.y)) + reach;
+  if (step.pen_down || stroke_open_) {
+    stroke_open_ = true;
+    undo_rec_.capture_rect(sim.canvas(), x0, y0, x1, y1);
+  }
+  poses_.clear();
+  for (int k = 1; k <= step.substeps; ++k) poses_.push_back(player_->pose_at(StrokePlayer::substep_time(step, k)));
+  sim.step(poses_.data(), step.substeps, float(step.dt));
+  // Paint changes only inside the active window around the brush (128 x 128 cells).
+  if (stroke_open_) {
+    const int w = 72;
+    invalidate_rect(int(std::min(a.x, b.x)) - w, int(std::min(a.y, b.y)) - w, int(std::max(a.x, b.x)) + w,
+                    int(std::max(a.y, b.y)) + w);
+  }
+  t_done_ = step.t;
+  ++steps_;
+  ++rate_steps_;
+
+  // Knots: a sample on this step boundary lets the next player start here (cheap rebuilds).
+  std::lock_guard lk(rec_mu_);
+  for (size_t j = rec_.samples.size(); j-- > chunk_start_ + 1;) {
+    if (rec_.samples[j].t < t_done_) break;
+    if (rec_.samples[j].t == t_done_) {
+      chunk_start_ = j;
+      player_.reset();
+      break;
+    }
+  }
+}
+
+void SimThread::apply_event(const StrokeEvent& e) {
+  apply_paint_event(*sim_, e);
+  switch (e.kind) {
+    case StrokeEventKind::Dip: {
+      const float add = std::max(0.f, e.load - brush_amount_);
+      brush_color_ = brush_amount_ <= 0.f ? Vec3(e.ryb[0], e.ryb[1], e.ryb[2])
+                                          : color_mix(brush_color_, Vec3(e.ryb[0], e.ryb[1], e.ryb[2]), brush_amount_, add);
+      brush_amount_ = std::max(brush_amount_, e.load);
+      break;
+    }
+    case StrokeEventKind::Wipe: brush_amount_ *= 1.f - e.fraction; break;
+    case StrokeEventKind::Clean:
+      brush_amount_ = 0.f;
+      brush_color_ = Vec3(0.f, 0.f, 0.f);
+      break;
+    case StrokeEventKind::Dry: invalidate_all(); break;
+  }
+}
+
+void SimThread::finish_stroke() {
+  if (!stroke_open_ || !sim_) return;
+  stroke_open_ = false;
+  flush_simulation(*sim_);
+  auto diff = std::make_shared<TileDiff>(undo_rec_.finish(sim_->canvas()));
+  if (!diff->empty()) Q_EMIT strokeFinished(diff);
+}
+
+void SimThread::render(bool force) {
+  if (!cache_ || !sim_) return;
+  if (dirty_x1_ < 0) return;
+  const double now = wall_now();
+  if (!force && now - last_render_ < 1.0 / 30.0) return;
+  last_render_ = now;
+  ParticleOverlay overlay = sim_->particle_overlay();
+  const Image& img = cache_->update(sim_->canvas(), sim_->live_window(), &overlay);
+  // Copy the changed pixels (the marked rectangle grown by the renderer's reach) to the front.
+  const int m = 48;
+  const QRect r = QRect(QPoint(dirty_x0_ - m, dirty_y0_ - m), QPoint(dirty_x1_ + m, dirty_y1_ + m))
+                      .intersected(QRect(0, 0, img.width, img.height));
+  dirty_x0_ = dirty_y0_ = 1 << 30;
+  dirty_x1_ = dirty_y1_ = -1;
+  if (r.isEmpty()) return;
+  {
+    std::lock_guard lk(frame_mu_);
+    for (int y = r.top(); y <= r.bottom(); ++y)
+      std::memcpy(front_.scanLine(y) + r.left() * 4, img.at(r.left(), y), size_t(r.width()) * 4);
+    front_dirty_ |= r;
+  }
+  Q_EMIT frameReady();
+}
+
+void SimThread::publish_status(bool force) {
+  const double now = wall_now();
+  if (!force && now - last_status_ < 0.5) return;
+  std::lock_guard lk(status_mu_);
+  const double span = now - rate_t0_;
+  if (span > 0.25 && rate_steps_ > 0) status_.steps_per_s = rate_steps_ / span;
+  if (rate_steps_ == 0) status_.steps_per_s = 0.0;
+  rate_steps_ = 0;
+  rate_t0_ = now;
+  last_status_ = now;
+  if (sim_) {
+    const double med = sim_->profiler().median_ms("sim.step");
+    if (med > 0) status_.step_ms = med;
+    sim_->profiler().clear();  // bounded memory over a long session
+    status_.particles = particle_count(*sim_);
+  }
+  status_.steps = steps_;
+  status_.brush_ryb = {brush_color_.x, brush_color_.y, brush_color_.z};
+  status_.brush_amount = brush_amount_;
+  status_.lag_s = rec_.samples.empty() ? 0.0 : std::max(0.0, rec_.samples.back().t - t_done_);
+}
+
+void SimThread::run() {
+  double busy_since = 0.0;
+  for (;;) {
+    std::deque<std::function<void(SimThread&)>> cmds;
+    bool more = false;
+    {
+      std::unique_lock lk(in_mu_);
+      more = busy_;
+      in_cv_.wait(lk, [&] { return quit_ || !in_cmds_.empty() || more; });
+      if (quit_) break;
+      cmds.swap(in_cmds_);
+      busy_ = true;
+    }
+    for (auto& fn : cmds) {
+      try {
+        fn(*this);
+      } catch (const std::exception& e) {
+        Q_EMIT failed(QString::fromStdString(e.what()));
+      }
+    }
+    // A few steps, then look at the inputs again: commands (undo, save) never wait long.
+    const double t_start = wall_now();
+    if (busy_since == 0.0) busy_since = t_start, rate_t0_ = t_start;
+    int n = 0;
+    try {
+      PlayerStep step;
+      while (n < 64 && wall_now() - t_start < 0.05 && step_available()) {
+        bool found = false;
+        while (player_->next(step)) {
+          if (!started_ || step.t > t_done_) {
+            found = true;
+            break;
+          }
+        }
+        if (!found) break;
+        run_step(step);
+        ++n;
+      }
+    } catch (const std::exception& e) {
+      failed_ = true;
+      {
+        std::lock_guard lk(status_mu_);
+        status_.error = e.what();
+      }
+      Q_EMIT failed(QString::fromStdString(e.what()));
+    }
+    const bool pending = !failed_ && step_available();
+    if (!pending) {
+      // Idle: the session time line is simulated up to its last sample; close the stroke.
+      if (!prev_contact_) {
+        try {
+          finish_stroke();
+        } catch (const std::exception& e) {
+          Q_EMIT failed(QString::fromStdString(e.what()));
+        }
+      }
+      render(true);
+    } else {
+      render(false);
+    }
+    {
+      std::lock_guard lk(status_mu_);
+      status_.idle = !pending;
+    }
+    publish_status(!pending);
+    {
+      std::lock_guard lk(in_mu_);
+      busy_ = pending;
+      if (!pending) busy_since = 0.0;
+    }
+    idle_cv_.notify_all();
+  }
+  idle_cv_.notify_all();
+}
+
+}  // namespace wb::studio

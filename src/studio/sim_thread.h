@@ -1,0 +1,168 @@
+// The studio's simulation thread: owns the Simulator, the renderer and its incremental
+// image cache, and the session recording. The UI thread only enqueues time-stamped pen
+// samples, palette events and commands, and takes the latest rendered pixels; it never waits
+// for a step. Steps run at the fixed dt of the session time line (pen_clock.h) through the
+// same StrokePlayer that `wetbrush replay` uses, so a saved recording replays to the same canvas.
+#pragma once
+#include <QImage>
+#include <QObject>
+#include <QRect>
+
+#include <array>
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include "core/io/stroke_player.h"
+#include "core/io/undo_tiles.h"
+#include "core/render/renderer.h"
+#include "core/sim/simulator.h"
+#include "studio/pen_clock.h"
+
+namespace wb::studio {
+
+/// A quality preset: brush resolution, canvas and render settings sized for the device.
+struct QualityPreset {
+  std::string name;
+  int bristles = 80;
+  int samples_per_bristle = 32;
+  int canvas_width = 1200, canvas_height = 900, canvas_depth = 32;
+  int ao_rays = 12;
+  static QualityPreset cpu();
+  static QualityPreset gpu();
+  static QualityPreset for_device(const Device& d) { return d.is_cuda() ? gpu() : cpu(); }
+};
+
+/// What the status bar shows; updated by the worker about twice a second.
+struct SimStatus {
+  double steps_per_s = 0.0;     ///< simulation steps per wall second (last ~0.5 s of activity)
+  double step_ms = 0.0;         ///< median wall time of one step
+  int64_t steps = 0;            ///< steps done in this session
+  int64_t particles = -1;       ///< liquid particles (-1: the simulator has none)
+  double lag_s = 0.0;           ///< session time not simulated yet
+  bool idle = true;
+  std::string device;
+  std::array<float, 3> brush_ryb{};  ///< mean colour of the paint on the brush (RYB)
+  float brush_amount = 0.f;          ///< how full the brush is, 0..1
+  std::string error;            ///< first error; stepping stops, the document is kept
+};
+
+class SimThread : public QObject {
+  Q_OBJECT
+ public:
+  SimThread(const SimConfig& config, const RenderParams& render, QObject* parent = nullptr);
+  ~SimThread() override;
+
+  // --- called from the UI thread: never block on the simulation ---------------------------
+  /// Appends clock output (samples and events in time order) to the session.
+  void push(const ClockOutput& out);
+  /// Runs `fn` on the simulation thread between steps (with exclusive access).
+  void post(std::function<void(SimThread&)> fn);
+  /// Copies the pixels that changed since the last call into `canvas` (the full canvas
+  /// image, one pixel per cell); returns the changed rectangle (empty when nothing changed).
+  QRect take_frame(QImage& canvas);
+  SimStatus status() const;
+  /// The recording so far (a copy).
+  Stroke recording() const;
+  /// True while the recording reproduces the canvas from a blank one.
+  bool recording_from_blank() const { return recording_from_blank_.load(); }
+  /// Blocks until every input pushed so far has been simulated (tests and shutdown only).
+  void wait_idle();
+
+  // --- on the simulation thread (inside post()) -----------------------------------------
+  Simulator& sim() { return *sim_; }
+  Renderer& renderer() { return renderer_; }
+  /// Replaces the simulator (new brush or canvas), keeping the canvas' tiles when `keep`.
+  void rebuild(const SimConfig& config, bool keep_canvas);
+  /// Starts a new recording (after undo, open, brush change): the next press begins it.
+  void restart_recording(bool from_blank);
+  /// Re-renders the whole canvas (light, paper, new canvas).
+  void invalidate_all();
+  void invalidate_rect(int x0, int y0, int x1, int y1);
+  /// The whole canvas rendered now (one pixel per cell).
+  Image canvas_image();
+  const SimConfig& config() const { return config_; }
+  /// Simulates every step the inputs so far allow (before a restart or a snapshot).
+  void drain();
+  /// Paint the brush holds (the palette's current well) for recordings that start now.
+  void set_paint(const PaintLoad& p) { paint_ = p; }
+  const PaintLoad& paint() const { return paint_; }
+  /// Mean colour (RYB) and amount (0..1) of the paint on the brush, as tracked for the UI.
+  Vec3 brush_color() const { return brush_color_; }
+  float brush_amount() const { return brush_amount_; }
+
+ Q_SIGNALS:
+  void frameReady();
+  /// One stroke finished: the tiles it changed (undo record).
+  void strokeFinished(std::shared_ptr<wb::TileDiff> diff);
+  void failed(QString message);
+
+ private:
+  void run();
+  bool step_available();
+  void rebuild_player();
+  void run_step(const PlayerStep& step);
+  void apply_event(const StrokeEvent& e);
+  void finish_stroke();
+  void render(bool force);
+  void publish_status(bool force);
+
+  SimConfig config_;
+  std::unique_ptr<Simulator> sim_;
+  Renderer renderer_;
+  std::unique_ptr<CanvasImageCache> cache_;
+  PaintLoad paint_{};
+  Vec3 brush_color_{};
+  float brush_amount_ = 0.f;
+
+  // Inputs (UI -> worker).
+  mutable std::mutex in_mu_;
+  std::condition_variable in_cv_, idle_cv_;
+  std::deque<PenSample> in_samples_;
+  std::deque<StrokeEvent> in_events_;
+  std::deque<std::function<void(SimThread&)>> in_cmds_;
+  bool quit_ = false;
+  bool busy_ = false;
+
+  // Session (worker only, except recording() which copies under rec_mu_).
+  mutable std::mutex rec_mu_;
+  Stroke rec_;
+  size_t chunk_start_ = 0;      ///< sample index where the current player's stroke starts
+  std::unique_ptr<StrokePlayer> player_;
+  std::vector<BrushPose> poses_;
+  size_t player_samples_ = 0;   ///< samples the player was built with
+  double t_done_ = 0.0;         ///< session time simulated so far (a step boundary)
+  bool started_ = false;        ///< the first step of this recording has run
+  size_t next_event_ = 0;
+  bool prev_contact_ = false;
+  std::atomic<bool> recording_from_blank_{true};
+  StrokeTileRecorder undo_rec_;
+  bool stroke_open_ = false;
+
+  // Frames (worker -> UI).
+  mutable std::mutex frame_mu_;
+  QImage front_;
+  QRect front_dirty_;
+  int dirty_x0_ = 1 << 30, dirty_y0_ = 1 << 30, dirty_x1_ = -1, dirty_y1_ = -1;
+  double last_render_ = 0.0;
+
+  mutable std::mutex status_mu_;
+  SimStatus status_;
+  int64_t steps_ = 0;
+  int64_t rate_steps_ = 0;
+  double rate_t0_ = 0.0;
+  double last_status_ = 0.0;
+  bool failed_ = false;
+
+  std::thread thread_;
+};
+
+/// Exact step boundary arithmetic: t rounded to the step grid (values are multiples of 1/1024).
+inline bool same_time(double a, double b) { return a == b; }
+
+}  // namespace wb::studio
