@@ -46,11 +46,11 @@ class BrushTest : public BackendTest {
  protected:
   static constexpr int kTrace = 512;
 
-  Footprint footprint(Brush& brush, float contact_height = 1.f) {
+  Footprint footprint(Brush& brush, float contact_height = 1.f, const SolidField& solid = {}) {
     DeviceBuffer<int32_t> trace(device_, size_t(kTrace) * kTrace);
     trace.fill_zero();
     Footprint f;
-    f.count = brush.mark_contacts(trace.data(), kTrace, kTrace, 0, 0, contact_height);
+    f.count = brush.mark_contacts(trace.data(), kTrace, kTrace, 0, 0, contact_height, solid);
     const auto t = trace.to_host();
     int64_t ones = 0;
     for (int y = 0; y < kTrace; ++y)
@@ -298,7 +298,7 @@ TEST_F(BrushTest, BristlesStayAboveADriedBlockOfPaint) {
   for (const Vec3& p : brush.samples_to_host())
     if (p.x >= 230.5f && p.x < 269.5f && p.y >= 230.5f && p.y < 269.5f) ASSERT_GE(p.z, float(top) - 1e-3f);
   // The footprint is on top of the block: contact measured against the dried paint.
-  const Footprint fp = footprint(brush);
+  const Footprint fp = footprint(brush, 1.f, env.solid);
   EXPECT_GT(fp.count, 100);
 }
 
