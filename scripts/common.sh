@@ -6,7 +6,8 @@ WB_BUILD="${WB_BUILD:-$WB_ROOT/build}"
 
 # Debian packages the build and tests need (Qt and Xvfb only for the studio).
 WB_PACKAGES=(cmake ninja-build g++ pkg-config libgtest-dev libgmock-dev libbenchmark-dev
-  nlohmann-json3-dev libcli11-dev libpng-dev libzstd-dev libzip-dev zlib1g-dev)
+  nlohmann-json3-dev libcli11-dev libpng-dev libzstd-dev libzip-dev zlib1g-dev
+  qt6-base-dev xvfb xauth libgl1-mesa-dri)
 
 wb_install_deps() {
   local missing=()

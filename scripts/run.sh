@@ -1,10 +1,16 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds, and runs the main job: a headless replay of an
-# example stroke into out/replay.png (with its stats in out/replay-stats.json).
+# Installs what is missing, builds, and runs the main job: the painting studio when there is a
+# display; otherwise a headless replay of an example stroke into out/replay.png (with its stats
+# in out/replay-stats.json).
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 wb_install_deps
 wb_build
+if { [ -n "${DISPLAY:-}" ] || [ -n "${WAYLAND_DISPLAY:-}" ]; } && [ -x "$WB_BUILD/bin/wetbrush-studio" ]; then
+  # The main job: the painting studio (quality preset chosen from the device).
+  exec "$WB_BUILD/bin/wetbrush-studio" "$@"
+fi
+echo "wetbrush: no display (DISPLAY / WAYLAND_DISPLAY unset): running the headless demo replay instead of the studio"
 mkdir -p "$WB_ROOT/out"
 "$WB_BUILD/bin/wetbrush" devices
 "$WB_BUILD/bin/wetbrush" replay "$WB_ROOT/examples/press-and-drag.json" \

@@ -1,6 +1,7 @@
 // wetbrush studio: the desktop painting application (Qt 6 Widgets, OpenGL canvas view).
 #include <QApplication>
 #include <QCommandLineParser>
+#include <QElapsedTimer>
 #include <QSurfaceFormat>
 #include <QTimer>
 
@@ -52,10 +53,22 @@ int main(int argc, char** argv) {
   w.show();
   if (cli.isSet(demo_opt)) {
     const QString out = cli.value(demo_opt);
-    QTimer::singleShot(500, &w, [&w, out] {
+    QTimer::singleShot(500, &w, [&w, out, &opt] {
+      // Also the frame-rate and simulation-rate measurement of docs/perf/studio.md.
+      QElapsedTimer timer;
+      timer.start();
+      const int64_t frames0 = w.view()->frames_drawn();
+      const int64_t steps0 = w.sim()->status().steps;
       run_demo_painting(w);
       w.settle();
       QApplication::processEvents();
+      const double secs = timer.elapsed() / 1000.0;
+      const SimStatus st = w.sim()->status();
+      std::printf("demo: %.1f s wall, %lld view frames (%.1f fps), %lld simulation steps (%.1f steps/s overall, "
+                  "median %.1f ms/step), %lld particles at the end, device %s, preset %s\n",
+                  secs, (long long)(w.view()->frames_drawn() - frames0), (w.view()->frames_drawn() - frames0) / secs,
+                  (long long)(st.steps - steps0), (st.steps - steps0) / secs, st.step_ms, (long long)st.particles,
+                  st.device.c_str(), opt.preset.name.c_str());
       w.grab().save(out);
       std::printf("wrote %s\n", qPrintable(out));
       w.undo_stack()->setClean();

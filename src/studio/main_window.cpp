@@ -105,6 +105,7 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   cfg.brush.bristles = q.bristles;
   cfg.brush.samples_per_bristle = q.samples_per_bristle;
   if (options_.brush) cfg.brush = *options_.brush;
+  cfg.window = Int3{q.window_xy, q.window_xy, std::min(q.window_z, q.canvas_depth)};
   RenderParams rp;
   rp.ao_rays = q.ao_rays;
   sim_ = std::make_unique<SimThread>(cfg, rp);

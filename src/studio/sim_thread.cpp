@@ -31,6 +31,8 @@ QualityPreset QualityPreset::cpu() {
   p.canvas_height = 900;
   p.canvas_depth = 32;
   p.ao_rays = 12;
+  p.window_xy = 64;
+  p.window_z = 16;
   return p;
 }
 

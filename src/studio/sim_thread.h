@@ -33,6 +33,7 @@ struct QualityPreset {
   int samples_per_bristle = 32;
   int canvas_width = 1200, canvas_height = 900, canvas_depth = 32;
   int ao_rays = 12;
+  int window_xy = 128, window_z = 32;  ///< active simulation window, cells (paper: 128 x 128 x 32)
   static QualityPreset cpu();
   static QualityPreset gpu();
   static QualityPreset for_device(const Device& d) { return d.is_cuda() ? gpu() : cpu(); }
