@@ -263,20 +263,33 @@ void Grid::advect(float dt) {
   }
   stats_.advect_change = after - before;
   stats_.advect_correction = 0;
+  bool keep_old_paint = false;
   if (params_.mass_correction && after != before) {
     // Conservative and local: rescale density only in the cells advection changed, in proportion
     // to their density (no smearing into empty cells, no change to untouched paint).
     touched_d(d, paint_tmp_.density.data(), paint.density.data(), v.cls, cell_tmp_.data(), n);
     const double touched = reduce_sum(d, cell_tmp_.data(), n, ws_);
     if (touched > 1e-9) {
-      const double scale = std::clamp(1.0 + (before - after) / touched, 0.5, 2.0);
-      scale_touched_d(d, paint_tmp_.density.data(), paint.density.data(), v.cls, float(scale), n);
-      stats_.advect_correction = (scale - 1.0) * touched;
+      const double scale = 1.0 + (before - after) / touched;
+      if (scale >= 0.0 && scale <= 16.0) {
+        scale_touched_d(d, paint_tmp_.density.data(), paint.density.data(), v.cls, float(scale), n);
+        stats_.advect_correction = (scale - 1.0) * touched;
+      } else {
+        // A thin film moved so fast that the backtrace lost (or made) most of it: no local
+        // rescale can restore that, so the paint keeps its place this step (exactly conservative).
+        keep_old_paint = true;
+        stats_.advect_correction = before - after;
+      }
+    } else {
+      keep_old_paint = true;  // advection emptied the touched cells: nothing to rescale
+      stats_.advect_correction = before - after;
     }
   }
+  if (!keep_old_paint) {
 #define WB_X(name, doc) paint.name.swap(paint_tmp_.name);
-  WB_PAINT_FIELDS(WB_X)
+    WB_PAINT_FIELDS(WB_X)
 #undef WB_X
+  }
   // Velocity: backtrace every open face through a copy of the field.
   for (int c = 0; c < 3; ++c)
     mem::copy_on_device(d, vel_tmp_[c].data(), v.vel[c], size_t(g.faces(c)) * sizeof(float));

@@ -17,6 +17,9 @@ void joint_cell_velocity(const Device& d, GridView g, float* vx, float* vy, floa
   WB_DISPATCH(d, joint_cell_velocity(g, vx, vy, vz));
 }
 void joint_zero_nonfinite(const Device& d, float* v, int64_t n) { WB_DISPATCH(d, joint_zero_nonfinite(v, n)); }
+void joint_clamp_to_canvas(const Device& d, ParticleView p, Vec3 lo, Vec3 hi) {
+  WB_DISPATCH(d, joint_clamp_to_canvas(p, lo, hi));
+}
 void joint_kill_nonfinite(const Device& d, ParticleView p) { WB_DISPATCH(d, joint_kill_nonfinite(p)); }
 
 }  // namespace wb

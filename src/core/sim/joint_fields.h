@@ -22,6 +22,9 @@ void joint_blend_velocity(const Device& d, GridView g, PaintWindowView paint, Pa
 void joint_cell_velocity(const Device& d, GridView g, float* vx, float* vy, float* vz);
 /// Replaces non-finite values by 0 in [n] floats; returns nothing (count them first).
 void joint_zero_nonfinite(const Device& d, float* v, int64_t n);
+/// Keeps particles inside the canvas box: its sides and floor are walls, so paint never leaves
+/// the canvas (and is never deposited into off-canvas window cells, which are not stored).
+void joint_clamp_to_canvas(const Device& d, ParticleView p, Vec3 lo, Vec3 hi);
 /// Flags particles with any non-finite state as dead.
 void joint_kill_nonfinite(const Device& d, ParticleView p);
 
@@ -30,7 +33,8 @@ void joint_kill_nonfinite(const Device& d, ParticleView p);
   void joint_blend_velocity(GridView g, PaintWindowView paint, ParticleRasterView raster, float cell_mass); \
   void joint_cell_velocity(GridView g, float* vx, float* vy, float* vz);                                \
   void joint_zero_nonfinite(float* v, int64_t n);                                                       \
-  void joint_kill_nonfinite(ParticleView p);
+  void joint_kill_nonfinite(ParticleView p);                                                            \
+  void joint_clamp_to_canvas(ParticleView p, Vec3 lo, Vec3 hi);
 namespace cpu {
 WB_JOINT_BACKEND_DECLS
 }

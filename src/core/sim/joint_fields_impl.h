@@ -53,6 +53,22 @@ void joint_zero_nonfinite(float* v, int64_t n) {
   });
 }
 
+void joint_clamp_to_canvas(ParticleView p, Vec3 lo, Vec3 hi) {
+  parallel_for(p.count, [=] WB_HD(int64_t k) {
+    const Vec3 x = p.x[k];
+    const Vec3 c(clampf(x.x, lo.x, hi.x), clampf(x.y, lo.y, hi.y), clampf(x.z, lo.z, hi.z));
+    if (c.x != x.x || c.y != x.y || c.z != x.z) {
+      p.x[k] = c;
+      // The wall stops the motion into it.
+      Vec3 v = p.v[k];
+      if (c.x != x.x) v.x = 0.f;
+      if (c.y != x.y) v.y = 0.f;
+      if (c.z != x.z) v.z = 0.f;
+      p.v[k] = v;
+    }
+  });
+}
+
 void joint_kill_nonfinite(ParticleView p) {
   parallel_for(p.count, [=] WB_HD(int64_t k) {
     const bool ok = isfinite3(p.x[k]) && isfinite3(p.v[k]) && isfinite(p.m[k]) && isfinite(p.pigment_r[k]) &&

@@ -195,6 +195,7 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
   }
 
   contain_nonfinite();
+  clamp_particles_to_canvas();
   {
     WB_PROFILE_SCOPE("books");
     books_.record(rec, census());
@@ -254,6 +255,15 @@ void Simulator::particle_stage(float dt) {
   SolidView solid;
   solid.floor_z = prm.floor_z;
   particles_adhesion_step(device(), particles_.view(), brush_->samples(), solid, prm, dt);
+  clamp_particles_to_canvas();
+}
+
+void Simulator::clamp_particles_to_canvas() {
+  if (particles_.size() == 0) return;
+  const CanvasDims c = config_.canvas;
+  // Half a cell inside the walls, so that Eq. 16's kernel lands on canvas cells.
+  joint_clamp_to_canvas(device(), particles_.view(), Vec3(0.5f, 0.5f, config_.params.particles.floor_z),
+                        Vec3(float(c.width) - 0.5f, float(c.height) - 0.5f, float(c.depth) - 0.5f));
 }
 
 void Simulator::joint_fields_stage() {
@@ -282,12 +292,14 @@ void Simulator::contain_nonfinite() {
   ActiveWindow& win = grid_->window();
   PaintWindow& paint = win.paint();
   int64_t bad = 0;
-  std::vector<std::pair<float*, int64_t>> arrays;
-#define WB_X(name, doc) arrays.emplace_back(paint.name.data(), paint.cell_count());
-  WB_PAINT_FIELDS(WB_X)
+  const std::pair<float*, int64_t> arrays[] = {
+#define WB_X(name, doc) {paint.name.data(), paint.cell_count()},
+      WB_PAINT_FIELDS(WB_X)
 #undef WB_X
-  for (int c = 0; c < 3; ++c) arrays.emplace_back(win.velocity(c).data(), int64_t(win.velocity(c).size()));
-  for (auto& [p, n] : arrays) {
+      {win.velocity(0).data(), int64_t(win.velocity(0).size())},
+      {win.velocity(1).data(), int64_t(win.velocity(1).size())},
+      {win.velocity(2).data(), int64_t(win.velocity(2).size())}};
+  for (const auto& [p, n] : arrays) {
     const int64_t k = count_nonfinite(device(), p, n, ws_);
     if (k) joint_zero_nonfinite(device(), p, n);
     bad += k;

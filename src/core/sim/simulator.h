@@ -89,6 +89,7 @@ class Simulator {
   void deposit_leaving_particles(Int3 next_origin, TransferRecord& rec);
   void joint_fields_stage();
   void contain_nonfinite();
+  void clamp_particles_to_canvas();
   TransferEnv transfer_env();
 
   SimConfig config_;
