@@ -11,19 +11,11 @@
 #include "core/brush/brush.h"
 #include "core/brush/samples_kernels.h"
 #include "core/exec/buffer.h"
+#include "brush/brush_test_util.h"
 
 namespace wb::test {
 
 namespace {
-constexpr float kDt = 1.f / 60.f;
-BrushPose make_pose(Vec3 p, Mat3 R = Mat3()) {
-  BrushPose pose;
-  pose.position = p;
-  pose.rotation = R;
-  return pose;
-}
-Mat3 rot_z(float deg) { return rotation_axis_angle(Vec3(0, 0, 1), deg * 3.14159265f / 180.f); }
-Mat3 rot_x(float deg) { return rotation_axis_angle(Vec3(1, 0, 0), deg * 3.14159265f / 180.f); }
 
 enum Field { kX = 0, kT, kN, kB, kV, kOmega, kA, kAlpha };
 
