@@ -4,7 +4,6 @@
 // bristle with Bishop frames and their motion, rasterised into psi for the grid.
 #pragma once
 #include <cstdint>
-#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
 #include <vector>
 
 #include "core/brush/bristle_fields.h"

@@ -5,7 +5,6 @@
 // corrections out; no allocation, no backend knowledge.
 #pragma once
 #include <cstdint>
-#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
 
 #include "core/brush/brush_views.h"
 #include "core/exec/hd.h"

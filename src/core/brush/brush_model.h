@@ -3,7 +3,6 @@
 // from BrushSpec::seed; the Brush uploads it once.
 #pragma once
 #include <cstdint>
-#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
 #include <vector>
 
 #include "core/brush/brush_spec.h"

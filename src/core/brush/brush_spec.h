@@ -4,7 +4,6 @@
 // (1 cell = 0.2 mm).
 #pragma once
 #include <cstdint>
-#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
 #include <string>
 
 #include "core/math/vec.h"

@@ -3,7 +3,6 @@
 // dispatcher. Every function is one or a few parallel_for launches over device pointers.
 #pragma once
 #include <cstdint>
-#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
 
 #include "core/brush/bristle_fields.h"
 #include "core/brush/brush_views.h"

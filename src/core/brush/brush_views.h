@@ -4,7 +4,6 @@
 // k * per_bristle + i; vertex 0 is the root, pinned in the ferrule).
 #pragma once
 #include <cstdint>
-#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
 
 #include "core/canvas/tile_store.h"
 #include "core/exec/hd.h"

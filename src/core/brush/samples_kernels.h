@@ -4,7 +4,6 @@
 // frames' angular velocity for Eq. 9, and the weights that rasterise samples into the
 // bristle density psi of the window (boundary condition of the projection, Eq. 12).
 #pragma once
-#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
 #include "core/exec/hd.h"
 #include "core/math/vec.h"
 

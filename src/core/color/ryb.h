@@ -4,7 +4,6 @@
 // rescaled so that the RGB brightness ||x||_M is the weighted mean of the inputs'.
 // All functions are WB_HD: the transfer kernels mix colours, the renderer converts them.
 #pragma once
-#include <math.h>  // sqrtf, sinf, isfinite in WB_HD code (before vec.h)
 #include "core/exec/hd.h"
 #include "core/math/vec.h"
 

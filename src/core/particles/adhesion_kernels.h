@@ -3,7 +3,6 @@
 // canvas frame), and their blend by the distance to the bristles (Eq. 10).
 // Plain WB_HD functions of values: no allocation, no backend.
 #pragma once
-#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
 #include <cstdint>
 
 #include "core/brush/bristle_fields.h"

@@ -2,7 +2,6 @@
 // particles' mass and momentum onto the window (joint fields), and the mixed FLIP/PIC
 // velocity update from the fields before and after projection.
 #pragma once
-#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
 #include <cstdint>
 
 #include "core/exec/atomics.h"

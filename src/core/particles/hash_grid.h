@@ -3,7 +3,6 @@
 // (d_B of Eq. 10, D0 of §5.2). Three launches to build: bucket keys, radix sort,
 // bucket ranges; one to gather the sorted positions.
 #pragma once
-#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
 #include <cstdint>
 
 #include "core/brush/bristle_fields.h"

@@ -3,7 +3,6 @@
 // after a radix sort by bucket each bucket is a contiguous range [start, end). A
 // particle finds its nearest sample by visiting shells of cells outwards.
 #pragma once
-#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
 #include <cstdint>
 
 #include "core/exec/hd.h"

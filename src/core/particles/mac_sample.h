@@ -4,7 +4,6 @@
 // (i, j+1/2, k+1/2), v(i,j,k) at (i+1/2, j, k+1/2), w(i,j,k) at (i+1/2, j+1/2, k).
 // u: (nx+1) x ny x nz, v: nx x (ny+1) x nz, w: nx x ny x (nz+1), x fastest.
 #pragma once
-#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
 #include <cstdint>
 
 #include "core/exec/hd.h"

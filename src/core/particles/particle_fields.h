@@ -2,7 +2,6 @@
 // once. The lists generate the owning buffers of ParticleStore, the POD view kernels
 // take, host copies and compaction. Units: 1 cell = 0.2 mm, time in s, mass in kg.
 #pragma once
-#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
 #include <cstdint>
 
 #include "core/math/vec.h"

@@ -2,7 +2,6 @@
 // by value to the stage drivers. Units: lengths in canvas cells (1 cell = 0.2 mm),
 // velocities in cells/s, time in s. Table 1 distances converted with that cell size.
 #pragma once
-#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
 #include <cstdint>
 
 #include "core/math/vec.h"

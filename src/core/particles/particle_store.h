@@ -2,7 +2,6 @@
 // Capacity grows geometrically up to a limit (default 2M, §7); particles are added in
 // batches and removed by flag plus one stream compaction, so a warm step never allocates.
 #pragma once
-#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
 #include <cstdint>
 #include <vector>
 

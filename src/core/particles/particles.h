@@ -4,7 +4,6 @@
 //   -> (grid projection) -> particles_flip_pic.
 // Each validates its input and dispatches to wb::cpu or wb::cuda (particles_impl.h).
 #pragma once
-#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
 #include <cstdint>
 
 #include "core/brush/bristle_fields.h"

@@ -2,7 +2,6 @@
 // and pan (default one image pixel per canvas cell) and an oblique view that shows relief.
 // A Camera is a host value; camera_basis() turns it into the POD the kernels use.
 #pragma once
-#include <math.h>  // sqrtf, sinf, isfinite in WB_HD code (before vec.h)
 #include <cmath>
 
 #include "core/canvas/tile_store.h"

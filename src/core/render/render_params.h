@@ -2,7 +2,6 @@
 // kernels. Distances are in cells (1 cell = 0.2 mm); directions in canvas coordinates with
 // z up (the canvas surface is z = 0, paint occupies z >= 0).
 #pragma once
-#include <math.h>  // sqrtf, sinf, isfinite in WB_HD code (before vec.h)
 #include "core/math/vec.h"
 
 namespace wb {

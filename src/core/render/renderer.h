@@ -2,7 +2,6 @@
 // live window and the particles near the brush into an image, on either backend. Also the
 // incremental per-tile image cache and the material exports (height, normal, albedo maps).
 #pragma once
-#include <math.h>  // sqrtf, sinf, isfinite in WB_HD code (before vec.h)
 #include <cstdint>
 #include <vector>
 

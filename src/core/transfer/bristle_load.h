@@ -3,7 +3,6 @@
 // of Eq. 13, the load radius R_j). Loading, dipping, wiping and cleaning act on the whole
 // brush; the transfer stage (transfer.h) moves paint between samples and particles.
 #pragma once
-#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
 #include <cstdint>
 #include <vector>
 

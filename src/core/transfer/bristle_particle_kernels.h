@@ -3,7 +3,6 @@
 // nearby surface (Eq. 13), absorption with colour mixing (Eq. 14), colour bleeding of
 // saturated samples, and emission in the lower hemisphere. Colours mix by Algorithm 2.
 #pragma once
-#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
 #include <cstdint>
 
 #include "core/color/ryb.h"

@@ -4,7 +4,6 @@
 // cells. Both directions spread a particle's mass over the cells with the kernel W of length
 // h, normalised over the cells it touches, so the grid changes by exactly the particle mass.
 #pragma once
-#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
 #include <cstdint>
 
 #include "core/canvas/window.h"

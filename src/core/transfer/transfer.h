@@ -4,7 +4,6 @@
 // and returns what each transfer moved (TransferRecord; PaintBooks keeps the budget).
 // The stage functions validate their input and dispatch to wb::cpu or wb::cuda (transfer_impl.h).
 #pragma once
-#include <math.h>  // before vec.h: its unqualified isfinite needs the global declaration
 #include <cstdint>
 #include <vector>
 
