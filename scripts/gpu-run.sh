@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Runs what scripts/bundle-gpu.sh built on a machine with a CUDA GPU: the test suite on the
+# CUDA backend, the benchmarks and the example replays, writing logs, stats and pictures to DIR.
+#   scripts/gpu-run.sh DIR [tests|bench|replay]...   (all three when none is named)
+set -uo pipefail
+here="$(cd "$(dirname "$0")/.." && pwd)"
+out="${1:?output directory}"; shift
+what="${*:-tests bench replay}"
+bin="$here/build-gpu/bin"
+export LD_LIBRARY_PATH="$bin${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+mkdir -p "$out"
+nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader | tee "$out/gpu.txt"
+"$bin/wetbrush" devices | tee -a "$out/gpu.txt"
+for w in $what; do
+  case "$w" in
+    tests)
+      WB_DEVICE=cuda timeout 400 "$bin/wetbrush_tests" --gtest_brief=1 > "$out/tests-cuda.log" 2>&1
+      echo "tests (cuda): exit $?"; grep -E "^\[  (PASSED|FAILED)|FAILED  \]|tests ran" "$out/tests-cuda.log" | head -40 ;;
+    bench)
+      WB_DEVICE=cuda timeout 300 "$bin/wetbrush_bench" --benchmark_min_time=0.2 \
+        --benchmark_out="$out/bench-cuda.json" --benchmark_out_format=json > "$out/bench-cuda.txt" 2>&1
+      echo "bench (cuda): exit $?"; grep -E "^BM_" "$out/bench-cuda.txt" ;;
+    replay)
+      for ex in press-and-drag stab-and-roll s-curve-flat; do
+        timeout 200 "$bin/wetbrush" replay "$here/examples/$ex.json" --device cuda -q \
+          -o "$out/$ex.png" --stats "$out/$ex.json" > "$out/$ex.log" 2>&1
+        echo "replay $ex (cuda): exit $?"; tail -3 "$out/$ex.log"
+      done ;;
+  esac
+done
