@@ -44,51 +44,61 @@ struct NearestSample {
   float dist;     ///< distance to it, or the range when none
 };
 
-/// Scans one bucket, keeping the nearest sample (ties: the lower sample index).
-WB_HD WB_INLINE void scan_bucket(const HashGridView& g, uint32_t bucket, Vec3 p, float& best_d2, int32_t& best) {
-  const uint32_t end = g.cell_end[bucket];
-  for (uint32_t s = g.cell_start[bucket]; s < end; ++s) {
-    const float d2 = length2(g.sorted_x[s] - p);
-    const int32_t idx = int32_t(g.sorted_index[s]);
-    if (d2 < best_d2 || (d2 == best_d2 && idx < best)) {
-      best_d2 = d2;
-      best = idx;
-    }
-  }
-}
+/// Rings (cells along one axis) from cell c to the nearest cell of [lo, hi]: 0 inside.
+WB_HD WB_INLINE int ring_near(int lo, int hi, int c) { return c < lo ? lo - c : (c > hi ? c - hi : 0); }
+/// Rings from cell c to the farthest cell of [lo, hi].
+WB_HD WB_INLINE int ring_far(int lo, int hi, int c) { return c - lo > hi - c ? c - lo : hi - c; }
 
 /// Nearest sample to p within max_range. Shells of cells at Chebyshev ring R = 0, 1, ...
 /// around p's cell are visited in order, clipped to the samples' cell bounding box; after
 /// ring R every unvisited sample is farther than R h, so the search stops once the best
-/// distance is below R h, R h reaches max_range, or the shell has left the box.
+/// distance is below R h, R h reaches max_range, or the shell has left the box. Ties go to
+/// the lower sample index, so the answer does not depend on the order buckets are visited.
 WB_HD WB_INLINE NearestSample nearest_sample(const HashGridView& g, Vec3 p, float max_range) {
   NearestSample out{-1, max_range};
   if (g.count == 0) return out;
   const float inv_h = 1.f / g.h;
   int cx, cy, cz;
   hash_cell_of(p, inv_h, cx, cy, cz);
-  // Box of sample cells relative to p's cell.
+  // Box of sample cells relative to p's cell, and the Chebyshev rings of its nearest and
+  // farthest cells. Each distance is a difference of the two ends taken in the order that
+  // makes it non-negative: nvcc 13.0 (sm_90) folded the equivalent nested
+  // max(lo, -hi, 0) of the negated differences wrongly (the query then skipped ring 0).
   const int lx = g.bounds[0] - cx, ly = g.bounds[1] - cy, lz = g.bounds[2] - cz;
   const int hx = g.bounds[3] - cx, hy = g.bounds[4] - cy, hz = g.bounds[5] - cz;
-  const int r_box = imax(imax(imax(-lx, hx), imax(-ly, hy)), imax(-lz, hz));  // farthest box cell
-  const int r_near = imax(imax(imax(lx, -hx), imax(ly, -hy)), imax(imax(lz, -hz), 0));  // nearest box cell
+  const int r_box = imax(imax(ring_far(g.bounds[0], g.bounds[3], cx), ring_far(g.bounds[1], g.bounds[4], cy)),
+                         ring_far(g.bounds[2], g.bounds[5], cz));
+  const int r_near = imax(imax(ring_near(g.bounds[0], g.bounds[3], cx), ring_near(g.bounds[1], g.bounds[4], cy)),
+                          ring_near(g.bounds[2], g.bounds[5], cz));
   float best_d2 = max_range * max_range;
   int32_t best = -1;
   // Cells of ring R hold points at distance <= max_range only while (R - 1) h < max_range.
   const int r_max = imin(int(ceilf(max_range * inv_h)) + 1, r_box);
   for (int R = r_near; R <= r_max; ++R) {
-    const float reach = float(R) * g.h;
     if (R > 0 && float(R - 1) * g.h >= max_range) break;
-    for (int dz = imax(-R, lz); dz <= imin(R, hz); ++dz)
-      for (int dy = imax(-R, ly); dy <= imin(R, hy); ++dy) {
-        if (dz == -R || dz == R || dy == -R || dy == R) {
-          for (int dx = imax(-R, lx); dx <= imin(R, hx); ++dx)
-            scan_bucket(g, hash_bucket(cx + dx, cy + dy, cz + dz, g.mask), p, best_d2, best);
-        } else {  // inner rows: only the two end cells lie on the shell
-          if (lx <= -R && -R <= hx) scan_bucket(g, hash_bucket(cx - R, cy + dy, cz + dz, g.mask), p, best_d2, best);
-          if (lx <= R && R <= hx) scan_bucket(g, hash_bucket(cx + R, cy + dy, cz + dz, g.mask), p, best_d2, best);
+    const int z0 = imax(-R, lz), z1 = imin(R, hz), y0 = imax(-R, ly), y1 = imin(R, hy);
+    const int x0 = imax(-R, lx), x1 = imin(R, hx);
+    for (int dz = z0; dz <= z1; ++dz)
+      for (int dy = y0; dy <= y1; ++dy) {
+        // On the shell's two z faces and two y faces the whole clipped row; inside them
+        // only the row's two end cells dx = -R and dx = R lie on the shell.
+        const bool face = dz == -R || dz == R || dy == -R || dy == R;
+        const int step = face ? 1 : 2 * R;
+        for (int dx = face ? x0 : -R; dx <= (face ? x1 : R); dx += step) {
+          if (dx < x0 || dx > x1) continue;
+          const uint32_t bucket = hash_bucket(cx + dx, cy + dy, cz + dz, g.mask);
+          const uint32_t end = g.cell_end[bucket];
+          for (uint32_t s = g.cell_start[bucket]; s < end; ++s) {
+            const float d2 = length2(g.sorted_x[s] - p);
+            const int32_t idx = int32_t(g.sorted_index[s]);
+            if (d2 < best_d2 || (d2 == best_d2 && best >= 0 && idx < best)) {
+              best_d2 = d2;
+              best = idx;
+            }
+          }
         }
       }
+    const float reach = float(R) * g.h;
     if (best >= 0 && best_d2 < reach * reach) break;
   }
   if (best >= 0 && best_d2 < max_range * max_range) {
