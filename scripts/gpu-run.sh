@@ -21,10 +21,26 @@ for w in $what; do
         --benchmark_out="$out/bench-cuda.json" --benchmark_out_format=json > "$out/bench-cuda.txt" 2>&1
       echo "bench (cuda): exit $?"; grep -E "^BM_" "$out/bench-cuda.txt" ;;
     replay)
-      for ex in press-and-drag stab-and-roll s-curve-flat; do
-        timeout 200 "$bin/wetbrush" replay "$here/examples/$ex.json" --device cuda -q \
-          -o "$out/$ex.png" --stats "$out/$ex.json" > "$out/$ex.log" 2>&1
-        echo "replay $ex (cuda): exit $?"; tail -3 "$out/$ex.log"
+      # Every example, painted and saved; press-and-drag also grid-only (Fig. 7).
+      for f in "$here"/examples/*.json "$here"/examples/*.txt; do
+        ex="$(basename "${f%.*}")"
+        timeout 300 "$bin/wetbrush" replay "$f" --device cuda -q -o "$out/$ex.png" --save "$out/$ex.ora" \
+          --stats "$out/$ex.json" > "$out/$ex.log" 2>&1
+        echo "replay $ex (cuda): exit $?"
+      done
+      timeout 300 "$bin/wetbrush" replay "$here/examples/press-and-drag.json" --device cuda -q --grid-only \
+        -o "$out/press-and-drag-grid-only.png" --save "$out/press-and-drag-grid-only.ora" \
+        --stats "$out/press-and-drag-grid-only.json" > "$out/press-and-drag-grid-only.log" 2>&1
+      echo "replay press-and-drag --grid-only (cuda): exit $?"
+      # Close-ups under a raking light (ridges and bristle streaks).
+      for ex in press-and-drag press-and-drag-grid-only cross-wet scumble; do
+        [ -f "$out/$ex.ora" ] || continue
+        c=512,512; sz=720x400
+        [ "$ex" = cross-wet ] && c=520,515 && sz=720x720
+        [ "$ex" = scumble ] && c=520,505
+        "$bin/wetbrush" render "$out/$ex.ora" --device cuda --center "$c" --size "$sz" --zoom 2 \
+          --light -0.8,0.35,0.5 -o "$out/$ex-detail.png" > /dev/null 2>&1
+        echo "render $ex detail: exit $?"
       done ;;
   esac
 done

@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
   cli.setApplicationDescription("wetbrush studio: paint with a simulated bristle brush and 3D oil paint");
   cli.addHelpOption();
   QCommandLineOption device_opt("device", "Simulation device: auto, cpu, cuda or cuda:N.", "device", "auto");
-  QCommandLineOption preset_opt("preset", "Quality preset: auto (from the device), cpu or gpu.", "preset", "auto");
+  QCommandLineOption preset_opt("preset", "Quality preset: auto (from the device), cpu, gpu or tiny (small canvas and brush, fast).", "preset", "auto");
   QCommandLineOption data_opt("data-dir", "Folder for presets, settings and the recovery file.", "dir");
   QCommandLineOption norecover_opt("no-recovery", "Do not offer to recover an autosaved painting.");
   QCommandLineOption demo_opt("demo-screenshot",
@@ -37,14 +37,11 @@ int main(int argc, char** argv) {
   StudioOptions opt;
   try {
     opt.device = wb::Device::parse(cli.value(device_opt).toStdString());
+    opt.preset = QualityPreset::from_name(cli.value(preset_opt).toStdString(), opt.device);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "wetbrush-studio: %s\n", e.what());
     return 2;
   }
-  const QString preset = cli.value(preset_opt);
-  opt.preset = preset == "gpu"   ? QualityPreset::gpu()
-               : preset == "cpu" ? QualityPreset::cpu()
-                                 : QualityPreset::for_device(opt.device);
   opt.data_dir = cli.value(data_opt);
   opt.offer_recovery = !cli.isSet(norecover_opt) && !cli.isSet(demo_opt);
   if (!cli.positionalArguments().isEmpty()) opt.open_path = cli.positionalArguments().first();

@@ -101,9 +101,7 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   SimConfig cfg;
   cfg.device = options_.device;
   cfg.canvas = CanvasDims{q.canvas_width, q.canvas_height, q.canvas_depth};
-  cfg.brush = default_brush(BrushShape::Round);
-  cfg.brush.bristles = q.bristles;
-  cfg.brush.samples_per_bristle = q.samples_per_bristle;
+  cfg.brush = q.start_brush();
   if (options_.brush) cfg.brush = *options_.brush;
   cfg.window = Int3{q.window_xy, q.window_xy, std::min(q.window_z, q.canvas_depth)};
   RenderParams rp;

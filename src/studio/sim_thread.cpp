@@ -17,8 +17,12 @@ double wall_now() {
   return duration<double>(steady_clock::now().time_since_epoch()).count();
 }
 
-/// Cells around the brush that one step may change: the brush's reach plus the active window.
-int step_reach(const BrushSpec& b) { return int(b.length + std::max(b.width, b.thickness)) + 80; }
+/// Cells around the pen that one step may change: the active window, centred near the brush's
+/// footprint (the bristles' reach) and snapped to the grid's window snap.
+int step_reach(const SimConfig& c) {
+  return int(c.brush.length + std::max(c.brush.width, c.brush.thickness)) + std::max(c.window.x, c.window.y) / 2 +
+         c.params.grid.window_snap + 2;
+}
 
 }  // namespace
 
@@ -46,6 +50,39 @@ QualityPreset QualityPreset::gpu() {
   p.canvas_depth = 64;
   p.ao_rays = 64;
   return p;
+}
+
+QualityPreset QualityPreset::tiny() {
+  QualityPreset p;
+  p.name = "tiny";
+  p.bristles = 40;  // the fewest a brush file accepts
+  p.brush_length = 16.f;
+  p.brush_width = 8.f;
+  p.samples_per_bristle = 24;  // gap below one cell along the longest bristle (16 x 1.16)
+  p.canvas_width = 160;
+  p.canvas_height = 120;
+  p.canvas_depth = 16;
+  p.ao_rays = 4;
+  p.window_xy = 32;
+  p.window_z = 8;
+  return p;
+}
+
+QualityPreset QualityPreset::from_name(const std::string& name, const Device& d) {
+  if (name == "auto") return for_device(d);
+  if (name == "cpu") return cpu();
+  if (name == "gpu") return gpu();
+  if (name == "tiny") return tiny();
+  WB_THROW("unknown quality preset '" + name + "' (valid: auto, cpu, gpu, tiny)");
+}
+
+BrushSpec QualityPreset::start_brush() const {
+  BrushSpec b = default_brush(BrushShape::Round);
+  b.bristles = bristles;
+  b.samples_per_bristle = samples_per_bristle;
+  if (brush_length > 0.f) b.length = brush_length;
+  if (brush_width > 0.f) b.width = b.thickness = brush_width;
+  return b;
 }
 
 SimThread::SimThread(const SimConfig& config, const RenderParams& render, QObject* parent)
@@ -275,7 +312,7 @@ void SimThread::run_step(const PlayerStep& step) {
   if (edge && rec_.paint.reload_on_pen_down) apply_initial_paint(sim, rec_.paint);
 
   // Undo: capture the tiles this step may touch before it runs.
-  const int reach = step_reach(config_.brush);
+  const int reach = step_reach(config_);
   const PenSample a = player_->pen_at(step.t_begin), b = step.pen;
   const int x0 = int(std::min(a.x, b.x)) - reach, x1 = int(std::max(a.x, b.x)) + reach;
   const int y0 = int(std::min(a.y, b.y)) - reach, y1 = int(std::max(a.y, b.y)) + reach;
@@ -285,12 +322,12 @@ void SimThread::run_step(const PlayerStep& step) {
   }
   poses_.clear();
   for (int k = 1; k <= step.substeps; ++k) poses_.push_back(player_->pose_at(StrokePlayer::substep_time(step, k)));
+  const Int3 o0 = sim.live_window()->origin();
   sim.step(poses_.data(), step.substeps, float(step.dt));
-  // Paint changes only inside the active window around the brush (128 x 128 cells).
+  // Paint changes only inside the active window (where it was and where it moved to).
   if (stroke_open_) {
-    const int w = 72;
-    invalidate_rect(int(std::min(a.x, b.x)) - w, int(std::min(a.y, b.y)) - w, int(std::max(a.x, b.x)) + w,
-                    int(std::max(a.y, b.y)) + w);
+    const Int3 o = sim.live_window()->origin(), n = sim.live_window()->dims();
+    invalidate_rect(std::min(o.x, o0.x), std::min(o.y, o0.y), std::max(o.x, o0.x) + n.x, std::max(o.y, o0.y) + n.y);
   }
   t_done_ = step.t;
   ++steps_;

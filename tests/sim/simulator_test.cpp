@@ -85,6 +85,37 @@ TEST_F(SimulatorTest, PressedLoadedBrushPaintsUnderItsFootprintAndBooksClose) {
   EXPECT_EQ(sim.counters().nonfinite_events, 0);
 }
 
+TEST_F(SimulatorTest, DraggedBrushKeepsPaintingWithWickingAndGridOnlyHoldsNoParticles) {
+  // The same drag three ways: wicking (default), without (the paper's model), and grid-only.
+  // With wicking the bristles' paint keeps reaching the tips, so more of it is left on the
+  // canvas; grid-only paint never stays particles past the step after it was emitted.
+  auto drag = [&](float wick, bool particles, int64_t* held_max) {
+    SimConfig c = small_config();
+    c.params.transfer.wick_rate = wick;
+    c.particles = particles;
+    Simulator sim(c, pose_at(c.brush, 100, 128, 0.f, false));
+    sim.load_paint(red());
+    int64_t held = 0;
+    for (int i = 0; i < 4; ++i) sim.step(pose_at(c.brush, 100.f, 128.f, 0.2f * float(i)), 1.f / 60.f);
+    for (int i = 0; i < 24; ++i) {
+      sim.step(pose_at(c.brush, 100.f + 2.f * float(i), 128.f, 0.6f), 1.f / 60.f);
+      held = std::max(held, sim.particles().size() - sim.books().steps().back().transfer.emitted_count);
+    }
+    sim.settle();
+    EXPECT_LT(std::abs(sim.books().max_drift()), 1e-4);
+    EXPECT_EQ(sim.counters().nonfinite_events, 0);
+    if (held_max) *held_max = held;
+    return sim.canvas().total_density(ws_);
+  };
+  const double wicked = drag(2000.f, true, nullptr);
+  const double paper = drag(0.f, true, nullptr);
+  int64_t held = -1;
+  const double grid_only = drag(2000.f, false, &held);
+  EXPECT_GT(wicked, 1.2 * paper) << "wicking feeds the tips: more paint on the canvas";
+  EXPECT_GT(grid_only, 0.0);
+  EXPECT_EQ(held, 0) << "grid-only: only this step's emission is held as particles";
+}
+
 TEST_F(SimulatorTest, JitterAndVeryFastStrokeStayFiniteAndKeepTheBooks) {
   SimConfig c = small_config();
   Simulator sim(c, pose_at(c.brush, 60, 60, 0.f, false));

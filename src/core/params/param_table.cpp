@@ -93,6 +93,15 @@ std::vector<ParamInfo> build_table() {
       WB_PARAM(particles.hash_cell, "Hash cell", "cells", "§6", 0.5, 100, "Cell size of the sample hash grid"),
       WB_PARAM(particles.max_particles, "Particle limit", "", "§7", 1, 2147483647.0, "Most particles at once"),
       // Rendering (§6).
+      // Liquid transfer (§5) and wicking.
+      WB_PARAM(transfer.mu, "Capacity compression mu", "", "Eq. 12", 0, 1, "How much bristle crowding cuts a sample's capacity"),
+      WB_PARAM(transfer.M_max, "Sample capacity M_max", "kg", "Eq. 12", 1e-12, 1e-5, "Most paint one bristle sample holds"),
+      WB_PARAM(transfer.epsilon, "Emission epsilon", "", "§5.1", 0, 10, "A sample emits above (1 + epsilon) M_j"),
+      WB_PARAM(transfer.absorb_limit, "Absorb limit", "", "§5.1", 0, 1024, "Particles one sample absorbs per step"),
+      WB_PARAM(transfer.emit_limit, "Emit limit", "", "§5.1", 0, 64, "Particles one sample emits per step"),
+      WB_PARAM(transfer.bleed, "Colour bleeding", "", "§5.1", 0, 1, "Colour exchanged with particles a full sample does not absorb"),
+      WB_PARAM(transfer.slow_speed, "Slow speed", "cells/s", "§5.2", 0, 1e4, "Particles slower than this go back to the grid"),
+      WB_PARAM(transfer.wick_rate, "Wicking", "1/s", "", 0, 1e6, "Capillary flow of paint along a bristle towards its emptier samples"),
       WB_PARAM(render.step, "Ray step", "cells", "§6", 0.05, 2, "Ray-march step"),
       WB_PARAM(render.threshold, "Surface density", "", "§6", 0.01, 1, "Density at which the surface is found"),
       WB_PARAM(render.penetration_per_oil, "Oil penetration", "cells", "§6", 0, 100,

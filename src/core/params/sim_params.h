@@ -6,6 +6,7 @@
 #include "core/grid/grid_params.h"
 #include "core/particles/particle_params.h"
 #include "core/render/render_params.h"
+#include "core/transfer/transfer_params.h"
 
 namespace wb {
 
@@ -14,6 +15,7 @@ struct SimParams {
   GridParams grid{};
   ParticleParams particles{};
   RenderParams render{};
+  TransferParams transfer{};
   /// Drag of the paint flow on the bristles (Eq. 2's a_i, kept grid velocity of §4.3):
   /// velocity relaxes towards the flow at this rate times the paint density, 1/s.
   float bristle_drag = 20.f;

@@ -33,11 +33,12 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
   grid_->recentre_on(centre);
   particles_ = ParticleStore(d, config_.params.particles.max_particles);
   hash_ = SampleHashGrid(d);
-  load_ = std::make_unique<BristleLoad>(d, brush_->sample_count(), config_.transfer);
-  transfer_ = std::make_unique<Transfer>(d, config_.transfer);
+  load_ = std::make_unique<BristleLoad>(d, brush_->sample_count(), config_.params.transfer);
+  transfer_ = std::make_unique<Transfer>(d, config_.params.transfer);
   if (!config_.particles) {
-    // Grid-only paint (Fig. 7a/c): emitted paint goes straight to the grid on the next step.
-    transfer_->params().slow_speed = std::numeric_limits<float>::infinity();
+    // Grid-only paint (Fig. 7a/c): with D0 = 0 (transfer_env) and the fastest valid "slow"
+    // speed (2 m/s), emitted paint goes straight to the grid on the next step.
+    transfer_->params().slow_speed = 1e4f;
   }
 
   const GridDims g = grid_->dims();
@@ -186,7 +187,9 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
       hash_.build(brush_->samples(), config_.params.particles.hash_cell, ws_, 0.f);
       hash_.query_nearest(particles_.view(), config_.params.particles.D0);
     }
-    const TransferRecord moved = transfer_->step(brush_->samples(), *load_, particles_, transfer_env());
+    TransferEnv env = transfer_env();
+    env.dt = dt;  // wicking along the bristles over this step
+    const TransferRecord moved = transfer_->step(brush_->samples(), *load_, particles_, env);
     const TransferRecord pre = rec;  // particles deposited before the window moved
     rec = moved;
     rec.to_grid_count += pre.to_grid_count;

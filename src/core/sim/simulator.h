@@ -26,7 +26,6 @@ struct SimConfig {
   Int3 window{128, 128, 32};  ///< active window, cells (§4.2: 128 x 128 x 32)
   BrushSpec brush{};
   SimParams params{};
-  TransferParams transfer{};
   /// false: grid-only paint (no particles, no bristle-particle transfer), the paper's Fig. 7a/c.
   bool particles = true;
 };

@@ -76,6 +76,10 @@ WB_HD WB_INLINE Vec3 mix_batch(Vec3 c_self, float w_self, Vec3 sum_wc, float sum
   return rescale_to_brightness(lin, b);
 }
 
+/// Edge conductance of the wicking flow between samples a and b of one bristle, kg per unit
+/// saturation: k dt min(M'_a, M'_b) (docs/TRANSFER.md "Wicking").
+WB_HD WB_INLINE float wick_conductance(float k_dt, float Mp_a, float Mp_b) { return k_dt * minf(Mp_a, Mp_b); }
+
 /// Colour bleeding (§5.1): a particle of mass m_k within R_j of a sample that does not absorb it
 /// exchanges e = bleed min(m_k, m_j) of colour with the sample; masses are unchanged.
 WB_HD WB_INLINE float bleed_weight(float bleed, float m_k, float m_j) { return bleed * minf(m_k, m_j); }

@@ -211,7 +211,8 @@ struct DistanceBlocks {
     const float v = d2[b];
     return v >= kFarDistance2 ? 1e30f : sqrtf(v) * float(block);
   }
-  WB_HD bool near(Vec3 q) const { return distance(q) <= D0; }
+  /// Within D0 of the bristles; nothing is near when D0 is 0 (grid-only paint, Fig. 7).
+  WB_HD bool near(Vec3 q) const { return D0 > 0.f && distance(q) <= D0; }
 };
 
 }  // namespace wb

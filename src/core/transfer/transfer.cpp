@@ -18,6 +18,9 @@ namespace {
 void d_absorb(const Device& d, ParticleView p, SampleView s, BristleLoadView l, AbsorbScratch a, TransferParams prm) {
   WB_DISPATCH(d, transfer_absorb(p, s, l, a, prm));
 }
+void d_wick(const Device& d, BristleLoadView l, int bristles, int per, float k_dt, float* a, float* b) {
+  WB_DISPATCH(d, transfer_wick(l, bristles, per, k_dt, a, b));
+}
 void d_absorb_apply(const Device& d, BristleLoadView l, AbsorbScratch a) { WB_DISPATCH(d, transfer_absorb_apply(l, a)); }
 void d_occupancy(const Device& d, SampleView s, DistanceBlocks db, int32_t* occ, int ox, int oy, int oz) {
   WB_DISPATCH(d, transfer_distance_occupancy(s, db, occ, ox, oy, oz));
@@ -69,6 +72,7 @@ void validate(const TransferParams& p) {
   WB_REQUIRE(in(p.epsilon, 0.f, 10.f), "TransferParams: epsilon must lie in [0, 10]");
   WB_REQUIRE(in(p.surface_density, 1e-6f, 1.f), "TransferParams: surface_density must lie in (0, 1]");
   WB_REQUIRE(in(p.march_step, 0.05f, 1.f), "TransferParams: march_step must lie in [0.05, 1] cells");
+  WB_REQUIRE(in(p.wick_rate, 0.f, 1e6f), "TransferParams: wick_rate must lie in [0, 1e6] 1/s");
   WB_REQUIRE(p.absorb_limit >= 0 && p.absorb_limit <= 1024, "TransferParams: absorb_limit must lie in [0, 1024]");
   WB_REQUIRE(p.emit_limit >= 0 && p.emit_limit <= 64, "TransferParams: emit_limit must lie in [0, 64]");
   WB_REQUIRE(in(p.emit_mass, 1e-20f, p.M_max), "TransferParams: emit_mass must lie in (0, M_max] kg");
@@ -153,6 +157,10 @@ TransferRecord Transfer::step(const SampleView& samples, BristleLoad& load, Part
     WB_PROFILE_SCOPE("transfer.capacity");
     update_capacity(samples, load, env);
   }
+  if (env.dt > 0.f && params_.wick_rate > 0.f) {
+    WB_PROFILE_SCOPE("transfer.wick");
+    wick(samples, load, env.dt);
+  }
   {
     WB_PROFILE_SCOPE("transfer.absorb");
     absorb(samples, load, particles, rec);
@@ -188,6 +196,17 @@ void Transfer::update_capacity(const SampleView& samples, BristleLoad& load, con
   const CellField psi{env.psi, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
   const CellField density{pw.density, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
   transfer_capacity(device_, samples, load.view(), psi, density, params_, env.floor_z);
+}
+
+void Transfer::wick(const SampleView& samples, BristleLoad& load, float dt) {
+  const int64_t ns = samples.count();
+  WB_REQUIRE(ns == load.size(), "Transfer::wick: " + std::to_string(ns) + " samples but a load of " +
+                                    std::to_string(load.size()));
+  WB_REQUIRE(std::isfinite(dt) && dt >= 0.f, "Transfer::wick: dt must be finite and >= 0");
+  if (ns == 0 || dt == 0.f || params_.wick_rate == 0.f || samples.per_bristle < 2) return;
+  ensure_samples(ns);
+  d_wick(device_, load.view(), samples.bristles, samples.per_bristle, params_.wick_rate * dt, s_f32_[0].data(),
+         s_f32_[1].data());
 }
 
 void Transfer::absorb(const SampleView& samples, BristleLoad& load, ParticleStore& particles, TransferRecord& rec) {

@@ -30,6 +30,7 @@ struct TransferEnv {
   float floor_z = 0.f;         ///< canvas surface height, cells (ParticleParams::floor_z)
   float dry_threshold = 0.95f; ///< dryness at which paint is solid (GridParams::dry_threshold)
   float D0 = 50.f;             ///< particle range around the bristles, cells (ParticleParams::D0)
+  float dt = 0.f;              ///< step length, s, for the wicking along the bristles (0: none)
   /// Window box (window cells, [keep_lo, keep_hi)) the particles may stay in: with keep_box on,
   /// particles outside it go to the grid by Eq. 16 whatever their speed or distance to the
   /// bristles, because the window is about to move and leave them outside (docs/TRANSFER.md).
@@ -116,6 +117,9 @@ class Transfer {
   // --- stages (public for tests and profiling; step() calls them in this order) ---
   /// Eq. 12-13 for every sample: load.potential, load.capacity, load.radius.
   void update_capacity(const SampleView& samples, BristleLoad& load, const TransferEnv& env);
+  /// Wicking (docs/TRANSFER.md): the load flows along each bristle from fuller to emptier
+  /// samples (saturation m / M'), implicitly over dt; colour and oil go with it.
+  void wick(const SampleView& samples, BristleLoad& load, float dt);
   /// Eq. 14: particles within R_j of their nearest sample j join it while m_j < M_j (at most
   /// absorb_limit per sample), else bleed colour. Absorbed particles are flagged dead.
   void absorb(const SampleView& samples, BristleLoad& load, ParticleStore& particles, TransferRecord& rec);
@@ -169,6 +173,7 @@ void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadVi
                          float floor_z);                                                                           \
   void transfer_absorb(ParticleView p, SampleView s, BristleLoadView load, AbsorbScratch a, TransferParams prm);    \
   void transfer_absorb_apply(BristleLoadView load, AbsorbScratch a);                                               \
+  void transfer_wick(BristleLoadView load, int bristles, int per, float k_dt, float* a, float* d);                 \
   void transfer_distance_occupancy(SampleView s, DistanceBlocks db, int32_t* occ, int ox, int oy, int oz);         \
   void transfer_distance_init(const int32_t* occ, float* d2, int64_t n);                                           \
   void transfer_distance_pass(DistanceBlocks db, int axis, const float* src, float* dst, int32_t* v, float* z);    \

@@ -28,6 +28,74 @@ void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellFi
   });
 }
 
+// --- wicking along each bristle (docs/TRANSFER.md "Wicking") -------------------------------
+
+// One thread per bristle: backward Euler for M'_i s_i - sum_e g_e (s_nb - s_i) = m_i (Thomas
+// algorithm; the matrix is an M-matrix, so s stays >= 0 and the bristle's mass is kept), then
+// the edge fluxes from the new saturations carry colour and oil upwind from the old values.
+// a, d are per-sample scratch (the eliminated diagonal and right-hand side).
+void transfer_wick(BristleLoadView load, int bristles, int per, float k_dt, float* a, float* d) {
+  parallel_for(
+      bristles,
+      [=] WB_HD(int64_t b) {
+        const int64_t o = b * per;
+        const float* Mp = load.potential + o;
+        float* m = load.m + o;
+        float* sc = a + o;  // c'_i of the Thomas sweep
+        float* sd = d + o;  // d'_i, then s_i
+        // Forward sweep: row i is (-g_{i-1}) s_{i-1} + (M'_i + g_{i-1} + g_i) s_i + (-g_i) s_{i+1} = m_i.
+        float g_prev = 0.f;
+        for (int i = 0; i < per; ++i) {
+          const float g = i + 1 < per ? wick_conductance(k_dt, Mp[i], Mp[i + 1]) : 0.f;
+          const float diag = maxf(Mp[i], 1e-30f) + g_prev + g - (i > 0 ? g_prev * sc[i - 1] : 0.f);
+          sc[i] = g / diag;  // minus the eliminated upper coefficient (-g_i / diag)
+          sd[i] = (m[i] + (i > 0 ? g_prev * sd[i - 1] : 0.f)) / diag;
+          g_prev = g;
+        }
+        for (int i = per - 2; i >= 0; --i) sd[i] += sc[i] * sd[i + 1];
+        // Fluxes F_i from sample i to i+1, then upwind colour: each sample mixes in what it
+        // received with the giver's old colour (Algorithm 2, batch form as in Eq. 14).
+        Vec3 c_left(0.f, 0.f, 0.f);
+        float oil_left = 0.f, F_left = 0.f;
+        for (int i = 0; i < per; ++i) {
+          const float F = i + 1 < per ? wick_conductance(k_dt, Mp[i], Mp[i + 1]) * (sd[i] - sd[i + 1]) : 0.f;
+          const Vec3 ci(load.pigment_r[o + i], load.pigment_y[o + i], load.pigment_b[o + i]);
+          const float oil_i = load.oil[o + i];
+          const float mi = m[i];
+          float gain = 0.f, oil_in = 0.f, b_in = 0.f;
+          Vec3 wc(0.f, 0.f, 0.f);
+          if (F_left > 0.f) {  // from i - 1
+            gain += F_left;
+            wc = wc + c_left * F_left;
+            b_in += F_left * pigment_brightness(c_left);
+            oil_in += F_left * oil_left;
+          }
+          if (F < 0.f) {  // from i + 1 (old values: not yet written)
+            const Vec3 cr(load.pigment_r[o + i + 1], load.pigment_y[o + i + 1], load.pigment_b[o + i + 1]);
+            gain -= F;
+            wc = wc + cr * (-F);
+            b_in += -F * pigment_brightness(cr);
+            oil_in += -F * load.oil[o + i + 1];
+          }
+          const float lose = maxf(-F_left, 0.f) + maxf(F, 0.f);
+          const float keep = maxf(mi - lose, 0.f);
+          const float m_new = maxf(mi + F_left - F, 0.f);
+          c_left = ci;
+          oil_left = oil_i;
+          F_left = F;
+          if (gain > 0.f) {
+            const Vec3 cn = mix_batch(ci, keep, wc, b_in, gain);
+            load.pigment_r[o + i] = cn.x;
+            load.pigment_y[o + i] = cn.y;
+            load.pigment_b[o + i] = cn.z;
+            load.oil[o + i] = (keep * oil_i + oil_in) / maxf(keep + gain, 1e-30f);
+          }
+          m[i] = m_new;
+        }
+      },
+      kMinParallelHeavy);
+}
+
 // --- Eq. 14: absorption and colour bleeding ----------------------------------------------
 
 void transfer_absorb(ParticleView p, SampleView s, BristleLoadView load, AbsorbScratch a, TransferParams prm) {

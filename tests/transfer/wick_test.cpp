@@ -1,0 +1,118 @@
+// Wicking along the bristles (docs/TRANSFER.md "Wicking"): the implicit per-bristle flow of the
+// load from fuller to emptier samples keeps each bristle's paint, never makes a load negative,
+// keeps saturations within their old range, spreads them towards one value, and carries colour.
+#include <random>
+
+#include "transfer/transfer_fixture.h"
+
+namespace wb::test {
+
+class WickTest : public TransferTest {
+ protected:
+  static SampleView layout(int bristles, int per) {
+    SampleView s{};
+    s.bristles = bristles;
+    s.per_bristle = per;
+    return s;
+  }
+  static BristleLoadHost random_load(int n, std::mt19937& rng, const TransferParams& prm) {
+    std::uniform_real_distribution<float> U(0.f, 1.f);
+    BristleLoadHost h;
+#define WB_X(name, doc) h.name.assign(size_t(n), 0.f);
+    WB_BRISTLE_LOAD_FIELDS(WB_X)
+#undef WB_X
+    for (int i = 0; i < n; ++i) {
+      h.potential[i] = prm.M_max * (0.3f + 0.7f * U(rng));
+      h.capacity[i] = h.potential[i];
+      h.radius[i] = 0.75f;
+      h.m[i] = h.potential[i] * U(rng) * U(rng) * 1.5f;  // some over-full, some nearly empty
+      h.pigment_r[i] = U(rng);
+      h.pigment_y[i] = U(rng);
+      h.pigment_b[i] = U(rng);
+      h.oil[i] = U(rng);
+    }
+    return h;
+  }
+};
+
+TEST_F(WickTest, KeepsEachBristlesPaintAndSaturationsInRange) {
+  std::mt19937 rng(11);
+  const int B = 24, per = 64;
+  TransferParams prm;
+  for (float k_dt : {0.f, 0.5f, 30.f, 1e4f, 1e6f}) {
+    const BristleLoadHost before = random_load(B * per, rng, prm);
+    BristleLoad load(device_, B * per, prm);
+    load.from_host(before);
+    prm.wick_rate = k_dt;
+    Transfer t(device_, prm);
+    t.wick(layout(B, per), load, 1.f);
+    const BristleLoadHost after = load.to_host();
+    for (int b = 0; b < B; ++b) {
+      double m0 = 0, m1 = 0;
+      float s_lo = 1e30f, s_hi = 0.f, s1_lo = 1e30f, s1_hi = 0.f;
+      for (int i = b * per; i < (b + 1) * per; ++i) {
+        m0 += before.m[i];
+        m1 += after.m[i];
+        ASSERT_GE(after.m[i], 0.f);
+        const float s0 = before.m[i] / before.potential[i], s1 = after.m[i] / after.potential[i];
+        s_lo = std::min(s_lo, s0), s_hi = std::max(s_hi, s0);
+        s1_lo = std::min(s1_lo, s1), s1_hi = std::max(s1_hi, s1);
+      }
+      EXPECT_NEAR(m1, m0, 1e-5 * m0) << "k dt = " << k_dt << ", bristle " << b;
+      // Maximum principle of the implicit diffusion: no new extremes of saturation.
+      EXPECT_GE(s1_lo, s_lo * (1 - 1e-4f) - 1e-6f) << "k dt = " << k_dt;
+      EXPECT_LE(s1_hi, s_hi * (1 + 1e-4f) + 1e-6f) << "k dt = " << k_dt;
+      if (k_dt == 0.f) EXPECT_EQ(m1, m0);
+      // The slowest mode of the chain decays by 1 / (1 + k dt pi^2 / per^2) per step: 1/25 at 1e4.
+      if (k_dt == 1e4f) EXPECT_LT(s1_hi - s1_lo, 0.1f * (s_hi - s_lo)) << "a fast flow evens the bristle out";
+      if (k_dt > 0.f) EXPECT_LT(s1_hi - s1_lo, s_hi - s_lo) << "the spread of saturations shrinks";
+    }
+  }
+}
+
+TEST_F(WickTest, FeedsAnEmptiedTipWithTheBristlesColour) {
+  // One bristle: the tip (sample 0) emptied, the rest full of blue paint. The tip fills from
+  // its neighbours and turns blue; samples far up only give, so they keep their colour.
+  const int per = 32;
+  TransferParams prm;
+  BristleLoadHost h;
+#define WB_X(name, doc) h.name.assign(size_t(per), 0.f);
+  WB_BRISTLE_LOAD_FIELDS(WB_X)
+#undef WB_X
+  for (int i = 0; i < per; ++i) {
+    h.potential[i] = h.capacity[i] = prm.M_max;
+    h.radius[i] = 0.75f;
+    h.m[i] = i == 0 ? 0.f : prm.M_max;
+    h.pigment_b[i] = i == 0 ? 0.f : 0.9f;
+    h.pigment_y[i] = i == 0 ? 0.8f : 0.f;
+    h.oil[i] = i == 0 ? 0.f : 0.4f;
+  }
+  BristleLoad load(device_, per, prm);
+  load.from_host(h);
+  prm.wick_rate = 2000.f;
+  Transfer t(device_, prm);
+  t.wick(layout(1, per), load, 1.f / 60.f);
+  const BristleLoadHost a = load.to_host();
+  EXPECT_GT(a.m[0], 0.3f * prm.M_max) << "k dt = 33: the tip refills within a step";
+  EXPECT_LT(a.m[0], prm.M_max);
+  EXPECT_GT(a.pigment_b[0], 0.5f) << "the paint that came in is blue";
+  EXPECT_LT(a.pigment_y[0], 0.8f);
+  EXPECT_GT(a.oil[0], 0.f);
+  EXPECT_LT(a.m[1], prm.M_max);
+  EXPECT_FLOAT_EQ(a.pigment_b[per - 1], 0.9f) << "a giver keeps its colour";
+  EXPECT_FLOAT_EQ(a.pigment_y[per - 1], 0.f);
+  // Saturation rises monotonically from the tip up.
+  for (int i = 1; i < per; ++i) EXPECT_GE(a.m[i], a.m[i - 1] * (1 - 1e-5f));
+}
+
+TEST_F(WickTest, RejectsBadInput) {
+  TransferParams prm;
+  BristleLoad load(device_, 8, prm);
+  Transfer t(device_, prm);
+  EXPECT_THROW(t.wick(layout(1, 4), load, 0.1f), Error) << "sample count differs from the load";
+  EXPECT_THROW(t.wick(layout(2, 4), load, std::nanf("")), Error);
+  prm.wick_rate = -1.f;
+  EXPECT_THROW(Transfer(device_, prm), Error);
+}
+
+}  // namespace wb::test
