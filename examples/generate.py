@@ -105,7 +105,7 @@ def scumble():
     # Scumbling: quick zig-zag passes at light pressure, the handle low.
     pts = [(400, 430), (640, 470), (420, 500), (640, 540), (420, 580)]
     for a, b in zip(pts, pts[1:]):
-        seg = stroke(t, line(a, b), 0.4, 0.45, tilt=(30 if b[0] > a[0] else -30, 0), twist=90,
+        seg = stroke(t, line(a, b), 0.8, 0.5, tilt=(30 if b[0] > a[0] else -30, 0), twist=90,
                      press_time=0.08, lift_time=0.08)
         s += seg
         t = round(s[-1]["t"] + 0.05, 4)

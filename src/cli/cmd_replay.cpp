@@ -106,6 +106,8 @@ int run_replay(const ReplayArgs& a) {
                    a.window[0] <= 1024 && a.window[1] <= 1024 && a.window[2] <= 256,
                "--window takes X,Y,Z cells (16..1024, 16..1024, 8..256)");
     cfg.window = Int3{a.window[0], a.window[1], std::min(a.window[2], stroke.canvas.depth)};
+  } else if (stroke.window) {
+    cfg.window = Int3{(*stroke.window)[0], (*stroke.window)[1], std::min((*stroke.window)[2], stroke.canvas.depth)};
   }
   if (!a.params_file.empty()) {
     std::ifstream f(a.params_file);

@@ -74,7 +74,7 @@ class StrokeCommand : public QUndoCommand {
     sim_->post([d, after](SimThread& s) {
       s.restart_recording(false);
       after ? d->apply_after(s.sim().canvas()) : d->apply_before(s.sim().canvas());
-      reload_window(s.sim());
+      s.canvas_written();
       int x0, y0, x1, y1;
       diff_rect(*d, s.sim().canvas().tiles_x(), x0, y0, x1, y1);
       s.invalidate_rect(x0, y0, x1, y1);
@@ -412,10 +412,8 @@ bool MainWindow::write_snapshot(const QString& path, bool wait, bool user_save) 
   ++saves_in_flight_;
   sim_->post([done, file, from_blank](SimThread& s) {
     try {
-      flush_simulation(s.sim());
-      TileStore& live = s.sim().canvas();
-      auto copy = std::make_shared<TileStore>(Device{}, live.dims());
-      for (int id : live.allocated_tile_ids()) copy->write_tile(live.read_tile(id));
+      // The paint at rest, with what is in flight now; the simulation goes on unchanged.
+      auto copy = std::make_shared<TileStore>(settled_canvas_copy(s.sim()));
       auto image = std::make_shared<Image>(s.canvas_image());
       const Vec3 paper = s.renderer().params().paper_rgb;
       nlohmann::json meta = {{"generator", "wetbrush-studio"},
@@ -483,7 +481,7 @@ bool MainWindow::open_from(const QString& path) {
       c.canvas = p.canvas.dims();
       s.rebuild(c, false);
       for (int id : p.canvas.allocated_tile_ids()) s.sim().canvas().write_tile(p.canvas.read_tile(id));
-      reload_window(s.sim());
+      s.canvas_written();
       s.restart_recording(false);
       s.invalidate_all();
       *dims = c.canvas;
@@ -529,8 +527,7 @@ bool MainWindow::export_maps(const QString& height_path, const QString& normal_p
   const std::string hp = height_path.toStdString(), np = normal_path.toStdString();
   sim_->post([done, hp, np](SimThread& s) {
     try {
-      flush_simulation(s.sim());
-      TileStore& canvas = s.sim().canvas();
+      TileStore canvas = settled_canvas_copy(s.sim(), s.sim().device());
       const FloatImage h = s.renderer().render_height_map(canvas);
       const double scale = 65535.0 / canvas.dims().depth;
       std::vector<uint16_t> q(h.data.size());

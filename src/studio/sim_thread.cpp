@@ -164,10 +164,12 @@ void SimThread::rebuild(const SimConfig& config, bool keep_canvas) {
   BrushPose rest;
   rest.position = Vec3(config.canvas.width * 0.5f, config.canvas.height * 0.5f, config.brush.length * 1.5f);
   sim_ = std::make_unique<Simulator>(config_, rest);
-  if (keep_canvas && same_dims)
-    for (int id : old->canvas().allocated_tile_ids()) sim_->canvas().write_tile(old->canvas().read_tile(id));
-  reload_window(*sim_);
+  if (keep_canvas && same_dims) {
+    const TileStore kept = settled_canvas_copy(*old);  // with the paint that was in flight
+    for (int id : kept.allocated_tile_ids()) sim_->canvas().write_tile(kept.read_tile(id));
+  }
   old.reset();
+  canvas_written();
   restart_recording(recording_from_blank_.load() && sim_->canvas().allocated_tiles() == 0);
   if (!cache_ || !same_dims) {
     cache_ = std::make_unique<CanvasImageCache>(renderer_, Camera::top(config.canvas), 32);
@@ -207,6 +209,14 @@ void SimThread::restart_recording(bool from_blank) {
   next_event_ = 0;
   prev_contact_ = false;
   recording_from_blank_ = from_blank;
+}
+
+void SimThread::canvas_written() {
+  if (!sim_) return;
+  reload_window(*sim_);
+  drop_particles(*sim_);
+  undo_rec_.reset();
+  stroke_open_ = false;
 }
 
 void SimThread::invalidate_all() {
@@ -316,19 +326,17 @@ void SimThread::run_step(const PlayerStep& step) {
   const PenSample a = player_->pen_at(step.t_begin), b = step.pen;
   const int x0 = int(std::min(a.x, b.x)) - reach, x1 = int(std::max(a.x, b.x)) + reach;
   const int y0 = int(std::min(a.y, b.y)) - reach, y1 = int(std::max(a.y, b.y)) + reach;
-  if (step.pen_down || stroke_open_) {
-    stroke_open_ = true;
-    undo_rec_.capture_rect(sim.canvas(), x0, y0, x1, y1);
-  }
+  // Every step belongs to the undo record of the stroke it leads to: the steps between two
+  // strokes (the lifted brush moving on, paint in flight landing) change tiles too.
+  stroke_open_ = true;
+  undo_rec_.capture_rect(sim.canvas(), x0, y0, x1, y1);
   poses_.clear();
   for (int k = 1; k <= step.substeps; ++k) poses_.push_back(player_->pose_at(StrokePlayer::substep_time(step, k)));
   const Int3 o0 = sim.live_window()->origin();
   sim.step(poses_.data(), step.substeps, float(step.dt));
   // Paint changes only inside the active window (where it was and where it moved to).
-  if (stroke_open_) {
-    const Int3 o = sim.live_window()->origin(), n = sim.live_window()->dims();
-    invalidate_rect(std::min(o.x, o0.x), std::min(o.y, o0.y), std::max(o.x, o0.x) + n.x, std::max(o.y, o0.y) + n.y);
-  }
+  const Int3 o = sim.live_window()->origin(), n = sim.live_window()->dims();
+  invalidate_rect(std::min(o.x, o0.x), std::min(o.y, o0.y), std::max(o.x, o0.x) + n.x, std::max(o.y, o0.y) + n.y);
   t_done_ = step.t;
   ++steps_;
   ++rate_steps_;
@@ -367,8 +375,15 @@ void SimThread::apply_event(const StrokeEvent& e) {
 void SimThread::finish_stroke() {
   if (!stroke_open_ || !sim_) return;
   stroke_open_ = false;
-  flush_simulation(*sim_);
-  auto diff = std::make_shared<TileDiff>(undo_rec_.finish(sim_->canvas()));
+  // The record holds the canvas with its paint at rest, before and after. Paint still in
+  // flight lands during the next steps, under the window: those tiles start the next record
+  // as they are at rest now, so that its undo returns to exactly this canvas.
+  auto diff = std::make_shared<TileDiff>();
+  const Int3 o = sim_->live_window()->origin(), n = sim_->live_window()->dims();
+  with_settled_canvas(*sim_, [&](TileStore& c) {
+    *diff = undo_rec_.finish(c);
+    undo_rec_.capture_rect(c, o.x, o.y, o.x + n.x, o.y + n.y);
+  });
   if (!diff->empty()) Q_EMIT strokeFinished(diff);
 }
 

@@ -90,6 +90,10 @@ class SimThread : public QObject {
   void rebuild(const SimConfig& config, bool keep_canvas);
   /// Starts a new recording (after undo, open, brush change): the next press begins it.
   void restart_recording(bool from_blank);
+  /// After tiles were written from outside (undo, redo, open): the simulation then holds that
+  /// canvas alone. The window is read back from the tiles, paint in flight is dropped (it
+  /// belonged to the canvas that was replaced) and the next undo record starts afresh.
+  void canvas_written();
   /// Re-renders the whole canvas (light, paper, new canvas).
   void invalidate_all();
   void invalidate_rect(int x0, int y0, int x1, int y1);

@@ -189,6 +189,23 @@ TEST(StrokeJson, EventAfterLastSampleRejected) {
   EXPECT_THROW(parse_stroke_json(text, "m.json"), Error);
 }
 
+TEST(StrokeJson, SimulationWindowIsReadCheckedAndKept) {
+  auto with_window = [](const std::string& w) {
+    return R"({"format": "wetbrush-stroke", "version": 1, "canvas": {"width": 512, "height": 512}, "simulation": {"window": )" + w +
+           R"(}, "samples": [{"t": 0, "x": 10, "y": 10, "pressure": 0.5}]})";
+  };
+  const Stroke st = parse_stroke_json(with_window("[192, 160, 32]"), "w.json");
+  ASSERT_TRUE(st.window.has_value());
+  EXPECT_EQ((*st.window)[0], 192);
+  EXPECT_EQ((*st.window)[1], 160);
+  EXPECT_EQ((*st.window)[2], 32);
+  EXPECT_EQ(parse_stroke_json(stroke_to_json_string(st), "again.json").window, st.window);
+  EXPECT_THROW(parse_stroke_json(with_window("[192.5, 160, 32]"), "w.json"), Error) << "whole cells only";
+  EXPECT_THROW(parse_stroke_json(with_window("[8, 160, 32]"), "w.json"), Error) << "too narrow";
+  EXPECT_THROW(parse_stroke_json(with_window("[192, 160]"), "w.json"), Error);
+  EXPECT_THROW(parse_stroke_json(with_window("[4096, 160, 32]"), "w.json"), Error);
+}
+
 TEST(StrokeJson, SaveLoadRoundTrip) {
   Stroke a = load_stroke(fixture("good/full.json"));
   a.samples[2].x = 123.456789f;  // not a short decimal

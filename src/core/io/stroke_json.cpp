@@ -357,6 +357,13 @@ Stroke parse_stroke_json(std::string_view text, const std::string& source) {
     st.max_substeps = s.integer_or("max_substeps", st.max_substeps, 1, 1024);
     st.lead_in = s.number_or("lead_in", st.lead_in, 0.0, 5.0);
     st.lead_out = s.number_or("lead_out", st.lead_out, 0.0, 5.0);
+    if (s.has("window")) {
+      const std::array<float, 3> w = s.triple("window", 8.0, 1024.0);
+      for (int i = 0; i < 3; ++i)
+        if (w[i] != std::floor(w[i])) s.fail("expected whole cells", "window");
+      WB_REQUIRE(w[0] >= 16 && w[1] >= 16, source + ": simulation.window needs X and Y of at least 16 cells");
+      st.window = std::array<int, 3>{int(w[0]), int(w[1]), int(w[2])};
+    }
     s.warn_unknown(st.warnings);
   }
   read_samples(top.raw("samples"), st);
@@ -376,11 +383,12 @@ std::string stroke_to_json_string(const Stroke& st) {
                       {"oil", float_for_json(st.paint.oil)},
                       {"load", float_for_json(st.paint.load)},
                       {"reload_on_pen_down", st.paint.reload_on_pen_down}};
-  const json sim = {{"dt", st.dt},
-                    {"max_move_per_substep", float_for_json(st.max_move_per_substep)},
-                    {"max_substeps", st.max_substeps},
-                    {"lead_in", st.lead_in},
-                    {"lead_out", st.lead_out}};
+  json sim = {{"dt", st.dt},
+              {"max_move_per_substep", float_for_json(st.max_move_per_substep)},
+              {"max_substeps", st.max_substeps},
+              {"lead_in", st.lead_in},
+              {"lead_out", st.lead_out}};
+  if (st.window) sim["window"] = {(*st.window)[0], (*st.window)[1], (*st.window)[2]};
   std::string out;
   out += "{\n  \"format\": \"" + std::string(kFormatName) + "\",\n";
   out += "  \"version\": " + std::to_string(kStrokeFormatVersion) + ",\n";

@@ -101,6 +101,7 @@ std::vector<ParamInfo> build_table() {
       WB_PARAM(transfer.emit_limit, "Emit limit", "", "§5.1", 0, 64, "Particles one sample emits per step"),
       WB_PARAM(transfer.bleed, "Colour bleeding", "", "§5.1", 0, 1, "Colour exchanged with particles a full sample does not absorb"),
       WB_PARAM(transfer.slow_speed, "Slow speed", "cells/s", "§5.2", 0, 1e4, "Particles slower than this go back to the grid"),
+      WB_PARAM(transfer.return_margin, "Return margin", "cells", "§5.2", 0, 100, "Particles go back to the grid only this far beyond D0"),
       WB_PARAM(transfer.wick_rate, "Wicking", "1/s", "", 0, 1e6, "Capillary flow of paint along a bristle towards its emptier samples"),
       WB_PARAM(render.step, "Ray step", "cells", "§6", 0.05, 2, "Ray-march step"),
       WB_PARAM(render.threshold, "Surface density", "", "§6", 0.01, 1, "Density at which the surface is found"),

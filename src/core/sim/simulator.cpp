@@ -9,6 +9,10 @@
 
 namespace wb {
 namespace {
+/// Rim of the window, cells, where paint is always grid paint (transfer_env).
+constexpr int kKeepRim = 3;
+}  // namespace
+namespace {
 
 /// Where the bristles meet the canvas: the rest tip under the handle (window centre).
 Vec3 footprint_centre(const BrushPose& pose, float length) {
@@ -108,6 +112,13 @@ TransferEnv Simulator::transfer_env() {
   env.floor_z = config_.params.particles.floor_z;
   env.dry_threshold = config_.params.grid.dry_threshold;
   env.D0 = config_.particles ? config_.params.particles.D0 : 0.f;
+  // Particles live inside the window less a rim of kKeepRim cells (the reach of Eq. 16's
+  // kernel): one that enters the rim goes to the grid, and rim paint is never sampled into
+  // particles, so nothing cycles between the two there (docs/TRANSFER.md).
+  const Int3 n = win.dims();
+  env.keep_box = true;
+  env.keep_lo = Int3{kKeepRim, kKeepRim, 0};
+  env.keep_hi = Int3{n.x - kKeepRim, n.y - kKeepRim, n.z - kKeepRim};
   return env;
 }
 
@@ -214,9 +225,9 @@ void Simulator::deposit_leaving_particles(Int3 next, TransferRecord& rec) {
   // the kernel of Eq. 16, return to the grid before the window moves.
   ActiveWindow& win = grid_->window();
   const Int3 cur = win.origin(), n = win.dims();
-  const int m = 3;
+  if (next.x == cur.x && next.y == cur.y && next.z == cur.z) return;  // the step's own pass keeps the rim
+  const int m = kKeepRim;
   TransferEnv env = transfer_env();
-  env.keep_box = true;
   env.keep_lo = Int3{std::max(cur.x, next.x) - cur.x + m, std::max(cur.y, next.y) - cur.y + m, 0};
   env.keep_hi = Int3{std::min(cur.x, next.x) + n.x - cur.x - m, std::min(cur.y, next.y) + n.y - cur.y - m, n.z - m};
   transfer_->update_distance(brush_->samples(), env);

@@ -189,6 +189,15 @@ WB_HD WB_INLINE void edt_line(const float* f, float* out, int n, int64_t stride,
 
 /// Coarse block grid of the bristle distance field: blocks of `block` cells over the window,
 /// extended by `margin` blocks on every side so that samples outside the window still count.
+/// Box of window cells [lo, hi) particles may live in (TransferEnv::keep_box); on == 0: all.
+struct KeepBox {
+  int on;
+  int lo[3], hi[3];
+  WB_HD bool contains(int i, int j, int k) const {
+    return !on || (i >= lo[0] && j >= lo[1] && k >= lo[2] && i < hi[0] && j < hi[1] && k < hi[2]);
+  }
+};
+
 struct DistanceBlocks {
   float* d2;  ///< squared distance to the nearest occupied block, in blocks^2
   int bx, by, bz;
@@ -213,6 +222,8 @@ struct DistanceBlocks {
   }
   /// Within D0 of the bristles; nothing is near when D0 is 0 (grid-only paint, Fig. 7).
   WB_HD bool near(Vec3 q) const { return D0 > 0.f && distance(q) <= D0; }
+  /// Within D0 + margin (the particles' side of the hysteresis, TransferParams::return_margin).
+  WB_HD bool near(Vec3 q, float margin) const { return D0 > 0.f && distance(q) <= D0 + margin; }
 };
 
 }  // namespace wb

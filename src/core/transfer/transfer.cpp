@@ -46,9 +46,9 @@ void d_emit_fill(const Device& d, SampleView s, BristleLoadView l, ParticleView 
                  TransferParams prm, float floor_z, float* emitted) {
   WB_DISPATCH(d, transfer_emit_fill(s, l, p, offset, count, mass_each, first, room, step_index, prm, floor_z, emitted));
 }
-void d_grid_count(const Device& d, PaintWindowView pw, DistanceBlocks db, TransferParams prm, float dry,
+void d_grid_count(const Device& d, PaintWindowView pw, DistanceBlocks db, KeepBox keep, TransferParams prm, float dry,
                   uint32_t* count) {
-  WB_DISPATCH(d, transfer_grid_count(pw, db, prm, dry, count));
+  WB_DISPATCH(d, transfer_grid_count(pw, db, keep, prm, dry, count));
 }
 void d_grid_emit(const Device& d, PaintWindowView pw, MacView vel, ParticleView p, const uint32_t* count,
                  const uint32_t* offset, int64_t first, int64_t room, TransferParams prm, float dry, float* demand) {
@@ -72,6 +72,7 @@ void validate(const TransferParams& p) {
   WB_REQUIRE(in(p.epsilon, 0.f, 10.f), "TransferParams: epsilon must lie in [0, 10]");
   WB_REQUIRE(in(p.surface_density, 1e-6f, 1.f), "TransferParams: surface_density must lie in (0, 1]");
   WB_REQUIRE(in(p.march_step, 0.05f, 1.f), "TransferParams: march_step must lie in [0.05, 1] cells");
+  WB_REQUIRE(in(p.return_margin, 0.f, 100.f), "TransferParams: return_margin must lie in [0, 100] cells");
   WB_REQUIRE(in(p.wick_rate, 0.f, 1e6f), "TransferParams: wick_rate must lie in [0, 1e6] 1/s");
   WB_REQUIRE(p.absorb_limit >= 0 && p.absorb_limit <= 1024, "TransferParams: absorb_limit must lie in [0, 1024]");
   WB_REQUIRE(p.emit_limit >= 0 && p.emit_limit <= 64, "TransferParams: emit_limit must lie in [0, 64]");
@@ -357,7 +358,9 @@ void Transfer::grid_to_particles(ParticleStore& particles, const TransferEnv& en
   ensure_cells(nc);
   uint32_t* count = c_u32_[0].data();
   uint32_t* offset = c_u32_[1].data();
-  d_grid_count(device_, env.paint, db, params_, env.dry_threshold, count);
+  KeepBox keep{env.keep_box ? 1 : 0, {env.keep_lo.x, env.keep_lo.y, env.keep_lo.z},
+               {env.keep_hi.x, env.keep_hi.y, env.keep_hi.z}};
+  d_grid_count(device_, env.paint, db, keep, params_, env.dry_threshold, count);
   const int64_t total = int64_t(exclusive_scan(device_, count, offset, nc, ws_));
   const int64_t room = std::max<int64_t>(particles.limit() - particles.size(), 0);
   const int64_t n_new = std::min(total, room);

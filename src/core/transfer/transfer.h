@@ -184,8 +184,8 @@ void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadVi
   void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, const uint32_t* offset,               \
                           const uint32_t* count, const float* mass_each, int64_t first, int64_t room,              \
                           int64_t step_index, TransferParams prm, float floor_z, float* emitted);                  \
-  void transfer_grid_count(PaintWindowView pw, DistanceBlocks db, TransferParams prm, float dry_threshold,          \
-                           uint32_t* count);                                                                        \
+  void transfer_grid_count(PaintWindowView pw, DistanceBlocks db, KeepBox keep, TransferParams prm,                \
+                           float dry_threshold, uint32_t* count);                                                                        \
   void transfer_grid_emit(PaintWindowView pw, MacView vel, ParticleView p, const uint32_t* count,                   \
                           const uint32_t* offset, int64_t first, int64_t room, TransferParams prm,                 \
                           float dry_threshold, float* demand);                                                      \

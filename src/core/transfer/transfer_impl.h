@@ -208,6 +208,7 @@ void transfer_distance_pass(DistanceBlocks db, int axis, const float* src, float
 void transfer_to_grid_mark(ParticleView p, PaintWindowView pw, DistanceBlocks db, DepositScratch acc,
                            TransferParams prm, float dry_threshold) {
   const float slow2 = prm.slow_speed * prm.slow_speed, h = prm.kernel_h, inv_cm = 1.f / prm.cell_mass();
+  const float margin = prm.return_margin;
   parallel_for(p.count, [=] WB_HD(int64_t k) {
     if (p.dead[k]) return;
     const float mk = p.m[k];
@@ -224,7 +225,7 @@ void transfer_to_grid_mark(ParticleView p, PaintWindowView pw, DistanceBlocks db
     const bool leaving = acc.keep_on && (q.x < float(acc.keep_lo[0]) || q.y < float(acc.keep_lo[1]) ||
                                          q.z < float(acc.keep_lo[2]) || q.x >= float(acc.keep_hi[0]) ||
                                          q.y >= float(acc.keep_hi[1]) || q.z >= float(acc.keep_hi[2]));
-    if (!leaving && (!(length2(p.v[k]) < slow2) || db.near(q))) return;
+    if (!leaving && (!(length2(p.v[k]) < slow2) || db.near(q, margin))) return;
     const Vec3 ck(p.pigment_r[k], p.pigment_y[k], p.pigment_b[k]);
     const float bk = pigment_brightness(ck), oil = p.oil[k], dry = p.dryness[k];
     const float a = mk * inv_cm;  // density units
@@ -312,15 +313,16 @@ void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, cons
 
 // --- Eq. 15: grid cells to particles ---------------------------------------------------------
 
-void transfer_grid_count(PaintWindowView pw, DistanceBlocks db, TransferParams prm, float dry_threshold,
-                         uint32_t* count) {
+void transfer_grid_count(PaintWindowView pw, DistanceBlocks db, KeepBox keep, TransferParams prm,
+                         float dry_threshold, uint32_t* count) {
   const float min_rho = prm.min_cell_density;
   parallel_for(pw.size(), [=] WB_HD(int64_t c) {
     count[c] = 0u;
     const float rho = pw.density[c];
     if (!(rho > 0.f) || rho < min_rho || cell_is_solid(rho, pw.dryness[c], dry_threshold)) return;
     const int i = int(c % pw.nx), j = int((c / pw.nx) % pw.ny), k = int(c / (int64_t(pw.nx) * pw.ny));
-    if (!db.near(Vec3(float(i) + 0.5f, float(j) + 0.5f, float(k) + 0.5f))) return;
+    // Paint outside the keep box stays grid paint: particles there would go straight back.
+    if (!keep.contains(i, j, k) || !db.near(Vec3(float(i) + 0.5f, float(j) + 0.5f, float(k) + 0.5f))) return;
     uint32_t n = 0;
     for (int s = 0; s < kCandidatesPerCell; ++s) {
       const Vec3 q = Vec3(float(i), float(j), float(k)) + candidate_offset(i + pw.ox, j + pw.oy, k + pw.oz, s);

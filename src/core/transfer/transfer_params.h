@@ -68,6 +68,12 @@ struct TransferParams {
   /// A particle moves back to the grid (Eq. 16) when slower than this, cells/s, and farther than
   /// D0 from the bristles. Default 10 cells/s (2 mm/s), range [0, 1e4]. §5.2.
   float slow_speed = 10.f;
+  /// Hysteresis of the D0 test, cells: cells within D0 become particles (Eq. 15), particles go
+  /// back (Eq. 16) only beyond D0 + return_margin. Without it the kernel of Eq. 16 spreads a
+  /// particle just beyond D0 into cells within D0, which turn into particles again the next
+  /// step: a shell of paint converted both ways every step. Default 8 cells (two distance
+  /// blocks), range [0, 100]. §5.2.
+  float return_margin = 8.f;
   /// Cells with less density than this are not sampled into particles. Default 1e-3, range [0, 1].
   float min_cell_density = 1e-3f;
   /// Block size of the coarse bristle distance field that decides "within D0", cells; the
