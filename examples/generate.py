@@ -98,7 +98,7 @@ def scumble():
     t = s[-1]["t"]
     events = [{"type": "dry", "t": round(t + 0.05, 4)},
               {"type": "clean", "t": round(t + 0.06, 4)},
-              {"type": "dip", "t": round(t + 0.07, 4), "ryb": [0.02, 0.35, 0.05], "oil": 0.2, "load": 0.6}]
+              {"type": "dip", "t": round(t + 0.07, 4), "ryb": [0.02, 0.35, 0.05], "oil": 0.2, "load": 1.0}]
     t = round(t + 0.2, 4)
     s += hover(s[-1]["t"], (380, 540), (400, 430), 0.2)
     t = round(s[-1]["t"] + DT, 4)

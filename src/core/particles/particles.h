@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "core/brush/bristle_fields.h"
+#include "core/canvas/window.h"
 #include "core/exec/device.h"
 #include "core/particles/adhesion_kernels.h"
 #include "core/particles/flip_kernels.h"
@@ -41,6 +42,11 @@ void particles_compact_field(const Device& d, const int32_t* src, int32_t* dst, 
                              const uint32_t* pos, int64_t n);
 void particles_compact_field(const Device& d, const uint32_t* src, uint32_t* dst, const uint32_t* dead,
                              const uint32_t* pos, int64_t n);
+/// Height field of the solid the particles rest on over the window's columns (SolidView):
+/// the top of the highest dried cell (dryness at or above dry_threshold, the grid's
+/// solid test) in each column, absolute canvas z, or floor_z where none. nx * ny floats.
+void particles_solid_height(const Device& d, const PaintWindowView& pw, float dry_threshold, float floor_z,
+                            float* height);
 /// Scratch of particles [first, first + n): nearest = -1, d_B = 0, key = 0, dead = 0.
 void particles_init_scratch(const Device& d, const ParticleView& p, int64_t first, int64_t n);
 
@@ -56,7 +62,8 @@ void particles_init_scratch(const Device& d, const ParticleView& p, int64_t firs
                                int64_t n);                                                                         \
   void particles_compact_field(const uint32_t* src, uint32_t* dst, const uint32_t* dead, const uint32_t* pos,       \
                                int64_t n);                                                                         \
-  void particles_init_scratch(ParticleView p, int64_t first, int64_t n);
+  void particles_init_scratch(ParticleView p, int64_t first, int64_t n);                                         \
+  void particles_solid_height(PaintWindowView pw, float dry_threshold, float floor_z, float* height);
 
 namespace cpu {
 WB_PARTICLES_BACKEND_DECLS

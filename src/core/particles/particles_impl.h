@@ -77,4 +77,21 @@ void particles_init_scratch(ParticleView p, int64_t first, int64_t n) {
   });
 }
 
+void particles_solid_height(PaintWindowView pw, float dry_threshold, float floor_z, float* height) {
+  parallel_for(int64_t(pw.nx) * pw.ny, [=] WB_HD(int64_t c) {
+    const int64_t layer = int64_t(pw.nx) * pw.ny;
+    float top = floor_z;
+    for (int k = pw.nz - 1; k >= 0; --k) {
+      const int64_t id = int64_t(k) * layer + c;
+      const float rho = pw.density[id];
+      if (rho > 0.f && pw.dryness[id] >= dry_threshold) {  // the grid's solid test (cell_is_solid)
+        // A partly filled top cell holds its paint at the bottom: the surface is rho up.
+        top = maxf(top, float(pw.oz + k) + minf(rho, 1.f));
+        break;
+      }
+    }
+    height[c] = top;
+  });
+}
+
 }  // namespace wb::WB_BACKEND_NS

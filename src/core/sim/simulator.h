@@ -108,6 +108,7 @@ class Simulator {
   DeviceBuffer<float> psi_, bristle_v_[3], cell_v_[3];
   DeviceBuffer<float> raster_mass_, raster_density_, raster_mom_[3], raster_w_[3];
   DeviceBuffer<float> overlay_mass_;
+  DeviceBuffer<float> solid_height_;  ///< dried-paint top per window column (particles' solid, Eq. 8)
 };
 
 }  // namespace wb

@@ -1,0 +1,45 @@
+// The solid the particles rest on (Eq. 8's d_k): canvas floor plus dried paint, per column.
+#include "backend_fixture.h"
+#include "core/canvas/window.h"
+#include "core/particles/particles.h"
+
+namespace wb::test {
+
+class SolidHeightTest : public BackendTest {};
+
+TEST_F(SolidHeightTest, DriedPaintRaisesTheFloorWetPaintDoesNot) {
+  const Int3 n{8, 4, 6};
+  PaintWindow w(device_, n);
+  w.set_origin(Int3{100, 200, 0});
+  std::vector<std::vector<float>> f(kPaintFieldCount, std::vector<float>(size_t(w.cell_count()), 0.f));
+  auto at = [&](int i, int j, int k) { return (size_t(k) * n.y + j) * n.x + i; };
+  for (int j = 0; j < n.y; ++j) {
+    // Column 1: three dried cells, the top one half full. Column 2: two dried cells under two
+    // wet ones. Column 3: wet paint only. Column 4: a dried cell above a gap.
+    for (int k = 0; k < 3; ++k) f[0][at(1, j, k)] = k == 2 ? 0.5f : 1.f, f[5][at(1, j, k)] = 1.f;
+    for (int k = 0; k < 4; ++k) f[0][at(2, j, k)] = 1.f, f[5][at(2, j, k)] = k < 2 ? 1.f : 0.2f;
+    for (int k = 0; k < 3; ++k) f[0][at(3, j, k)] = 1.f, f[5][at(3, j, k)] = 0.1f;
+    f[0][at(4, j, 4)] = 1.f, f[5][at(4, j, 4)] = 1.f;
+  }
+  w.from_host(f);
+  DeviceBuffer<float> h(device_, size_t(n.x) * n.y);
+  particles_solid_height(device_, w.view(), 0.95f, 0.25f, h.data());
+  const std::vector<float> hh = h.to_host();
+  for (int j = 0; j < n.y; ++j) {
+    EXPECT_FLOAT_EQ(hh[size_t(j) * n.x + 0], 0.25f) << "no paint: the canvas floor";
+    EXPECT_FLOAT_EQ(hh[size_t(j) * n.x + 1], 2.5f) << "top of the dried layer, half-full top cell";
+    EXPECT_FLOAT_EQ(hh[size_t(j) * n.x + 2], 2.f) << "wet paint on dried paint: the dried top";
+    EXPECT_FLOAT_EQ(hh[size_t(j) * n.x + 3], 0.25f) << "wet paint is not solid";
+    EXPECT_FLOAT_EQ(hh[size_t(j) * n.x + 4], 5.f) << "the highest dried cell counts";
+  }
+  // A particle resting above column 1 is 0.5 cells from the solid; above column 3, 2.25.
+  SolidView s;
+  s.floor_z = 0.25f;
+  std::vector<float> host = hh;
+  s.height = host.data();
+  s.nx = n.x, s.ny = n.y, s.ox = 100, s.oy = 200;
+  EXPECT_FLOAT_EQ(solid_distance(s, Vec3(101.5f, 201.5f, 3.f)), 0.5f);
+  EXPECT_FLOAT_EQ(solid_distance(s, Vec3(103.5f, 201.5f, 2.5f)), 2.25f);
+}
+
+}  // namespace wb::test
