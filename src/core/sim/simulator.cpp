@@ -9,8 +9,12 @@
 
 namespace wb {
 namespace {
-/// Rim of the window, cells, where paint is always grid paint (transfer_env).
-constexpr int kKeepRim = 3;
+/// Rim of the window, cells, where paint is always grid paint (transfer_env): wider than a
+/// particle moving with a fast stroke (480 cells/s) travels in one 1/60 s step, so that one
+/// leaving the window is caught in the rim rather than clamped to the wall.
+constexpr int kKeepRim = 8;
+/// Rim under the window's lid, cells: paint rises slowly, the kernel of Eq. 16 needs 3.
+constexpr int kKeepRimTop = 3;
 }  // namespace
 namespace {
 
@@ -114,13 +118,13 @@ TransferEnv Simulator::transfer_env() {
   env.floor_z = config_.params.particles.floor_z;
   env.dry_threshold = config_.params.grid.dry_threshold;
   env.D0 = config_.particles ? config_.params.particles.D0 : 0.f;
-  // Particles live inside the window less a rim of kKeepRim cells (the reach of Eq. 16's
+  // Particles live inside the window less a rim of kKeepRim cells (beyond the reach of Eq. 16's
   // kernel): one that enters the rim goes to the grid, and rim paint is never sampled into
   // particles, so nothing cycles between the two there (docs/TRANSFER.md).
   const Int3 n = win.dims();
   env.keep_box = true;
   env.keep_lo = Int3{kKeepRim, kKeepRim, 0};
-  env.keep_hi = Int3{n.x - kKeepRim, n.y - kKeepRim, n.z - kKeepRim};
+  env.keep_hi = Int3{n.x - kKeepRim, n.y - kKeepRim, n.z - kKeepRimTop};
   return env;
 }
 
@@ -229,9 +233,9 @@ void Simulator::deposit_leaving_particles(Int3 next, TransferRecord& rec) {
   const Int3 cur = win.origin(), n = win.dims();
   if (next.x == cur.x && next.y == cur.y && next.z == cur.z) return;  // the step's own pass keeps the rim
   const int m = kKeepRim;
-  TransferEnv env = transfer_env();
+  TransferEnv env = transfer_env();  // z rim as in every step
   env.keep_lo = Int3{std::max(cur.x, next.x) - cur.x + m, std::max(cur.y, next.y) - cur.y + m, 0};
-  env.keep_hi = Int3{std::min(cur.x, next.x) + n.x - cur.x - m, std::min(cur.y, next.y) + n.y - cur.y - m, n.z - m};
+  env.keep_hi = Int3{std::min(cur.x, next.x) + n.x - cur.x - m, std::min(cur.y, next.y) + n.y - cur.y - m, n.z - kKeepRimTop};
   transfer_->update_distance(brush_->samples(), env);
   transfer_->particles_to_grid(particles_, env, rec);
   particles_.compact(ws_);
