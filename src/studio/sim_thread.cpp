@@ -197,6 +197,7 @@ void SimThread::restart_recording(bool from_blank) {
   rec_.paint.reload_on_pen_down = false;  // the studio's brush stays dirty between strokes
   rec_.paper_rgb = std::array<float, 3>{renderer_.params().paper_rgb.x, renderer_.params().paper_rgb.y,
                                         renderer_.params().paper_rgb.z};
+  rec_.window = std::array<int, 3>{config_.window.x, config_.window.y, config_.window.z};  // the replay's window
   rec_.dt = kStepDt;
   rec_.lead_in = kLeadIn;
   rec_.lead_out = 0.0;
