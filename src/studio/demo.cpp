@@ -70,7 +70,7 @@ std::vector<ScriptPoint> line_points(QPointF a, QPointF b, int n, float pressure
 
 namespace wb::studio {
 
-void run_demo_painting(MainWindow& w) {
+double run_demo_painting(MainWindow& w) {
   CanvasView* v = w.view();
   const QSize c = v->canvas_size();
   const double W = c.width(), H = c.height();
@@ -81,8 +81,10 @@ void run_demo_painting(MainWindow& w) {
     float pressure;
     float tilt;
   };
-  const Pass passes[] = {{0, 0.30, 0.06, 0.55f, 20.f}, {1, 0.45, 0.08, 0.7f, -15.f}, {2, 0.60, 0.05, 0.45f, 30.f},
-                         {6, 0.72, 0.07, 0.8f, 0.f}};
+  // Well 0 and well 2 of the default palette; the third stroke crosses the wet first one.
+  const Pass passes[] = {{0, 0.40, 0.06, 0.6f, 20.f}, {2, 0.55, 0.08, 0.75f, -15.f}, {0, 0.66, 0.05, 0.5f, 25.f}};
+  QElapsedTimer pen;
+  double pen_s = 0.0;
   for (const Pass& p : passes) {
     PaintLoad paint = w.paint_panel()->current_paint();
     const QColor col = w.paint_panel()->well_color(p.well);
@@ -91,17 +93,20 @@ void run_demo_painting(MainWindow& w) {
     w.clean_brush();
     w.dip(paint);
     std::vector<ScriptPoint> pts;
-    const int n = 90;
+    const int n = 60;
     for (int i = 0; i < n; ++i) {
       const double s = double(i) / (n - 1);
-      const double x = W * (0.15 + 0.7 * s);
-      const double y = H * (p.y + p.amp * std::sin(s * 6.28318 * 1.3));
+      const double x = W * (0.30 + 0.4 * s);
+      const double y = H * (p.y + p.amp * std::sin(s * 6.28318 * 1.1));
       const float pr = p.pressure * float(0.6 + 0.4 * std::sin(s * 3.14159));
       pts.push_back({QPointF(x, y), pr, p.tilt, 0.f, 0.f});
     }
-    tablet_stroke(v, pts, 12);
+    pen.start();
+    tablet_stroke(v, pts, 16);
+    pen_s += pen.elapsed() / 1000.0;
     w.settle();
   }
+  return pen_s;
 }
 
 }  // namespace wb::studio

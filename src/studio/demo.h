@@ -27,7 +27,8 @@ std::vector<ScriptPoint> line_points(QPointF a, QPointF b, int n, float pressure
 
 namespace wb::studio {
 class MainWindow;
-/// A small scripted painting: a few colours dipped from the palette, curved strokes with
-/// varying pressure and tilt (the README screenshot and the frame-rate measurement).
-void run_demo_painting(MainWindow& w);
+/// A small scripted painting: three curved strokes in two colours dipped from the palette, with
+/// varying pressure and tilt (the README screenshot and the frame-rate measurement). Returns
+/// the seconds the pen spent on the canvas.
+double run_demo_painting(MainWindow& w);
 }  // namespace wb::studio

@@ -2,6 +2,7 @@
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QElapsedTimer>
+#include <QFile>
 #include <QSurfaceFormat>
 #include <QTimer>
 
@@ -30,7 +31,11 @@ int main(int argc, char** argv) {
                               "Paint a scripted picture with synthesised tablet strokes, save a screenshot of "
                               "the window to FILE and quit.",
                               "file");
-  cli.addOptions({device_opt, preset_opt, data_opt, norecover_opt, demo_opt});
+  QCommandLineOption stats_opt("demo-stats",
+                               "With --demo-screenshot: write the view frame rate and the simulation rate of the "
+                               "scripted painting to FILE (JSON).",
+                               "file");
+  cli.addOptions({device_opt, preset_opt, data_opt, norecover_opt, demo_opt, stats_opt});
   cli.addPositionalArgument("painting", "OpenRaster painting to open (.ora).", "[painting]");
   cli.process(app);
 
@@ -49,23 +54,48 @@ int main(int argc, char** argv) {
   MainWindow w(opt);
   w.show();
   if (cli.isSet(demo_opt)) {
-    const QString out = cli.value(demo_opt);
-    QTimer::singleShot(500, &w, [&w, out, &opt] {
+    const QString out = cli.value(demo_opt), stats = cli.value(stats_opt);
+    QTimer::singleShot(500, &w, [&w, out, stats, &opt] {
       // Also the frame-rate and simulation-rate measurement of docs/perf/studio.md.
+      w.settle();
       QElapsedTimer timer;
       timer.start();
       const int64_t frames0 = w.view()->frames_drawn();
       const int64_t steps0 = w.sim()->status().steps;
-      run_demo_painting(w);
+      const double pen_s = run_demo_painting(w);
       w.settle();
       QApplication::processEvents();
       const double secs = timer.elapsed() / 1000.0;
       const SimStatus st = w.sim()->status();
-      std::printf("demo: %.1f s wall, %lld view frames (%.1f fps), %lld simulation steps (%.1f steps/s overall, "
-                  "median %.1f ms/step), %lld particles at the end, device %s, preset %s\n",
-                  secs, (long long)(w.view()->frames_drawn() - frames0), (w.view()->frames_drawn() - frames0) / secs,
-                  (long long)(st.steps - steps0), (st.steps - steps0) / secs, st.step_ms, (long long)st.particles,
-                  st.device.c_str(), opt.preset.name.c_str());
+      const int64_t frames = w.view()->frames_drawn() - frames0, steps = st.steps - steps0;
+      const double sim_s = double(steps) * kStepDt;
+      std::printf("demo: %.1f s wall (pen on the canvas %.1f s), %lld view frames (%.1f fps), %lld simulation steps "
+                  "(%.2f steps/s, real-time factor %.3f, median %.1f ms/step), %lld particles at the end, device %s, "
+                  "preset %s\n",
+                  secs, pen_s, (long long)frames, frames / secs, (long long)steps, steps / secs, sim_s / secs,
+                  st.step_ms, (long long)st.particles, st.device.c_str(), opt.preset.name.c_str());
+      if (!stats.isEmpty()) {
+        QFile f(stats);
+        if (f.open(QIODevice::WriteOnly | QIODevice::Truncate)) {
+          const QString j =
+              QString("{\n  \"preset\": \"%1\",\n  \"device\": \"%2\",\n  \"wall_s\": %3,\n  \"pen_s\": %4,\n"
+                      "  \"view_frames\": %5,\n  \"view_fps\": %6,\n  \"steps\": %7,\n  \"steps_per_s\": %8,\n"
+                      "  \"simulated_s\": %9,\n  \"real_time_factor\": %10,\n  \"median_step_ms\": %11,\n"
+                      "  \"particles_end\": %12\n}\n")
+                  .arg(QString::fromStdString(opt.preset.name), QString::fromStdString(st.device))
+                  .arg(secs, 0, 'f', 2)
+                  .arg(pen_s, 0, 'f', 2)
+                  .arg(frames)
+                  .arg(frames / secs, 0, 'f', 2)
+                  .arg(steps)
+                  .arg(steps / secs, 0, 'f', 3)
+                  .arg(sim_s, 0, 'f', 3)
+                  .arg(sim_s / secs, 0, 'f', 4)
+                  .arg(st.step_ms, 0, 'f', 1)
+                  .arg(st.particles);
+          f.write(j.toUtf8());
+        }
+      }
       w.grab().save(out);
       std::printf("wrote %s\n", qPrintable(out));
       w.undo_stack()->setClean();
