@@ -100,13 +100,13 @@ TEST_F(AdhesionTest, BlendWeightsOfEq10) {
 }
 
 TEST_F(AdhesionTest, BetaZeroCarriesARotatingFrameRigidly) {
-  // A sample spinning at 6 rad/s about z (and about its own tangent), particle co-rotating.
+  // A sample turning at 6 rad/s about an axis across its tangent, particle co-rotating.
   const float w = 6.f;
   SampleFrame s;
   s.x = Vec3(100.f, 100.f, 50.f);
   const Vec3 axis = normalize(Vec3(0.3f, 0.f, 1.f));
-  s.t = rotate_axis_angle(Vec3(1, 0, 0), axis, 0.7f);
-  s.n = rotate_axis_angle(Vec3(0, 1, 0), axis, 0.7f);
+  s.t = normalize(cross(axis, Vec3(0, 1, 0)));  // perpendicular to the axis: the turn bends t
+  s.n = normalize(cross(axis, s.t));
   s.b = cross(s.t, s.n);
   s.v = Vec3();
   s.a = Vec3();
@@ -124,6 +124,42 @@ TEST_F(AdhesionTest, BetaZeroCarriesARotatingFrameRigidly) {
   const Vec3 rest = local_frame_step(p, Vec3(), Vec3(), s, 1.f, kDt);
   EXPECT_LT(length(rest - p), 0.5f * w * w * length(rl) * kDt * kDt * 4.f);
   EXPECT_GT(length(pn - p), 10.f * length(rest - p));
+}
+
+TEST_F(AdhesionTest, SpinAboutTheTangentDoesNotSwingParticlesAndTurnsAreCapped) {
+  // A round bristle spinning about its own tangent carries no paint around with it: a particle
+  // at rest beside it stays where it is (beta_L = 0, no acceleration).
+  SampleFrame s;
+  s.x = Vec3(50.f, 50.f, 20.f);
+  s.t = Vec3(1, 0, 0), s.n = Vec3(0, 1, 0), s.b = Vec3(0, 0, 1);
+  s.omega = s.t * 300.f;  // 5 rad per step: a parallel-transport artefact
+  const Vec3 p = s.x + Vec3(0.f, 4.f, 0.f);
+  EXPECT_NEAR(length(local_frame_step(p, Vec3(), Vec3(), s, 0.f, kDt) - p), 0.f, 1e-4f);
+  // A turn across the tangent faster than kMaxFrameTurn per step is capped to it, keeping its axis.
+  s.omega = Vec3(0.f, 0.f, 600.f) + s.t * 200.f;  // 10 rad per step across t, plus spin
+  const SampleFrame c = physical_rotation(s, kDt);
+  EXPECT_NEAR(dot(c.omega, s.t), 0.f, 1e-4f);
+  EXPECT_NEAR(length(c.omega) * kDt, kMaxFrameTurn, 1e-5f);
+  EXPECT_NEAR(length(cross(normalize(c.omega), Vec3(0, 0, 1))), 0.f, 1e-5f);
+}
+
+TEST_F(AdhesionTest, CanvasHoldsPaintThatTouchesItAgainstBristleJolts) {
+  // A sample next to a particle lying on the canvas jolts (velocity change of 600 cells/s in a
+  // step). The canvas holds the particle (Eq. 8 weight 1 at d = 0); one a few cells up follows
+  // the jolt in part.
+  SampleFrame s;
+  s.x = Vec3(50.f, 50.f, 1.f);
+  s.t = Vec3(0, 0, 1), s.n = Vec3(1, 0, 0), s.b = Vec3(0, 1, 0);
+  s.v = Vec3(600.f, 0.f, 0.f);
+  s.a = s.v / kDt;
+  SolidView floor;
+  auto moved = [&](Vec3 p) {
+    Vec3 v;
+    adhesion_update(p, v, &s, 1.f, floor, Vec3(), 0.1f, 0.1f, 15.f, kDt);
+    return std::fabs(v.x) * kDt;
+  };
+  EXPECT_LT(moved(Vec3(50.f, 51.f, 0.f)), 1e-4f) << "on the canvas";
+  EXPECT_GT(moved(Vec3(50.f, 51.f, 5.f)), 1.f) << "5 cells above it the bristle drags it";
 }
 
 TEST_F(AdhesionTest, RelativeVelocityAfterASuddenChangeIsBetaTimesIt) {

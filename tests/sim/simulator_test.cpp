@@ -1,6 +1,9 @@
 // The whole step of Figure 4 on a small scene: paint books, no paint from a clean brush,
 // paint only under a pressed brush, stability under jitter and a very fast stroke.
+#include <algorithm>
+#include <utility>
 #include <cmath>
+#include <vector>
 
 #include "backend_fixture.h"
 #include "core/io/pen_pose.h"
@@ -140,6 +143,124 @@ TEST_F(SimulatorTest, JitterAndVeryFastStrokeStayFiniteAndKeepTheBooks) {
     ASSERT_TRUE(std::isfinite(pv.x[k].x) && std::isfinite(pv.x[k].y) && std::isfinite(pv.x[k].z));
     ASSERT_GE(pv.x[k].z, -1e-3f) << "particle below the canvas";
   }
+}
+
+/// Painted columns of the canvas: cells (x, y) whose paint column holds at least `min_rho`.
+struct Footprint {
+  int64_t columns = 0;
+  double mass = 0;
+  std::vector<float> column;  ///< summed density per (x, y)
+};
+
+Footprint footprint_of(Simulator& sim, const Device& device, float min_rho = 0.05f) {
+  const CanvasDims d = sim.canvas().dims();
+  PaintWindow w(device, Int3{d.width, d.height, d.depth});
+  sim.canvas().gather(w);
+  const auto f = w.to_host();
+  Footprint fp;
+  fp.column.assign(size_t(d.width) * d.height, 0.f);
+  for (int z = 0; z < d.depth; ++z)
+    for (size_t c = 0; c < fp.column.size(); ++c) fp.column[c] += f[0][size_t(z) * fp.column.size() + c];
+  for (float v : fp.column) {
+    fp.columns += v >= min_rho;
+    fp.mass += v;
+  }
+  return fp;
+}
+
+/// Radius around (cx, cy) within which `share` of the footprint's paint lies, cells.
+double mass_radius(const Footprint& f, int width, float cx, float cy, double share) {
+  std::vector<std::pair<double, double>> rm;
+  for (size_t c = 0; c < f.column.size(); ++c)
+    if (f.column[c] > 0.f)
+      rm.emplace_back(std::hypot(double(c % width) + 0.5 - cx, double(c / width) + 0.5 - cy), f.column[c]);
+  std::sort(rm.begin(), rm.end());
+  double acc = 0;
+  for (const auto& [r, m] : rm)
+    if ((acc += m) >= share * f.mass) return r;
+  return rm.empty() ? 0.0 : rm.back().first;
+}
+
+TEST_F(SimulatorTest, MorePressureSpreadsAWiderMark) {
+  // The mark's width: the radius holding 90 % of the paint a press leaves. A firm press splays
+  // the bristles, whose tips carry the paint outward (the mark becomes a ring: docs/EXAMPLES.md).
+  auto press = [&](float pressure) {
+    const SimConfig c = small_config();
+    Simulator sim(c, pose_at(c.brush, 128, 128, 0.f, false));
+    sim.load_paint(red());
+    for (int i = 0; i < 4; ++i) sim.step(pose_at(c.brush, 128.f, 128.f, pressure * 0.25f * float(i + 1)), 1.f / 60.f);
+    for (int i = 0; i < 10; ++i) sim.step(pose_at(c.brush, 128.f, 128.f, pressure), 1.f / 60.f);
+    for (int i = 0; i < 6; ++i) sim.step(pose_at(c.brush, 128.f, 128.f, 0.f, false), 1.f / 60.f);
+    sim.settle();
+    EXPECT_LT(std::abs(sim.books().max_drift()), 1e-4);
+    const Footprint f = footprint_of(sim, device_);
+    EXPECT_GT(f.mass, 0.0) << "pressure " << pressure << " left no mark";
+    return std::make_pair(mass_radius(f, 256, 128.f, 128.f, 0.9), f.mass);
+  };
+  const auto [r_light, m_light] = press(0.25f);
+  const auto [r_firm, m_firm] = press(1.f);
+  EXPECT_GT(r_firm, 1.15 * r_light) << "90 % radius: light " << r_light << ", firm " << r_firm << " cells";
+  EXPECT_GT(m_firm, m_light) << "a firm press leaves more paint";
+}
+
+TEST_F(SimulatorTest, SecondPassMovesWetPaintAndPicksUpItsColour) {
+  // A red stroke along +x; then a clean brush loaded with blue drags across it along +y. The
+  // second pass moves red paint (the red columns change) and the blue brush picks red up.
+  const SimConfig c = small_config();
+  Simulator sim(c, pose_at(c.brush, 100, 128, 0.f, false));
+  sim.load_paint(red());
+  for (int i = 0; i < 4; ++i) sim.step(pose_at(c.brush, 100.f, 128.f, 0.2f * float(i)), 1.f / 60.f);
+  for (int i = 0; i < 28; ++i) sim.step(pose_at(c.brush, 100.f + 2.f * float(i), 128.f, 0.7f), 1.f / 60.f);
+  for (int i = 0; i < 6; ++i) sim.step(pose_at(c.brush, 156.f, 128.f, 0.f, false), 1.f / 60.f);
+  sim.settle();
+  const Footprint first = footprint_of(sim, device_);
+  ASSERT_GT(first.columns, 50);
+  sim.clean();
+  PaintLoad blue;
+  blue.ryb[0] = 0.05f, blue.ryb[1] = 0.05f, blue.ryb[2] = 0.9f;
+  blue.load = 0.5f;
+  sim.reset_brush(pose_at(c.brush, 128, 100, 0.f, false));
+  sim.load_paint(blue);
+  const Vec3 before = sim.load().mean_color(ws_);
+  for (int i = 0; i < 4; ++i) sim.step(pose_at(c.brush, 128.f, 100.f, 0.2f * float(i)), 1.f / 60.f);
+  for (int i = 0; i < 28; ++i) sim.step(pose_at(c.brush, 128.f, 100.f + 2.f * float(i), 0.8f), 1.f / 60.f);
+  const Vec3 after = sim.load().mean_color(ws_);
+  for (int i = 0; i < 6; ++i) sim.step(pose_at(c.brush, 128.f, 156.f, 0.f, false), 1.f / 60.f);
+  sim.settle();
+  EXPECT_LT(std::abs(sim.books().max_drift()), 1e-4);
+  EXPECT_GT(after.x, before.x + 0.01f) << "the blue brush took up red: R " << before.x << " -> " << after.x;
+  // The red stroke's paint moved: where the two strokes cross its columns changed.
+  const Footprint second = footprint_of(sim, device_);
+  double moved = 0;
+  for (int y = 100; y < 160; ++y)
+    for (int x = 100; x < 160; ++x) {
+      const size_t id = size_t(y) * 256 + x;
+      moved += std::abs(double(second.column[id]) - double(first.column[id]));
+    }
+  EXPECT_GT(moved, 0.05 * first.mass) << "the second pass left the wet paint where it was";
+}
+
+TEST_F(SimulatorTest, StrokeOffTheCanvasEdgeKeepsPaintOnAndAboveTheCanvas) {
+  // A stroke that runs off the canvas's right edge: no paint below the canvas or outside it,
+  // and nothing is lost (the canvas stores only its own cells; particles stay within it).
+  const SimConfig c = small_config();
+  Simulator sim(c, pose_at(c.brush, 220, 128, 0.f, false));
+  sim.load_paint(red());
+  const double loaded = sim.census().total();
+  for (int i = 0; i < 4; ++i) sim.step(pose_at(c.brush, 220.f, 128.f, 0.25f * float(i)), 1.f / 60.f);
+  for (int i = 0; i < 24; ++i) {
+    sim.step(pose_at(c.brush, std::min(220.f + 3.f * float(i), 256.f), 128.f, 0.8f), 1.f / 60.f);
+    const auto pv = sim.particles().to_host();
+    for (size_t k = 0; k < pv.size(); ++k) {
+      ASSERT_GE(pv.x[k].z, 0.f) << "particle below the canvas";
+      ASSERT_TRUE(pv.x[k].x >= 0.f && pv.x[k].x <= 256.f && pv.x[k].y >= 0.f && pv.x[k].y <= 256.f)
+          << "particle outside the canvas at " << pv.x[k].x << ", " << pv.x[k].y;
+    }
+  }
+  sim.settle();
+  EXPECT_LT(std::abs(sim.books().max_drift()), 1e-4);
+  EXPECT_NEAR(sim.census().total(), loaded, 1e-4 * loaded);
+  EXPECT_GT(footprint_of(sim, device_).columns, 0);
 }
 
 }  // namespace

@@ -72,6 +72,26 @@ WB_HD WB_INLINE Vec3 to_canvas(Vec3 t, Vec3 n, Vec3 b, Vec3 v) { return t * v.x 
 /// The canvas-frame update without adhesion (symplectic Euler): p'' = p + dt (v + dt a_k).
 WB_HD WB_INLINE Vec3 canvas_frame_step(Vec3 p, Vec3 v, Vec3 a_k, float dt) { return p + (v + a_k * dt) * dt; }
 
+/// Largest turn of a sample frame that carries particles in one step, radians.
+inline constexpr float kMaxFrameTurn = 0.5f;
+
+/// The part of a sample frame's rotation that paint around the bristle feels. A bristle is
+/// round: its Bishop frame's spin about the tangent t is a by-product of parallel transport
+/// along the moving curve, not a motion of the fibre, and at sharp bends it reached 2500 rad/s
+/// on a 16-cell brush, flinging particles up to D1 away around the bristle. Only the rotation
+/// that turns t is kept (omega - (omega . t) t, likewise alpha), capped at kMaxFrameTurn per step.
+WB_HD WB_INLINE SampleFrame physical_rotation(SampleFrame s, float dt) {
+  s.omega = s.omega - s.t * dot(s.omega, s.t);
+  s.alpha = s.alpha - s.t * dot(s.alpha, s.t);
+  const float turn = length(s.omega) * dt;
+  if (turn > kMaxFrameTurn) {
+    const float k = kMaxFrameTurn / turn;
+    s.omega = s.omega * k;
+    s.alpha = s.alpha * k;
+  }
+  return s;
+}
+
 /// Eq. 9, the local-frame update; returns p' in the canvas frame.
 /// The sample holds its state at the end of the brush step (t + dt), with velocities from
 /// position differences (v = dx/dt, a = dv/dt, rotation over the step = omega dt, as
@@ -81,7 +101,8 @@ WB_HD WB_INLINE Vec3 canvas_frame_step(Vec3 p, Vec3 v, Vec3 a_k, float dt) { ret
 ///   dv^l/dt = R_L a_k - beta_L (R_L a_j + w x (w x p^l) + R_L alpha_j x p^l + 2 w x v^l),  w = R_L omega_j,
 /// integrated by symplectic Euler, and p^l mapped back with the frame at t + dt.
 /// With beta_L = 0 and a_k = 0 a particle moving with the sample stays rigidly attached.
-WB_HD WB_INLINE Vec3 local_frame_step(Vec3 p, Vec3 v, Vec3 a_k, const SampleFrame& s, float beta_L, float dt) {
+WB_HD WB_INLINE Vec3 local_frame_step(Vec3 p, Vec3 v, Vec3 a_k, const SampleFrame& s_in, float beta_L, float dt) {
+  const SampleFrame s = physical_rotation(s_in, dt);
   // The frame at the start of the step.
   const Vec3 x0 = s.x - s.v * dt;
   const Vec3 v0 = s.v - s.a * dt;
@@ -113,10 +134,14 @@ WB_HD WB_INLINE Vec3 local_frame_step(Vec3 p, Vec3 v, Vec3 a_k, const SampleFram
 /// v = (p_new - p) / dt. `sample` may be null when no sample is near.
 WB_HD WB_INLINE void adhesion_update(Vec3& p, Vec3& v, const SampleFrame* sample, float d_B, const SolidView& solid,
                                      Vec3 gravity, float delta, float beta_L, float D1, float dt) {
-  const Vec3 a_k = gravity + friction_accel(v, solid_distance(solid, p), delta, dt);
+  const float d = solid_distance(solid, p);
+  const Vec3 a_k = gravity + friction_accel(v, d, delta, dt);
   const Vec3 p_canvas = canvas_frame_step(p, v, a_k, dt);
   Vec3 p_new = p_canvas;
-  const float w = adhesion_weight(d_B, D1);
+  // Paint the canvas holds (Eq. 8's weight) does not also follow a bristle: without this a
+  // particle lying on the canvas takes (1 - beta_L) of every jolt of a nearby sample's
+  // acceleration, and those jolts random-walk it away from the stroke (docs/PARTICLES.md).
+  const float w = adhesion_weight(d_B, D1) * (1.f - friction_weight(d, delta));
   if (sample && w > 0.f) p_new = p_canvas + (local_frame_step(p, v, a_k, *sample, beta_L, dt) - p_canvas) * w;
   // The particle cannot enter the solid; the projection only sees the solid on the grid.
   const float zs = solid_surface_z(solid, p_new);

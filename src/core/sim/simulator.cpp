@@ -1,5 +1,6 @@
 #include "core/sim/simulator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -109,6 +110,15 @@ void Simulator::settle() {
   grid_->window().flush();
 }
 
+float Simulator::effective_D0() const {
+  // The particle zone must end inside the window's kept box with room for the return margin:
+  // if D0 reached past it, no particle would ever be "beyond D0" and slow paint would stay
+  // particles for the whole stroke, drift, and be caught in the rim (docs/TRANSFER.md).
+  const Int3 n = grid_->window().dims();
+  const float room = 0.5f * float(std::min(n.x, n.y) - 2 * kKeepRim) - config_.params.transfer.return_margin;
+  return std::clamp(room, 0.f, config_.params.particles.D0);
+}
+
 TransferEnv Simulator::transfer_env() {
   ActiveWindow& win = grid_->window();
   TransferEnv env;
@@ -117,7 +127,7 @@ TransferEnv Simulator::transfer_env() {
   env.velocity = mac_view(win.velocity(0).data(), win.velocity(1).data(), win.velocity(2).data(), win);
   env.floor_z = config_.params.particles.floor_z;
   env.dry_threshold = config_.params.grid.dry_threshold;
-  env.D0 = config_.particles ? config_.params.particles.D0 : 0.f;
+  env.D0 = config_.particles ? effective_D0() : 0.f;
   // Particles live inside the window less a rim of kKeepRim cells (beyond the reach of Eq. 16's
   // kernel): one that enters the rim goes to the grid, and rim paint is never sampled into
   // particles, so nothing cycles between the two there (docs/TRANSFER.md).

@@ -90,6 +90,8 @@ class Simulator {
   void contain_nonfinite();
   void clamp_particles_to_canvas();
   TransferEnv transfer_env();
+  /// D0 of §5.2, limited so that the particle zone fits in the window (transfer_env).
+  float effective_D0() const;
 
   SimConfig config_;
   Profiler profiler_;
