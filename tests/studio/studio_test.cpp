@@ -176,11 +176,8 @@ class StudioTest : public QObject {
     w_->undo_stack()->clear();
   }
 
-  /// Grid-only paint (SimConfig::particles = false, the paper's Fig. 7a/c) on a new blank
-  /// canvas: where a mark lands and how wide it is are then set by the bristles' contact alone,
-  /// which is what the studio's input path (position, pressure) drives. With liquid particles
-  /// the simulator currently spreads part of the paint over the whole active window
-  /// (docs/STUDIO.md, "Tests"); the other tests run with particles.
+  /// A new blank canvas, with liquid particles (the hybrid paint) or grid-only paint
+  /// (SimConfig::particles = false, the paper's Fig. 7a/c).
   void grid_only_canvas(bool grid_only) {
     on_sim(*w_, [grid_only](SimThread& s) {
       SimConfig c = s.config();
@@ -193,7 +190,7 @@ class StudioTest : public QObject {
   }
 
   void paintUnderPathOnly() {
-    grid_only_canvas(true);
+    grid_only_canvas(false);
     const float y0 = 60.f, x0 = 30.f, x1 = 130.f;
     stroke(y0, 0.8f, x0, x1);
     const std::vector<float> col = column_density(*w_);
@@ -218,7 +215,7 @@ class StudioTest : public QObject {
   }
 
   void pressureChangesWidth() {
-    grid_only_canvas(true);
+    grid_only_canvas(false);
     // Both strokes start with the same load: a clean brush dipped in the same well.
     const PaintLoad paint = w_->paint_panel()->current_paint();
     w_->clean_brush();
