@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
+#include "core/exec/memory.h"
 #include "core/io/document.h"
 #include "core/io/png.h"
 #include "core/io/stroke.h"
@@ -42,6 +43,8 @@ struct ReplayArgs {
   std::vector<std::string> sets;
   std::string params_file;
   bool quiet = false;
+  bool bench = false;  ///< `wetbrush bench`: no pictures; a per-stage timing table
+  std::string bench_json;
 };
 
 double median_of_differences(const std::vector<double>& a, const std::vector<double>& b) {
@@ -84,6 +87,46 @@ void apply_overrides(const ReplayArgs& a, Stroke& stroke) {
     stroke.paint.load = a.load;
   }
   if (a.no_reload) stroke.paint.reload_on_pen_down = false;
+}
+
+/// `wetbrush bench`: every profiler scope's median, 90th percentile and share of the step
+/// (the paper's Figure 12), the step rate against the stroke's own clock, and memory.
+void report_bench(const ReplayArgs& a, const Simulator& sim, const Stroke& stroke, const Device& device,
+                  int64_t steps) {
+  const Profiler& prof = sim.profiler();
+  const double step_ms = prof.median_ms("sim.step");
+  auto pct = [](std::vector<double> v, double q) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    return v[std::min(v.size() - 1, size_t(q * double(v.size())))];
+  };
+  const mem::Usage use = mem::usage(!device.is_cpu());
+  nlohmann::json stages = nlohmann::json::object();
+  std::printf("%s on %s: %lld steps, %lld particles at most\n", a.strokes.c_str(), device.to_string().c_str(),
+              static_cast<long long>(steps), static_cast<long long>(sim.counters().particles_max));
+  std::printf("%-28s %10s %10s %7s %6s\n", "stage", "median ms", "p90 ms", "calls", "step%");
+  for (const std::string& name : prof.names()) {
+    const std::vector<double>& v = prof.samples(name);
+    const double med = prof.median_ms(name), p90 = pct(v, 0.9);
+    std::printf("%-28s %10.3f %10.3f %7zu %5.1f%%\n", name.c_str(), med, p90, v.size(),
+                step_ms > 0 ? 100.0 * med / step_ms : 0.0);
+    stages[name] = {{"median_ms", med}, {"p90_ms", p90}, {"calls", v.size()}};
+  }
+  const double rate = step_ms > 0 ? 1e3 / step_ms : 0.0;
+  std::printf("step rate %.1f steps/s, %.2f x real time (dt %.4g s); %s memory %.1f MiB peak, %.1f MiB held\n",
+              rate, rate * stroke.dt, stroke.dt, device.is_cpu() ? "host" : "device",
+              double(use.peak) / 1048576.0, double(use.in_use) / 1048576.0);
+  if (!a.bench_json.empty()) {
+    nlohmann::json j{{"stroke", a.strokes},
+                     {"device", device.to_string()},
+                     {"steps", steps},
+                     {"particles_max", sim.counters().particles_max},
+                     {"step_rate", rate},
+                     {"real_time_factor", rate * stroke.dt},
+                     {"memory_peak_bytes", use.peak},
+                     {"stages", stages}};
+    write_text_file(a.bench_json, j.dump(2) + "\n");
+  }
 }
 
 int run_replay(const ReplayArgs& a) {
@@ -137,6 +180,7 @@ int run_replay(const ReplayArgs& a) {
   const auto t0 = std::chrono::steady_clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   double last_print = -1.0;
+  mem::reset_peak();
   while (replay.advance()) {
     const int64_t done = replay.steps_done();
     if (!a.frames_dir.empty() && done % a.every == 0) {
@@ -157,6 +201,10 @@ int run_replay(const ReplayArgs& a) {
   }
   if (progress) std::fprintf(stderr, "\n");
   const double wall_ms = elapsed() * 1e3;
+  if (a.bench) {
+    report_bench(a, sim, stroke, device, replay.steps_done());
+    return sim.counters().nonfinite_events ? 3 : 0;
+  }
   const int64_t particles_final = sim.particles().size();
 
   // The stroke is over: particles settle into the grid and the canvas holds the painting.
@@ -266,6 +314,20 @@ void register_replay(CLI::App& app) {
   sub->add_flag("-q,--quiet", args->quiet, "No progress or summary output");
   add_device_option(sub, args->device);
   set_action(sub, [args]() { return run_replay(*args); });
+
+  auto bench = std::make_shared<ReplayArgs>();
+  bench->bench = true;
+  CLI::App* b = app.add_subcommand(
+      "bench", "Time a stroke file's simulation per stage (median, p90, share of the step), its step rate and memory");
+  b->add_option("STROKES", bench->strokes, "Stroke file: wetbrush JSON or MyPaint dump")->required()->check(CLI::ExistingFile);
+  b->add_option("--json", bench->bench_json, "Also write the figures as JSON");
+  b->add_flag("--grid-only", bench->grid_only, "No particles: paint lives on the grid only");
+  b->add_option("--window", bench->window, "Active window size X,Y,Z in cells")->delimiter(',');
+  b->add_option("--set", bench->sets, "Set a parameter, id=value (see `wetbrush params`); repeatable");
+  b->add_option("--params", bench->params_file, "Read parameters from a JSON file");
+  add_device_option(b, bench->device);
+  bench->quiet = true;
+  set_action(b, [bench]() { return run_replay(*bench); });
 }
 
 }  // namespace wb::cli

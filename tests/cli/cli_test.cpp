@@ -46,7 +46,7 @@ TEST(Cli, EverySubcommandHasHelp) {
   const RunResult top = run_cli("--help");
   EXPECT_EQ(top.exit_code, 0) << top.output;
   // Every command that runs kernels takes --device; `params` only prints the table.
-  for (const char* sub : {"replay", "devices", "params", "solver-study"}) {
+  for (const char* sub : {"replay", "bench", "devices", "params", "solver-study"}) {
     const RunResult r = run_cli(std::string(sub) + " --help");
     EXPECT_EQ(r.exit_code, 0) << sub << ": " << r.output;
     if (std::string(sub) != "params")
@@ -103,6 +103,28 @@ TEST(Cli, ReplayWritesImageAndStats) {
   EXPECT_GT(j["timing_ms"]["step_median"].get<double>(), 0.0);
   EXPECT_TRUE(j["wall_ms"].is_number());
   EXPECT_FALSE(std::filesystem::is_empty(dir / "frames"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Cli, BenchReportsEveryStageTheStepRateAndMemory) {
+  const auto dir = temp_dir("bench");
+  const std::string out = (dir / "bench.json").string();
+  const RunResult r =
+      run_cli("bench --device cpu " + data("strokes/good/minimal.json") + " --window 32,32,8 --json " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* row : {"sim.step", "grid.advect", "brush.step", "step rate", "memory"})
+    EXPECT_NE(r.output.find(row), std::string::npos) << "no '" << row << "' in:\n" << r.output;
+  std::ifstream f(out);
+  const nlohmann::json j = nlohmann::json::parse(f);
+  EXPECT_GT(j["steps"].get<int>(), 0);
+  EXPECT_GT(j["step_rate"].get<double>(), 0.0);
+  EXPECT_GT(j["memory_peak_bytes"].get<double>(), 1e5) << "the window and the brush alone hold more";
+  const nlohmann::json& step = j["stages"]["sim.step"];
+  EXPECT_EQ(step["calls"].get<int>(), j["steps"].get<int>());
+  EXPECT_GE(step["p90_ms"].get<double>(), step["median_ms"].get<double>());
+  for (const auto& [name, st] : j["stages"].items())
+    EXPECT_LE(st["median_ms"].get<double>(), step["p90_ms"].get<double>() * 1.01 + 1e-3) << name << " longer than a step";
+  EXPECT_NE(run_cli("bench --device cpu " + data("strokes/bad/empty.json")).exit_code, 0);
   std::filesystem::remove_all(dir);
 }
 

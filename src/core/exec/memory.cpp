@@ -3,7 +3,9 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <mutex>
 #include <new>
+#include <unordered_map>
 
 #include "core/exec/dispatch.h"
 #if defined(WB_WITH_CUDA)
@@ -12,18 +14,61 @@
 #endif
 
 namespace wb::mem {
+namespace {
+// Allocation is never on the per-step path (buffers are sized once and grown geometrically),
+// so a mutex-guarded map is cheap enough for the books.
+struct Ledger {
+  std::mutex m;
+  std::unordered_map<const void*, size_t> size;
+  Usage use[2];
+};
+Ledger& ledger() {
+  static Ledger l;
+  return l;
+}
+void booked(const void* p, size_t bytes, bool cuda) {
+  Ledger& l = ledger();
+  std::lock_guard<std::mutex> lock(l.m);
+  l.size[p] = bytes;
+  Usage& u = l.use[cuda];
+  u.in_use += bytes;
+  if (u.in_use > u.peak) u.peak = u.in_use;
+}
+void unbooked(const void* p, bool cuda) noexcept {
+  Ledger& l = ledger();
+  std::lock_guard<std::mutex> lock(l.m);
+  const auto it = l.size.find(p);
+  if (it == l.size.end()) return;
+  l.use[cuda].in_use -= it->second;
+  l.size.erase(it);
+}
+}  // namespace
+
+Usage usage(bool cuda) {
+  Ledger& l = ledger();
+  std::lock_guard<std::mutex> lock(l.m);
+  return l.use[cuda];
+}
+
+void reset_peak() {
+  Ledger& l = ledger();
+  std::lock_guard<std::mutex> lock(l.m);
+  for (Usage& u : l.use) u.peak = u.in_use;
+}
 
 void* allocate(const Device& device, size_t bytes) {
   if (bytes == 0) bytes = 1;
   if (device.is_cpu()) {
     void* p = std::aligned_alloc(64, (bytes + 63) & ~size_t(63));
     if (!p) WB_THROW("out of host memory allocating " + std::to_string(bytes) + " bytes");
+    booked(p, bytes, false);
     return p;
   }
 #if defined(WB_WITH_CUDA)
   void* p = nullptr;
   device.activate();
   WB_CUDA_CHECK(cudaMalloc(&p, bytes));
+  booked(p, bytes, true);
   return p;
 #else
   detail::throw_no_cuda();
@@ -32,6 +77,7 @@ void* allocate(const Device& device, size_t bytes) {
 
 void release(const Device& device, void* ptr) noexcept {
   if (!ptr) return;
+  unbooked(ptr, !device.is_cpu());
   if (device.is_cpu()) {
     std::free(ptr);
     return;

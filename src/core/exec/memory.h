@@ -13,4 +13,13 @@ void copy_from_host(const Device& device, void* dev_dst, const void* host_src, s
 void copy_on_device(const Device& device, void* dst, const void* src, size_t bytes);
 void fill_zero(const Device& device, void* ptr, size_t bytes);
 
+/// Bytes held by live allocations of this module, per backend (CPU or all CUDA devices), and
+/// the most held at once since the last reset_peak: the memory figure of `wetbrush bench`.
+struct Usage {
+  size_t in_use = 0;
+  size_t peak = 0;
+};
+Usage usage(bool cuda);
+void reset_peak();
+
 }  // namespace wb::mem

@@ -52,6 +52,7 @@ class Simulator {
   Transfer& transfer() { return *transfer_; }
   const PaintBooks& books() const { return books_; }
   Profiler& profiler() { return profiler_; }
+  const Profiler& profiler() const { return profiler_; }
   const SimCounters& counters() const { return counters_; }
   Workspace& workspace() { return ws_; }
 

@@ -151,7 +151,7 @@ void Transfer::ensure_particles(int64_t n) { p_moved_.resize(size_t(n)); }
 
 TransferRecord Transfer::step(const SampleView& samples, BristleLoad& load, ParticleStore& particles,
                               const TransferEnv& env) {
-  WB_PROFILE_SCOPE("transfer");
+  WB_PROFILE_SCOPE("transfer.step");
   TransferRecord rec;
   rec.step = step_index_;
   {
