@@ -5,40 +5,17 @@
 #include <cstdint>
 
 #include "core/grid/grid_fields.h"
+#include "core/math/trilinear.h"
 #include "core/math/vec.h"
 
 namespace wb {
-
-WB_HD WB_INLINE int floor_to_int(float x) {
-  const int i = int(x);
-  return (x < float(i)) ? i - 1 : i;
-}
-
-/// Trilinear interpolation of a lattice of ex x ey x ez values whose node (i,j,k) sits at
-/// (i,j,k) + offset; the sample point is clamped into the lattice.
-WB_HD WB_INLINE float sample_lattice(const float* f, int ex, int ey, int ez, float gx, float gy, float gz) {
-  gx = clampf(gx, 0.f, float(ex - 1));
-  gy = clampf(gy, 0.f, float(ey - 1));
-  gz = clampf(gz, 0.f, float(ez - 1));
-  const int i0 = clampi(floor_to_int(gx), 0, ex - 1), j0 = clampi(floor_to_int(gy), 0, ey - 1),
-            k0 = clampi(floor_to_int(gz), 0, ez - 1);
-  const int i1 = i0 + 1 < ex ? i0 + 1 : i0, j1 = j0 + 1 < ey ? j0 + 1 : j0, k1 = k0 + 1 < ez ? k0 + 1 : k0;
-  const float fx = gx - float(i0), fy = gy - float(j0), fz = gz - float(k0);
-  auto at = [&](int i, int j, int k) { return f[(int64_t(k) * ey + j) * ex + i]; };
-  const float c00 = at(i0, j0, k0) * (1.f - fx) + at(i1, j0, k0) * fx;
-  const float c10 = at(i0, j1, k0) * (1.f - fx) + at(i1, j1, k0) * fx;
-  const float c01 = at(i0, j0, k1) * (1.f - fx) + at(i1, j0, k1) * fx;
-  const float c11 = at(i0, j1, k1) * (1.f - fx) + at(i1, j1, k1) * fx;
-  return (c00 * (1.f - fy) + c10 * fy) * (1.f - fz) + (c01 * (1.f - fy) + c11 * fy) * fz;
-}
 
 /// One MAC component c at point p (window cells): the lattice of component c is offset by
 /// half a cell on the two other axes.
 WB_HD WB_INLINE float sample_component(const float* f, const GridDims& d, int c, Vec3 p) {
   int ex, ey, ez;
   d.face_extent(c, ex, ey, ez);
-  return sample_lattice(f, ex, ey, ez, c == 0 ? p.x : p.x - 0.5f, c == 1 ? p.y : p.y - 0.5f,
-                        c == 2 ? p.z : p.z - 0.5f);
+  return sample_nodes(f, ex, ey, ez, c == 0 ? 0.f : 0.5f, c == 1 ? 0.f : 0.5f, c == 2 ? 0.f : 0.5f, p);
 }
 
 /// Trilinear sample of the staggered velocity at p (window cells), cells/s. Used by
@@ -74,12 +51,9 @@ struct CellStencil {
   float wgt[8];
 };
 WB_HD WB_INLINE bool cell_stencil_fluid(const GridDims& d, const uint8_t* cls, Vec3 p, CellStencil& s) {
-  const float gx = clampf(p.x - 0.5f, 0.f, float(d.nx - 1)), gy = clampf(p.y - 0.5f, 0.f, float(d.ny - 1)),
-              gz = clampf(p.z - 0.5f, 0.f, float(d.nz - 1));
-  const int i0 = clampi(floor_to_int(gx), 0, d.nx - 1), j0 = clampi(floor_to_int(gy), 0, d.ny - 1),
-            k0 = clampi(floor_to_int(gz), 0, d.nz - 1);
-  const int i1 = i0 + 1 < d.nx ? i0 + 1 : i0, j1 = j0 + 1 < d.ny ? j0 + 1 : j0, k1 = k0 + 1 < d.nz ? k0 + 1 : k0;
-  const float fx = gx - float(i0), fy = gy - float(j0), fz = gz - float(k0);
+  const Stencil1 sx = stencil1(p.x, 0.5f, d.nx), sy = stencil1(p.y, 0.5f, d.ny), sz = stencil1(p.z, 0.5f, d.nz);
+  const int i0 = sx.i0, i1 = sx.i1, j0 = sy.i0, j1 = sy.i1, k0 = sz.i0, k1 = sz.i1;
+  const float fx = sx.w1, fy = sy.w1, fz = sz.w1;
   float total = 0.f;
   for (int n = 0; n < 8; ++n) {
     const int i = (n & 1) ? i1 : i0, j = (n & 2) ? j1 : j0, k = (n & 4) ? k1 : k0;

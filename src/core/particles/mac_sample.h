@@ -7,44 +7,10 @@
 #include <cstdint>
 
 #include "core/exec/hd.h"
+#include "core/math/trilinear.h"
 #include "core/math/vec.h"
 
 namespace wb {
-
-/// Trilinear stencil along one axis for nodes at (i + off), i in [0, n): the two node
-/// indices and the weight of the upper one. Outside the node range the stencil clamps to the
-/// end node (constant extension), so the two weights always sum to one.
-struct Stencil1 {
-  int i0, i1;
-  float w1;
-};
-WB_HD WB_INLINE Stencil1 stencil1(float q, float off, int n) {
-  const float s = q - off;
-  const float fl = floorf(s);
-  int i0 = int(fl);
-  float w1 = s - fl;
-  if (i0 < 0) {
-    i0 = 0;
-    w1 = 0.f;
-  } else if (i0 >= n - 1) {
-    i0 = n - 1;
-    w1 = 0.f;
-  }
-  return Stencil1{i0, i0 + 1 < n ? i0 + 1 : n - 1, w1};
-}
-
-/// Trilinear sample of one node grid of ex x ey x ez nodes at offsets (ox, oy, oz) cells.
-WB_HD WB_INLINE float sample_nodes(const float* f, int ex, int ey, int ez, float ox, float oy, float oz, Vec3 q) {
-  const Stencil1 sx = stencil1(q.x, ox, ex), sy = stencil1(q.y, oy, ey), sz = stencil1(q.z, oz, ez);
-  auto at = [&](int i, int j, int k) { return f[(int64_t(k) * ey + j) * ex + i]; };
-  const float c00 = at(sx.i0, sy.i0, sz.i0) * (1.f - sx.w1) + at(sx.i1, sy.i0, sz.i0) * sx.w1;
-  const float c10 = at(sx.i0, sy.i1, sz.i0) * (1.f - sx.w1) + at(sx.i1, sy.i1, sz.i0) * sx.w1;
-  const float c01 = at(sx.i0, sy.i0, sz.i1) * (1.f - sx.w1) + at(sx.i1, sy.i0, sz.i1) * sx.w1;
-  const float c11 = at(sx.i0, sy.i1, sz.i1) * (1.f - sx.w1) + at(sx.i1, sy.i1, sz.i1) * sx.w1;
-  const float c0 = c00 * (1.f - sy.w1) + c10 * sy.w1;
-  const float c1 = c01 * (1.f - sy.w1) + c11 * sy.w1;
-  return c0 * (1.f - sz.w1) + c1 * sz.w1;
-}
 
 /// Velocity of the MAC field (u, v, w) at q (window cells): each component trilinear on its
 /// own faces, clamped at the window's edges.
