@@ -10,6 +10,7 @@
 #include "core/particles/hash_grid.h"
 #include "core/particles/particle_store.h"
 #include "core/particles/particles.h"
+#include "bench_scene.h"
 #include "../tests/particles/sample_fixture.h"  // synthetic samples shared with the tests
 
 namespace {
@@ -52,17 +53,11 @@ struct Scene {
       }
     }
     ds.upload(hs);
-    // 210K particles: 90% within 8 cells of a random sample, 10% up to 40 cells away.
+    // 210K particles around the brush (bench_scene.h).
     ParticleHost ph;
     ph.resize(210000);
+    ph.x = bench::positions_around(hs.x, ph.size(), rng);
     for (size_t k = 0; k < ph.size(); ++k) {
-      const Vec3 s = hs.x[size_t(U(rng) * float(hs.x.size() - 1))];
-      const float reach = k % 10 == 0 ? 40.f : 8.f;
-      Vec3 o;
-      do o = Vec3(2.f * U(rng) - 1.f, 2.f * U(rng) - 1.f, 2.f * U(rng) - 1.f);
-      while (length2(o) > 1.f);
-      ph.x[k] = s + o * reach;
-      if (ph.x[k].z < 0.f) ph.x[k].z = -ph.x[k].z;
       ph.v[k] = Vec3(500.f, 0.f, 0.f);
       ph.m[k] = 1e-9f;
     }

@@ -13,6 +13,7 @@
 #include "core/particles/particle_store.h"
 #include "core/transfer/bristle_load.h"
 #include "core/transfer/transfer.h"
+#include "bench_scene.h"
 #include "../tests/particles/sample_fixture.h"  // synthetic samples shared with the tests
 
 namespace {
@@ -68,16 +69,10 @@ struct TransferScene {
           paint0[4][c] = 0.3f;
         }
     window.from_host(paint0);
-    // 210K particles: 90% within 8 cells of a random sample, 10% up to 40 cells away.
+    // 210K particles around the brush (bench_scene.h); every tenth, the far ones, at rest.
     particles0.resize(210000);
+    particles0.x = bench::positions_around(hs.x, particles0.size(), rng);
     for (size_t k = 0; k < particles0.size(); ++k) {
-      const Vec3 s = hs.x[size_t(U(rng) * float(hs.x.size() - 1))];
-      const float reach = k % 10 == 0 ? 40.f : 8.f;
-      Vec3 o;
-      do o = Vec3(2.f * U(rng) - 1.f, 2.f * U(rng) - 1.f, 2.f * U(rng) - 1.f);
-      while (length2(o) > 1.f);
-      particles0.x[k] = s + o * reach;
-      if (particles0.x[k].z < 0.f) particles0.x[k].z = -particles0.x[k].z;
       particles0.v[k] = k % 10 == 0 ? Vec3(0.f, 0.f, 0.f) : Vec3(500.f, 0.f, 0.f);
       particles0.m[k] = 3e-10f;
       particles0.pigment_r[k] = 1.f;
