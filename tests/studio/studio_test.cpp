@@ -87,16 +87,13 @@ std::vector<uint8_t> volume_bytes(MainWindow& w) {
   });
 }
 
-/// Painted width across the column x within rows [y0, y1): from the first to the last cell
-/// holding a mark (more than a twentieth of a cell of paint), 0 when there is none.
+/// Painted width across the column x within rows [y0, y1): the cells holding a mark (more than
+/// a twentieth of a cell of paint). Counted rather than spanned, so that a fleck thrown off at
+/// lift-off (docs/STUDIO.md) adds a cell, not the distance to it.
 int painted_width(const std::vector<float>& col, int width, int height, int x, int y0, int y1) {
-  int first = -1, last = -1;
-  for (int y = std::max(0, y0); y < std::min(height, y1); ++y)
-    if (col[size_t(y) * width + x] > 0.05f) {
-      if (first < 0) first = y;
-      last = y;
-    }
-  return first < 0 ? 0 : last - first + 1;
+  int n = 0;
+  for (int y = std::max(0, y0); y < std::min(height, y1); ++y) n += col[size_t(y) * width + x] > 0.05f;
+  return n;
 }
 
 }  // namespace
