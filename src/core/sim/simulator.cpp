@@ -132,9 +132,7 @@ TransferEnv Simulator::transfer_env() {
   // kernel): one that enters the rim goes to the grid, and rim paint is never sampled into
   // particles, so nothing cycles between the two there (docs/TRANSFER.md).
   const Int3 n = win.dims();
-  env.keep_box = true;
-  env.keep_lo = Int3{kKeepRim, kKeepRim, 0};
-  env.keep_hi = Int3{n.x - kKeepRim, n.y - kKeepRim, n.z - kKeepRimTop};
+  env.keep = KeepBox::of(Int3{kKeepRim, kKeepRim, 0}, Int3{n.x - kKeepRim, n.y - kKeepRim, n.z - kKeepRimTop});
   return env;
 }
 
@@ -244,8 +242,9 @@ void Simulator::deposit_leaving_particles(Int3 next, TransferRecord& rec) {
   if (next.x == cur.x && next.y == cur.y && next.z == cur.z) return;  // the step's own pass keeps the rim
   const int m = kKeepRim;
   TransferEnv env = transfer_env();  // z rim as in every step
-  env.keep_lo = Int3{std::max(cur.x, next.x) - cur.x + m, std::max(cur.y, next.y) - cur.y + m, 0};
-  env.keep_hi = Int3{std::min(cur.x, next.x) + n.x - cur.x - m, std::min(cur.y, next.y) + n.y - cur.y - m, n.z - kKeepRimTop};
+  env.keep = KeepBox::of(Int3{std::max(cur.x, next.x) - cur.x + m, std::max(cur.y, next.y) - cur.y + m, 0},
+                         Int3{std::min(cur.x, next.x) + n.x - cur.x - m, std::min(cur.y, next.y) + n.y - cur.y - m,
+                              n.z - kKeepRimTop});
   transfer_->update_distance(brush_->samples(), env);
   transfer_->particles_to_grid(particles_, env, rec);
   particles_.compact(ws_);

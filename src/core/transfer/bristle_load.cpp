@@ -44,6 +44,7 @@ BristleLoad::BristleLoad(const Device& device, int64_t samples, const TransferPa
   WB_BRISTLE_LOAD_FIELDS(WB_X)
 #undef WB_X
   scratch_.set_device(device);
+  ws_ = Workspace(device);
   scratch_.resize(size_t(samples));
   BristleLoadHost h;
 #define WB_X(name, doc) h.name.assign(size_t(samples), 0.f);
@@ -65,20 +66,16 @@ BristleLoadView BristleLoad::view() {
   return v;
 }
 
-double BristleLoad::fill(const PaintLoad& paint) {
-  validate(paint, "BristleLoad::fill");
-  if (count_ == 0) return 0.0;
-  d_dip(device_, view(), Vec3(paint.ryb[0], paint.ryb[1], paint.ryb[2]), paint.oil, paint.load, 1, scratch_.data());
-  Workspace ws(device_);
-  return reduce_sum(device_, scratch_.data(), count_, ws);
-}
+double BristleLoad::fill(const PaintLoad& paint) { return load(paint, true, "BristleLoad::fill"); }
 
-double BristleLoad::dip(const PaintLoad& paint) {
-  validate(paint, "BristleLoad::dip");
+double BristleLoad::dip(const PaintLoad& paint) { return load(paint, false, "BristleLoad::dip"); }
+
+double BristleLoad::load(const PaintLoad& paint, bool replace, const char* what) {
+  validate(paint, what);
   if (count_ == 0) return 0.0;
-  d_dip(device_, view(), Vec3(paint.ryb[0], paint.ryb[1], paint.ryb[2]), paint.oil, paint.load, 0, scratch_.data());
-  Workspace ws(device_);
-  return reduce_sum(device_, scratch_.data(), count_, ws);
+  d_dip(device_, view(), Vec3(paint.ryb[0], paint.ryb[1], paint.ryb[2]), paint.oil, paint.load, replace ? 1 : 0,
+        scratch_.data());
+  return reduce_sum(device_, scratch_.data(), count_, ws_);
 }
 
 double BristleLoad::wipe(float fraction) {
@@ -86,16 +83,14 @@ double BristleLoad::wipe(float fraction) {
              "BristleLoad::wipe: the fraction must lie in [0, 1], got " + std::to_string(fraction));
   if (count_ == 0) return 0.0;
   d_scale(device_, view(), 1.f - fraction, scratch_.data());
-  Workspace ws(device_);
-  return reduce_sum(device_, scratch_.data(), count_, ws);
+  return reduce_sum(device_, scratch_.data(), count_, ws_);
 }
 
 double BristleLoad::clean() {
   if (count_ == 0) return 0.0;
   // A fill with nothing: no load, no pigment (white), no oil.
   d_dip(device_, view(), Vec3(0.f, 0.f, 0.f), 0.f, 0.f, 1, scratch_.data());
-  Workspace ws(device_);
-  return -reduce_sum(device_, scratch_.data(), count_, ws);
+  return -reduce_sum(device_, scratch_.data(), count_, ws_);
 }
 
 double BristleLoad::total_mass(Workspace& ws) const { return reduce_sum(device_, m.data(), count_, ws); }

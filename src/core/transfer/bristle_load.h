@@ -83,9 +83,12 @@ class BristleLoad {
 #undef WB_X
 
  private:
+  /// fill (replace) and dip (top up and mix) in one pass: the kg added.
+  double load(const PaintLoad& paint, bool replace, const char* what);
   Device device_;
   int64_t count_ = 0;
   DeviceBuffer<float> scratch_;
+  Workspace ws_;  ///< reduction scratch of fill / dip / wipe / clean, kept between calls
 };
 
 }  // namespace wb

@@ -108,31 +108,27 @@ WB_HD WB_INLINE int for_each_kernel_cell(const PaintWindowView& pw, Vec3 q, floa
   const int i0 = imax_t(int(ceilf(q.x - 0.5f - h)), 0), i1 = imin_t(int(floorf(q.x - 0.5f + h)), pw.nx - 1);
   const int j0 = imax_t(int(ceilf(q.y - 0.5f - h)), 0), j1 = imin_t(int(floorf(q.y - 0.5f + h)), pw.ny - 1);
   const int k0 = imax_t(int(ceilf(q.z - 0.5f - h)), 0), k1 = imin_t(int(floorf(q.z - 0.5f + h)), pw.nz - 1);
+  // Every liquid-capable cell the tent touches, with its raw weight.
+  auto visit = [&](auto&& g) {
+    for (int k = k0; k <= k1; ++k)
+      for (int j = j0; j <= j1; ++j)
+        for (int i = i0; i <= i1; ++i) {
+          const float w = tent(q.x - (float(i) + 0.5f), h) * tent(q.y - (float(j) + 0.5f), h) *
+                          tent(q.z - (float(k) + 0.5f), h);
+          if (!(w > 0.f)) continue;
+          const int64_t id = pw.index(i, j, k);
+          if (!cell_is_solid(pw.density[id], pw.dryness[id], dry_threshold)) g(id, w);
+        }
+  };
   float sum = 0.f;
   int n = 0;
-  for (int k = k0; k <= k1; ++k)
-    for (int j = j0; j <= j1; ++j)
-      for (int i = i0; i <= i1; ++i) {
-        const float w = tent(q.x - (float(i) + 0.5f), h) * tent(q.y - (float(j) + 0.5f), h) *
-                        tent(q.z - (float(k) + 0.5f), h);
-        if (!(w > 0.f)) continue;
-        const int64_t id = pw.index(i, j, k);
-        if (cell_is_solid(pw.density[id], pw.dryness[id], dry_threshold)) continue;
-        sum += w;
-        ++n;
-      }
+  visit([&](int64_t, float w) {
+    sum += w;
+    ++n;
+  });
   if (!(sum > 0.f)) return 0;
   const float inv = 1.f / sum;
-  for (int k = k0; k <= k1; ++k)
-    for (int j = j0; j <= j1; ++j)
-      for (int i = i0; i <= i1; ++i) {
-        const float w = tent(q.x - (float(i) + 0.5f), h) * tent(q.y - (float(j) + 0.5f), h) *
-                        tent(q.z - (float(k) + 0.5f), h);
-        if (!(w > 0.f)) continue;
-        const int64_t id = pw.index(i, j, k);
-        if (cell_is_solid(pw.density[id], pw.dryness[id], dry_threshold)) continue;
-        f(id, w * inv);
-      }
+  visit([&](int64_t id, float w) { f(id, w * inv); });
   return n;
 }
 
@@ -189,12 +185,20 @@ WB_HD WB_INLINE void edt_line(const float* f, float* out, int n, int64_t stride,
 
 /// Coarse block grid of the bristle distance field: blocks of `block` cells over the window,
 /// extended by `margin` blocks on every side so that samples outside the window still count.
-/// Box of window cells [lo, hi) particles may live in (TransferEnv::keep_box); on == 0: all.
+/// Box of window cells [lo, hi) the particles may live in (TransferEnv::keep); on == 0: all
+/// of the window. Particles outside it go to the grid (Eq. 16) and cells outside it are never
+/// sampled into particles (Eq. 15): docs/TRANSFER.md, "The window's rim".
 struct KeepBox {
-  int on;
-  int lo[3], hi[3];
+  int on = 0;
+  int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  static KeepBox of(Int3 l, Int3 h) { return KeepBox{1, {l.x, l.y, l.z}, {h.x, h.y, h.z}}; }
   WB_HD bool contains(int i, int j, int k) const {
     return !on || (i >= lo[0] && j >= lo[1] && k >= lo[2] && i < hi[0] && j < hi[1] && k < hi[2]);
+  }
+  /// The same for a position in window cells.
+  WB_HD bool contains(Vec3 q) const {
+    return !on || (q.x >= float(lo[0]) && q.y >= float(lo[1]) && q.z >= float(lo[2]) && q.x < float(hi[0]) &&
+                   q.y < float(hi[1]) && q.z < float(hi[2]));
   }
 };
 

@@ -309,9 +309,7 @@ void Transfer::particles_to_grid(ParticleStore& particles, const TransferEnv& en
   acc.dryness = c_f32_[6].data();
   acc.moved = p_moved_.data();
   acc.counter = counters_.data();
-  acc.keep_on = env.keep_box ? 1 : 0;
-  acc.keep_lo[0] = env.keep_lo.x, acc.keep_lo[1] = env.keep_lo.y, acc.keep_lo[2] = env.keep_lo.z;
-  acc.keep_hi[0] = env.keep_hi.x, acc.keep_hi[1] = env.keep_hi.y, acc.keep_hi[2] = env.keep_hi.z;
+  acc.keep = env.keep;
   if (np > 0) {
     d_to_grid_mark(device_, particles.view(), env.paint, db, acc, params_, env.dry_threshold);
     d_to_grid_apply(device_, env.paint, acc);
@@ -321,6 +319,15 @@ void Transfer::particles_to_grid(ParticleStore& particles, const TransferEnv& en
   rec.to_grid_count = count;
   rec.to_grid_from_particles = reduce_sum(device_, p_moved_.data(), np, ws_);
   rec.to_grid_into_grid = reduce_sum(device_, acc.rho, nc, ws_) * double(params_.cell_mass());
+}
+
+int64_t Transfer::make_room(ParticleStore& particles, const uint32_t* count, uint32_t* offset, int64_t n,
+                            int64_t& first, int64_t& dropped) {
+  const int64_t total = int64_t(exclusive_scan(device_, count, offset, n, ws_));
+  const int64_t n_new = std::min(total, std::max<int64_t>(particles.limit() - particles.size(), 0));
+  dropped = total - n_new;
+  if (n_new > 0) first = particles.append_uninitialised(n_new);
+  return n_new;
 }
 
 void Transfer::emit(const SampleView& samples, BristleLoad& load, ParticleStore& particles, const TransferEnv& env,
@@ -336,12 +343,9 @@ void Transfer::emit(const SampleView& samples, BristleLoad& load, ParticleStore&
   float* mass_each = s_f32_[0].data();
   float* emitted = s_f32_[1].data();
   d_emit_count(device_, lv, params_, count, mass_each);
-  const int64_t total = int64_t(exclusive_scan(device_, count, offset, ns, ws_));
-  const int64_t room = std::max<int64_t>(particles.limit() - particles.size(), 0);
-  const int64_t n_new = std::min(total, room);
-  rec.emission_dropped = total - n_new;
+  int64_t first = 0;
+  const int64_t n_new = make_room(particles, count, offset, ns, first, rec.emission_dropped);
   if (n_new == 0) return;
-  const int64_t first = particles.append_uninitialised(n_new);
   const ParticleView pv = particles.view();
   d_emit_fill(device_, samples, lv, pv, offset, count, mass_each, first, n_new, step_index_, params_, env.floor_z,
               emitted);
@@ -358,15 +362,10 @@ void Transfer::grid_to_particles(ParticleStore& particles, const TransferEnv& en
   ensure_cells(nc);
   uint32_t* count = c_u32_[0].data();
   uint32_t* offset = c_u32_[1].data();
-  KeepBox keep{env.keep_box ? 1 : 0, {env.keep_lo.x, env.keep_lo.y, env.keep_lo.z},
-               {env.keep_hi.x, env.keep_hi.y, env.keep_hi.z}};
-  d_grid_count(device_, env.paint, db, keep, params_, env.dry_threshold, count);
-  const int64_t total = int64_t(exclusive_scan(device_, count, offset, nc, ws_));
-  const int64_t room = std::max<int64_t>(particles.limit() - particles.size(), 0);
-  const int64_t n_new = std::min(total, room);
-  rec.to_particles_dropped = total - n_new;
+  d_grid_count(device_, env.paint, db, env.keep, params_, env.dry_threshold, count);
+  int64_t first = 0;
+  const int64_t n_new = make_room(particles, count, offset, nc, first, rec.to_particles_dropped);
   if (n_new == 0) return;
-  const int64_t first = particles.append_uninitialised(n_new);
   const ParticleView pv = particles.view();
   float* demand = c_f32_[0].data();
   float* removed = c_f32_[1].data();

@@ -31,11 +31,9 @@ struct TransferEnv {
   float dry_threshold = 0.95f; ///< dryness at which paint is solid (GridParams::dry_threshold)
   float D0 = 50.f;             ///< particle range around the bristles, cells (ParticleParams::D0)
   float dt = 0.f;              ///< step length, s, for the wicking along the bristles (0: none)
-  /// Window box (window cells, [keep_lo, keep_hi)) the particles may stay in: with keep_box on,
-  /// particles outside it go to the grid by Eq. 16 whatever their speed or distance to the
-  /// bristles, because the window is about to move and leave them outside (docs/TRANSFER.md).
-  bool keep_box = false;
-  Int3 keep_lo{}, keep_hi{};
+  /// Window box the particles may stay in (off: the whole window); the simulator sets it every
+  /// step and, before the window moves, to the part that stays (docs/TRANSFER.md).
+  KeepBox keep{};
 };
 
 /// What one step's transfers moved, kg, each measured on both sides (source / destination),
@@ -96,8 +94,7 @@ struct DepositScratch {
   float* dryness;
   float* moved;    ///< per particle: mass sent to the grid
   int32_t* counter;
-  int keep_on;              ///< 1: particles outside [keep_lo, keep_hi) are deposited regardless
-  int keep_lo[3], keep_hi[3];
+  KeepBox keep;             ///< particles outside it are deposited regardless (TransferEnv::keep)
 };
 
 class Transfer {
@@ -139,6 +136,11 @@ class Transfer {
   std::vector<float> distance_to_host();
 
  private:
+  /// Slots for new particles: offsets = exclusive scan of the per-source counts; as many as the
+  /// store's limit allows are appended at `first` (sources served in index order), the rest
+  /// counted in `dropped`. Returns the number appended.
+  int64_t make_room(ParticleStore& particles, const uint32_t* count, uint32_t* offset, int64_t n, int64_t& first,
+                    int64_t& dropped);
   void ensure_samples(int64_t n);
   void ensure_cells(int64_t n);
   void ensure_particles(int64_t n);

@@ -217,14 +217,12 @@ void transfer_to_grid_mark(ParticleView p, PaintWindowView pw, DistanceBlocks db
     Vec3 q(x.x - float(pw.ox), x.y - float(pw.oy), x.z - float(pw.oz));
     if (!(q.x >= 0.f && q.y >= 0.f && q.z >= 0.f && q.x < float(pw.nx) && q.y < float(pw.ny) && q.z < float(pw.nz))) {
       // Outside the window (flew out in one step): only the keep-box pass takes it, at the edge.
-      if (!acc.keep_on || !isfinite3(q)) return;
+      if (!acc.keep.on || !isfinite3(q)) return;
       q = Vec3(clampf(q.x, 0.5f, float(pw.nx) - 0.5f), clampf(q.y, 0.5f, float(pw.ny) - 0.5f),
                clampf(q.z, 0.5f, float(pw.nz) - 0.5f));
     }
     // Leaving the window's next box: back to the grid now, or it would be outside every field.
-    const bool leaving = acc.keep_on && (q.x < float(acc.keep_lo[0]) || q.y < float(acc.keep_lo[1]) ||
-                                         q.z < float(acc.keep_lo[2]) || q.x >= float(acc.keep_hi[0]) ||
-                                         q.y >= float(acc.keep_hi[1]) || q.z >= float(acc.keep_hi[2]));
+    const bool leaving = !acc.keep.contains(q);
     if (!leaving && (!(length2(p.v[k]) < slow2) || db.near(q, margin))) return;
     const Vec3 ck(p.pigment_r[k], p.pigment_y[k], p.pigment_b[k]);
     const float bk = pigment_brightness(ck), oil = p.oil[k], dry = p.dryness[k];
