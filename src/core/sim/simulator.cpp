@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "core/exec/algorithms.h"
 #include "core/particles/particles.h"
@@ -16,6 +15,8 @@ namespace {
 constexpr int kKeepRim = 8;
 /// Rim under the window's lid, cells: paint rises slowly, the kernel of Eq. 16 needs 3.
 constexpr int kKeepRimTop = 3;
+/// An empty keep box: every particle goes to the grid (settle, grid-only paint).
+KeepBox nowhere() { return KeepBox::of(Int3{}, Int3{}); }
 }  // namespace
 namespace {
 
@@ -44,12 +45,6 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
   hash_ = SampleHashGrid(d);
   load_ = std::make_unique<BristleLoad>(d, brush_->sample_count(), config_.params.transfer);
   transfer_ = std::make_unique<Transfer>(d, config_.params.transfer);
-  if (!config_.particles) {
-    // Grid-only paint (Fig. 7a/c): with D0 = 0 (transfer_env) and the fastest valid "slow"
-    // speed (2 m/s), emitted paint goes straight to the grid on the next step.
-    transfer_->params().slow_speed = 1e4f;
-  }
-
   const GridDims g = grid_->dims();
   auto cells = [&](DeviceBuffer<float>& b) {
     b.set_device(d);
@@ -92,11 +87,10 @@ void Simulator::dry_canvas() {
 
 void Simulator::settle() {
   if (particles_.size() > 0) {
-    // Every particle, slow or not and near the bristles or not, goes back by Eq. 16.
-    TransferParams& tp = transfer_->params();
-    const float slow = tp.slow_speed;
-    tp.slow_speed = std::numeric_limits<float>::infinity();
+    // Every particle, slow or not and near the bristles or not, goes back by Eq. 16: none may
+    // stay anywhere.
     TransferEnv env = transfer_env();
+    env.keep = nowhere();
     env.D0 = 0.f;
     SampleView none = brush_->samples();
     none.bristles = 0;  // no bristles: every particle is far from them
@@ -104,7 +98,6 @@ void Simulator::settle() {
     transfer_->update_distance(none, env);
     transfer_->particles_to_grid(particles_, env, rec);
     particles_.compact(ws_);
-    tp.slow_speed = slow;
     books_.record(rec, census());
   }
   grid_->window().flush();
@@ -133,6 +126,9 @@ TransferEnv Simulator::transfer_env() {
   // particles, so nothing cycles between the two there (docs/TRANSFER.md).
   const Int3 n = win.dims();
   env.keep = KeepBox::of(Int3{kKeepRim, kKeepRim, 0}, Int3{n.x - kKeepRim, n.y - kKeepRim, n.z - kKeepRimTop});
+  // Grid-only paint (Fig. 7a/c): particles may live nowhere, so what the bristles emit goes to
+  // the grid on the next step and no cell is sampled into particles.
+  if (!config_.particles) env.keep = nowhere();
   return env;
 }
 
