@@ -1,10 +1,53 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds (CPU and, when nvcc exists, CUDA backends) and runs every test.
+# Installs what is missing, checks the install list, builds every product (CLI, tests,
+# benchmarks, studio; CPU and, when nvcc exists, CUDA backends), runs every test and ends with a
+# summary: the products built and the tests per group (core, cli, studio). Fails when a test
+# fails or a group has no test.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 wb_install_deps
+"$WB_ROOT/scripts/check-packages.sh"
 wb_build
 cd "$WB_BUILD"
 # Two test processes share the two cores: OpenMP threads must sleep, not spin, while they wait.
 export OMP_WAIT_POLICY="${OMP_WAIT_POLICY:-PASSIVE}"
-ctest --output-on-failure --parallel "$(nproc)" --timeout 900
+junit="$WB_BUILD/ctest-results.xml"
+rm -f "$junit"
+set +e
+ctest --output-on-failure --parallel "$(nproc)" --timeout 900 --output-junit "$junit"
+ctest_rc=$?
+set -e
+
+# --- summary ---------------------------------------------------------------------------------
+echo
+echo "== wetbrush test summary =="
+ok=1
+products=()
+for p in wetbrush wetbrush_tests wetbrush_bench wetbrush-studio wetbrush_studio_tests; do
+  if [ -x "$WB_BUILD/bin/$p" ]; then products+=("$p"); else echo "MISSING product: bin/$p"; ok=0; fi
+done
+cuda=$(sed -n 's/^WB_CUDA:STRING=//p' "$WB_BUILD/CMakeCache.txt")
+echo "products built: ${products[*]} (CUDA backend: ${cuda:-OFF})"
+# Status of every test case from CTest's JUnit file: name<TAB>status (run, fail, notrun, ...).
+statuses=$(sed -n 's/.*<testcase name="\([^"]*\)".*status="\([^"]*\)".*/\1\t\2/p' "$junit" 2>/dev/null || true)
+total_pass=0 total_fail=0 total_skip=0
+for group in core cli studio; do
+  names=$(ctest -N -L "^${group}\$" | sed -n 's/^ *Test *#[0-9]*: //p')
+  n=0 pass=0 fail=0 skip=0
+  while IFS= read -r name; do
+    [ -n "$name" ] || continue
+    n=$((n + 1))
+    st=$(printf '%s\n' "$statuses" | awk -F'\t' -v t="$name" '$1 == t { print $2; exit }')
+    case "$st" in
+      run) pass=$((pass + 1)) ;;
+      fail | "") fail=$((fail + 1)) ;;
+      *) skip=$((skip + 1)) ;;
+    esac
+  done <<< "$names"
+  printf '  %-7s %4d tests: %d passed, %d failed, %d skipped\n' "$group" "$n" "$pass" "$fail" "$skip"
+  if [ "$n" -eq 0 ]; then echo "  ERROR: the $group group has no tests"; ok=0; fi
+  total_pass=$((total_pass + pass)) total_fail=$((total_fail + fail)) total_skip=$((total_skip + skip))
+done
+if [ "$ctest_rc" -ne 0 ] || [ "$total_fail" -ne 0 ]; then ok=0; fi
+echo "summary: $total_pass passed, $total_fail failed, $total_skip skipped"
+[ "$ok" -eq 1 ] || { echo "wetbrush: tests FAILED"; exit 1; }

@@ -1,7 +1,8 @@
 // Studio tests (Qt Test, run under xvfb-run for Mesa OpenGL): the window opens with an OpenGL
 // canvas; synthesised tablet strokes paint under their path only; pressure widens the stroke;
 // undo / redo restore the exact canvas; save then open gives the same volume; a recorded
-// session replays to the same canvas; closing with unsaved changes asks.
+// session replays to the same canvas; closing with unsaved changes asks. Each test function
+// stands alone: CTest runs each in a process of its own (cmake/StudioTests.cmake).
 #include <QApplication>
 #include <QElapsedTimer>
 #include <QFile>
@@ -266,6 +267,8 @@ class StudioTest : public QObject {
   }
 
   void saveThenOpenGivesSameVolume() {
+    grid_only_canvas(false);
+    stroke(50.f, 0.6f);
     const std::vector<uint8_t> now = volume_bytes(*w_);
     QVERIFY(now.size() > 0);
     const QString path = dir_.path() + "/painting.ora";
