@@ -29,7 +29,8 @@ done
 cuda=$(sed -n 's/^WB_CUDA:STRING=//p' "$WB_BUILD/CMakeCache.txt")
 echo "products built: ${products[*]} (CUDA backend: ${cuda:-OFF})"
 # Status of every test case from CTest's JUnit file: name<TAB>status (run, fail, notrun, ...).
-statuses=$(sed -n 's/.*<testcase name="\([^"]*\)".*status="\([^"]*\)".*/\1\t\2/p' "$junit" 2>/dev/null || true)
+statuses=$(sed -n 's/.*<testcase name="\([^"]*\)".*status="\([^"]*\)".*/\1\t\2/p' "$junit" 2>/dev/null |
+  sed 's/&lt;/</g; s/&gt;/>/g; s/&quot;/"/g; s/&apos;/'"'"'/g; s/&amp;/\&/g' || true)
 total_pass=0 total_fail=0 total_skip=0
 for group in core cli studio; do
   names=$(ctest -N -L "^${group}\$" | sed -n 's/^ *Test *#[0-9]*: //p')
