@@ -129,6 +129,46 @@ TEST_F(BrushSamplesTest, RigidMotionGivesSampleVelocitiesAndFrameRotation) {
   EXPECT_LT(worst_a, 5.0);
 }
 
+TEST_F(BrushSamplesTest, SampleMotionIsTheWholeStepsWhateverTheSubsteps) {
+  // A brush accelerating along x (v = a t): the samples' v, a over a step are the step's own
+  // (v dt = the step's displacement), not the last sub-step's, so 1 and 8 sub-steps agree and
+  // Eq. 9's rewind x - v dt lands on the step's start.
+  BrushSpec spec = default_brush(BrushShape::Round);
+  spec.beta_B = 0.f;
+  BrushEnvironment env;
+  env.gravity = Vec3();
+  const float acc = 6000.f;  // cells/s^2
+  auto run = [&](int substeps) {
+    Brush brush(device_, spec, make_pose(Vec3(250, 250, 200)));
+    std::vector<BrushPose> poses(static_cast<size_t>(substeps), make_pose(Vec3(250, 250, 200)));
+    std::vector<Vec3> start;
+    for (int s = 1; s <= 6; ++s) {
+      for (int k = 0; k < substeps; ++k) {
+        const float t = (float(s - 1) + float(k + 1) / float(substeps)) * kDt;
+        poses[size_t(k)] = make_pose(Vec3(250 + 0.5f * acc * t * t, 250, 200));
+      }
+      start = brush.samples_to_host();
+      brush.step(poses.data(), substeps, kDt, env);
+    }
+    const auto f = brush.sample_fields_to_host();
+    double rewind = 0;
+    for (size_t q = 0; q < f[kX].size(); ++q) rewind = std::max(rewind, double(length(f[kX][q] - f[kV][q] * kDt - start[q])));
+    return std::make_tuple(f, rewind);
+  };
+  const auto [one, rewind_one] = run(1);
+  const auto [eight, rewind_eight] = run(8);
+  EXPECT_LT(rewind_one, 1e-3);
+  EXPECT_LT(rewind_eight, 1e-3) << "x - v dt is the sample at the step's start";
+  double dv = 0, da = 0;
+  for (size_t q = 0; q < one[kV].size(); ++q) {
+    dv = std::max(dv, double(length(one[kV][q] - eight[kV][q])));
+    da = std::max(da, double(length(one[kA][q] - eight[kA][q])));
+  }
+  // Over 6 steps the brush reaches 6 * 100 = 600 cells/s; its acceleration is 6000 cells/s^2.
+  EXPECT_LT(dv, 0.01 * 600) << "sample velocity independent of the sub-step count";
+  EXPECT_LT(da, 0.05 * acc) << "sample acceleration independent of the sub-step count";
+}
+
 TEST_F(BrushSamplesTest, RasterisedPsiHoldsTheBristleVolumeAndVelocity) {
   BrushSpec spec = default_brush(BrushShape::Round);
   spec.beta_B = 0.f;

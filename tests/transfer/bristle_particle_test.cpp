@@ -27,6 +27,60 @@ TEST(TransferCapacity, PotentialCapacityFallsWithPsiAndClampsAtMin) {
   EXPECT_FLOAT_EQ(potential_capacity(0.9f, 1.f, p.M_max, p.M_min), p.M_min);
 }
 
+TEST(TransferSweep, SegmentAreaMatchesNumericIntegration) {
+  // A(R, r) = area of the disc of radius R beyond the chord at distance r: 2 int_r^R sqrt(R^2 - z^2) dz.
+  const float R = 0.75f;
+  for (float r : {-0.5f, 0.f, 0.2f, 0.5f, 0.74f}) {
+    double num = 0;
+    const int n = 20000;
+    for (int i = 0; i < n; ++i) {
+      const double z = r + (R - r) * (i + 0.5) / n;
+      num += 2.0 * std::sqrt(std::max(double(R) * R - z * z, 0.0)) * (R - r) / n;
+    }
+    EXPECT_NEAR(segment_area(R, r), num, 1e-4) << "r " << r;
+  }
+  EXPECT_FLOAT_EQ(segment_area(R, R), 0.f);
+  EXPECT_FLOAT_EQ(segment_area(R, 2.f), 0.f);
+}
+
+TEST(TransferSweep, DepositScalesWithDistanceSlidNotSteps) {
+  const TransferParams p;
+  const float cm = p.cell_mass(), m = p.M_max, split = 0.5f;
+  // Proportional to the distance slid: one step of 4 cells leaves what two of 2 cells leave.
+  const float one = swept_deposit(m, 0.f, 4.f, split, cm);
+  const float half = swept_deposit(m, 0.f, 2.f, split, cm);
+  EXPECT_NEAR(one, 2.f * half, 1e-6f * one);
+  EXPECT_NEAR(one, split * cm * segment_area(load_radius(m, cm), 0.f) * 4.f, 1e-6f * one);
+  // Not sliding, or not reaching the surface (a light load's sphere above it), leaves nothing.
+  EXPECT_EQ(swept_deposit(m, 0.f, 0.f, split, cm), 0.f);
+  EXPECT_EQ(swept_deposit(0.01f * m, 0.5f, 4.f, split, cm), 0.f) << "dry brush: the paint does not reach";
+  EXPECT_GT(swept_deposit(m, 0.5f, 4.f, split, cm), 0.f);
+  // Never more than the load.
+  EXPECT_LE(swept_deposit(m, 0.f, 1e4f, split, cm), m);
+  // split = 0 is the paper's model: nothing leaves by sliding.
+  EXPECT_EQ(swept_deposit(m, 0.f, 4.f, 0.f, cm), 0.f);
+}
+
+TEST(TransferSweep, ParticlesLayTheTrailAlongThePath) {
+  float me = 0.f;
+  // At most two particles per cell slid, each at most emit_mass.
+  EXPECT_EQ(swept_count(1e-8f, 3.f, 1e-9f, me), 6);
+  EXPECT_NEAR(me * 6.f, 1e-8f, 1e-14f);
+  EXPECT_EQ(swept_count(2.5e-9f, 10.f, 1e-9f, me), 3);
+  EXPECT_LE(me, 1e-9f);
+  // Positions run from the step's start x - v dt to its end, above the surface.
+  const Vec3 x(100.f, 50.f, 2.f), vt(600.f, 0.f, 0.f);
+  const float dt = 1.f / 60.f;
+  float lo = 1e9f, hi = -1e9f;
+  for (int i = 0; i < 10; ++i) {
+    const Vec3 q = swept_position(x, vt, dt, 0.5f, 1.5f, i, 10, emission_pattern_point(i, 16), 0.f);
+    lo = std::min(lo, q.x), hi = std::max(hi, q.x);
+    EXPECT_NEAR(q.z, 2.f - 1.5f + 0.25f, 1e-5f);
+  }
+  EXPECT_LT(lo, x.x - 0.8f * 10.f);
+  EXPECT_GT(hi, x.x - 0.2f * 10.f);
+}
+
 TEST(TransferCapacity, CapFormulaMatchesNumericIntegration) {
   // The cap beyond a plane at distance r from the centre: integral_r^R pi (R^2 - z^2) dz.
   for (float R : {0.3f, 0.75f, 2.f}) {

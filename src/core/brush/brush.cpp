@@ -92,7 +92,7 @@ Brush::Brush(const Device& device, const BrushSpec& spec, const BrushPose& pose,
   WB_REQUIRE(params.iterations >= 1 && params.iterations <= 100, "brush solver: iterations must be in 1..100");
   WB_REQUIRE(params.density_iterations >= 0 && params.density_iterations <= 20,
              "brush solver: density_iterations must be in 0..20");
-  WB_REQUIRE(params.damping >= 0.f && params.damping <= 1.f, "brush solver: damping must be in [0, 1]");
+  WB_REQUIRE(params.damping >= 0.f && params.damping <= 1000.f, "brush solver: damping must be in [0, 1000] 1/s");
   check_pose(pose, "Brush");
   device_.activate();
 
@@ -201,10 +201,11 @@ void Brush::reset(const BrushPose& pose) {
   update_samples(1.f, f, SolidField{});  // at rest: the canvas plane only
 }
 
-void Brush::step(const BrushPose& pose, float dt, const BrushEnvironment& env) {
+void Brush::step(const BrushPose* poses, int substeps, float dt, const BrushEnvironment& env) {
   WB_PROFILE_SCOPE("brush.step");
+  WB_REQUIRE(poses && substeps >= 1, "Brush::step: needs at least one sub-step pose");
   WB_REQUIRE(std::isfinite(dt) && dt > 0.f && dt <= 1.f, "Brush::step: dt must be in (0, 1] s (got " + std::to_string(dt) + ")");
-  check_pose(pose, "Brush::step");
+  for (int k = 0; k < substeps; ++k) check_pose(poses[k], "Brush::step");
   WB_REQUIRE(env.friction >= 0.f && env.friction <= 1.f, "Brush::step: friction must be in [0, 1]");
   WB_REQUIRE(isfinite3(env.gravity), "Brush::step: gravity is not finite");
   if (env.drag) {
@@ -217,6 +218,15 @@ void Brush::step(const BrushPose& pose, float dt, const BrushEnvironment& env) {
     WB_REQUIRE(env.solid.tiles.slot_of_tile && env.solid.tiles.density && env.solid.tiles.dryness,
                "Brush::step: solid field is marked valid but has no tile store");
 
+  const float dt_sub = dt / float(substeps);
+  BrushFrame f{};
+  for (int k = 0; k < substeps; ++k) f = substep(poses[k], dt_sub, env);
+  // The samples once per step, with the motion made over the whole step.
+  WB_PROFILE_SCOPE("brush.samples");
+  update_samples(dt, f, env.solid);
+}
+
+BrushFrame Brush::substep(const BrushPose& pose, float dt, const BrushEnvironment& env) {
   // Motion of the brush frame (Eq. 2): linear and angular velocity from consecutive poses,
   // their rates from the previous step's.
   BrushFrame f = frame_for(pose);
@@ -237,7 +247,7 @@ void Brush::step(const BrushPose& pose, float dt, const BrushEnvironment& env) {
   const BristleRest r = rest_view();
   {
     WB_PROFILE_SCOPE("brush.integrate");
-    brush_integrate_on(device_, s, r, f, forces, spec_.beta_B, params_.damping, dt);
+    brush_integrate_on(device_, s, r, f, forces, spec_.beta_B, 1.f - std::exp(-params_.damping * dt), dt);
   }
   {
     WB_PROFILE_SCOPE("brush.constraints");
@@ -267,8 +277,7 @@ void Brush::step(const BrushPose& pose, float dt, const BrushEnvironment& env) {
     frame_omega_B_ = omega_B;
   }
   pose_ = pose;
-  WB_PROFILE_SCOPE("brush.samples");
-  update_samples(dt, f, env.solid);
+  return f;
 }
 
 void Brush::apply_min_density(int iterations) {

@@ -32,7 +32,9 @@ struct BrushEnvironment {
 struct BrushSolverParams {
   int iterations = 8;               ///< Gauss-Seidel sweeps per step (bending, length, collision)
   int density_iterations = 4;       ///< minimum-density Jacobi iterations per step (0 = off)
-  float damping = 0.1f;             ///< fraction of the brush-frame velocity removed per step
+  /// Decay rate of the brush-frame velocity, 1/s: v^B loses 1 - exp(-damping dt) over a
+  /// (sub-)step of dt, so the decay per second is the same whatever the sub-step count.
+  float damping = 25.f;
   float min_spacing = -1.f;         ///< s_min, cells; < 0: 2 * bristle_radius, capped by the rest spacing
 };
 
@@ -62,9 +64,14 @@ class Brush {
   /// Puts the bristles back at rest at `pose`, forgetting all motion.
   void reset(const BrushPose& pose);
 
-  /// One step: brush-frame dynamics (Eq. 2), constraints, collisions, then the samples.
-  /// Allocates nothing. A non-finite result is rolled back (see stats().nonfinite).
-  void step(const BrushPose& pose, float dt, const BrushEnvironment& env);
+  /// One step of length dt in `substeps` equal sub-steps ending at poses[0..substeps):
+  /// brush-frame dynamics (Eq. 2), constraints and collisions per sub-step, then the samples
+  /// once, with the motion they made over the whole step (v, omega from the step's start and
+  /// end states, a, alpha from the previous step's), so that Eq. 9's rewind x - v dt is exact
+  /// whatever the sub-step count. Allocates nothing. A non-finite sub-step is rolled back
+  /// (see stats().nonfinite).
+  void step(const BrushPose* poses, int substeps, float dt, const BrushEnvironment& env);
+  void step(const BrushPose& pose, float dt, const BrushEnvironment& env) { step(&pose, 1, dt, env); }
 
   /// Bristle density psi (occupied volume fraction, clamped to 1) and the psi-weighted
   /// mean bristle velocity (cells/s) on the cell-centred window at `window_origin`, sized
@@ -92,6 +99,8 @@ class Brush {
   std::vector<std::vector<Vec3>> sample_fields_to_host() const;
 
  private:
+  /// One sub-step of length dt ending at `pose`; returns the brush frame it ended in.
+  BrushFrame substep(const BrushPose& pose, float dt, const BrushEnvironment& env);
   BristleState state_view();
   BristleRest rest_view() const;
   SamplePrev prev_view();

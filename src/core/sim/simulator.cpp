@@ -255,7 +255,6 @@ SolidField Simulator::solid_field() {
 }
 
 void Simulator::brush_stage(const BrushPose* poses, int substeps, float dt) {
-  const float dt_sub = dt / float(substeps);
   ActiveWindow& win = grid_->window();
   const int64_t rollbacks_before = brush_->stats().nonfinite;
   // The grid velocity kept from the last step drags the bristles (Eq. 2's a_i, §4.3).
@@ -266,7 +265,7 @@ void Simulator::brush_stage(const BrushPose* poses, int substeps, float dt) {
   BrushEnvironment env;
   env.drag = config_.params.bristle_drag > 0.f ? &drag : nullptr;
   env.solid = solid_field();
-  for (int k = 0; k < substeps; ++k) brush_->step(poses[k], dt_sub, env);
+  brush_->step(poses, substeps, dt, env);
   counters_.nonfinite_events += brush_->stats().nonfinite - rollbacks_before;
 }
 

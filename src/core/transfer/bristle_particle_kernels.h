@@ -40,17 +40,25 @@ WB_HD WB_INLINE float surface_capacity(float M_prime, float R, float r, float ce
 /// (steps of `step` cells) where the window density reaches `threshold` (grid liquid or dried
 /// paint; linear between the last two points). The brush works from above, so the surfaces
 /// that cut its load lie below it: the march is along -z only.
+///
+/// With a dryness field (dryness.f set), only dried paint (dryness >= dry_threshold) is a
+/// surface: the solid below the sample, which the swept contact slides over.
 WB_HD WB_INLINE float surface_distance(Vec3 x, float R, float floor_z, const CellField& density, float threshold,
-                                       float step) {
+                                       float step, const CellField& dryness = CellField{}, float dry_threshold = 0.f) {
   float r = x.z - floor_z;
+  // Density that counts as surface at p: all of it, or only where the paint has dried.
+  const auto surface = [&](Vec3 p) {
+    const float d = cell_field_at(density, p);
+    return dryness.f == nullptr || cell_field_at(dryness, p) >= dry_threshold ? d : 0.f;
+  };
   if (density.f != nullptr && r > 0.f) {
-    float prev = cell_field_at(density, x);
+    float prev = surface(x);
     if (prev >= threshold) return 0.f;
     float s_prev = 0.f;
     const float reach = minf(R, r);
     for (int it = 0; it < 4096 && s_prev < reach; ++it) {
       const float s = minf(s_prev + step, reach);
-      const float val = cell_field_at(density, Vec3(x.x, x.y, x.z - s));
+      const float val = surface(Vec3(x.x, x.y, x.z - s));
       if (val >= threshold) {
         const float t = val > prev ? (threshold - prev) / (val - prev) : 1.f;
         r = minf(r, s_prev + (s - s_prev) * clampf(t, 0.f, 1.f));
@@ -99,6 +107,52 @@ WB_HD WB_INLINE int emission_count(float m, float M, float eps, float emit_mass,
   const int n = want < 1.f ? 1 : int(want);
   mass_each = excess / float(n);
   return n;
+}
+
+/// Area of the circular segment cut from a disc of radius R by a chord at distance r from its
+/// centre, cells^2: R^2 acos(r/R) - r sqrt(R^2 - r^2); 0 when r >= R.
+WB_HD WB_INLINE float segment_area(float R, float r) {
+  if (!(R > 0.f) || !(r < R)) return 0.f;
+  const float q = clampf(r / R, -1.f, 1.f);
+  return R * R * acosf(q) - r * R * sqrtf(maxf(1.f - q * q, 0.f));
+}
+
+/// Paint a sample leaves on the surface it slides over during a step, kg (docs/TRANSFER.md,
+/// "Swept contact"; beyond the paper). The surface r cells below the sample cuts the cap off the
+/// sphere of its paint (radius R_m of its load m, as R_j of §5.1 is of M'_j), the geometry of
+/// Eq. 13. Sliding `travel` cells over the surface, the sample sweeps a slab of paint of that
+/// cap's cross-section, the segment A(R_m, r); the film splits between bristle and surface and
+/// `split` of it stays on the surface. Proportional to the distance slid, not to the steps taken;
+/// a lightly loaded sample whose paint does not reach the surface leaves nothing (dry brush).
+WB_HD WB_INLINE float swept_deposit(float m, float r, float travel, float split, float cell_mass) {
+  if (!(m > 0.f) || !(travel > 0.f)) return 0.f;
+  const float Rm = load_radius(m, cell_mass);
+  return minf(m, split * cell_mass * segment_area(Rm, r) * travel);
+}
+
+/// Particles that carry a swept deposit: mass_each at most emit_mass, at most two per cell slid
+/// (the trail is laid at the grid's resolution whatever the speed). Returns n and sets mass_each.
+WB_HD WB_INLINE int swept_count(float deposit, float travel, float emit_mass, float& mass_each) {
+  mass_each = 0.f;
+  if (!(deposit > 0.f) || !(emit_mass > 0.f)) return 0;
+  const float most = fmaxf(1.f, ceilf(2.f * travel));
+  const float n = fminf(fmaxf(ceilf(deposit / emit_mass), 1.f), most);
+  mass_each = deposit / n;
+  return int(n);
+}
+
+/// Position of the i-th of n particles of a swept deposit: spread along the sample's path over
+/// the step, from x_j - v_t dt to x_j (v_t: the velocity along the surface), across the cap's
+/// footprint (half-width a = sqrt(R_m^2 - r^2)) by pattern point `slot`, a quarter cell above
+/// the surface r_j below the sample (never below the canvas).
+WB_HD WB_INLINE Vec3 swept_position(Vec3 x_j, Vec3 v_t, float dt, float a, float r, int i, int n, Vec3 pattern,
+                                    float floor_z) {
+  const float u = (float(i) + 0.5f) / float(n);
+  Vec3 p = x_j - v_t * (dt * (1.f - u));
+  p.x += pattern.x * a;
+  p.y += pattern.y * a;
+  p.z = maxf(x_j.z - r, floor_z) + 0.25f;
+  return p;
 }
 
 /// Point s of the fixed emission pattern of P points, uniform in the lower half of the unit

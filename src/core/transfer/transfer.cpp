@@ -38,13 +38,16 @@ void d_to_grid_mark(const Device& d, ParticleView p, PaintWindowView pw, Distanc
 void d_to_grid_apply(const Device& d, PaintWindowView pw, DepositScratch acc) {
   WB_DISPATCH(d, transfer_to_grid_apply(pw, acc));
 }
-void d_emit_count(const Device& d, BristleLoadView l, TransferParams prm, uint32_t* count, float* mass_each) {
-  WB_DISPATCH(d, transfer_emit_count(l, prm, count, mass_each));
+void d_emit_count(const Device& d, SampleView s, BristleLoadView l, TransferParams prm, float dt, uint32_t* count,
+                  float* mass_each, float* swept_each, uint32_t* swept_n) {
+  WB_DISPATCH(d, transfer_emit_count(s, l, prm, dt, count, mass_each, swept_each, swept_n));
 }
 void d_emit_fill(const Device& d, SampleView s, BristleLoadView l, ParticleView p, const uint32_t* offset,
-                 const uint32_t* count, const float* mass_each, int64_t first, int64_t room, int64_t step_index,
-                 TransferParams prm, float floor_z, float* emitted) {
-  WB_DISPATCH(d, transfer_emit_fill(s, l, p, offset, count, mass_each, first, room, step_index, prm, floor_z, emitted));
+                 const uint32_t* count, const float* mass_each, const float* swept_each, const uint32_t* swept_n,
+                 int64_t first, int64_t room, int64_t step_index, TransferParams prm, float floor_z, float dt,
+                 float* emitted) {
+  WB_DISPATCH(d, transfer_emit_fill(s, l, p, offset, count, mass_each, swept_each, swept_n, first, room, step_index,
+                                    prm, floor_z, dt, emitted));
 }
 void d_grid_count(const Device& d, PaintWindowView pw, DistanceBlocks db, KeepBox keep, TransferParams prm, float dry,
                   uint32_t* count) {
@@ -79,6 +82,7 @@ void validate(const TransferParams& p) {
   WB_REQUIRE(in(p.emit_mass, 1e-20f, p.M_max), "TransferParams: emit_mass must lie in (0, M_max] kg");
   WB_REQUIRE(p.emit_pattern >= 1 && p.emit_pattern <= 64, "TransferParams: emit_pattern must lie in [1, 64]");
   WB_REQUIRE(in(p.bleed, 0.f, 1.f), "TransferParams: bleed must lie in [0, 1]");
+  WB_REQUIRE(in(p.split, 0.f, 1.f), "TransferParams: split must lie in [0, 1]");
   WB_REQUIRE(in(p.kernel_h, 0.5f, 2.f), "TransferParams: kernel_h must lie in [0.5, 2] cells");
   WB_REQUIRE(in(p.slow_speed, 0.f, 1e4f), "TransferParams: slow_speed must lie in [0, 1e4] cells/s");
   WB_REQUIRE(in(p.min_cell_density, 0.f, 1.f), "TransferParams: min_cell_density must lie in [0, 1]");
@@ -116,11 +120,12 @@ double TransferRecord::max_closure_error() const {
 }
 
 void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadView& load, const CellField& psi,
-                       const CellField& density, const TransferParams& prm, float floor_z) {
+                       const CellField& density, const CellField& dryness, const TransferParams& prm, float floor_z,
+                       float dry_threshold) {
   WB_REQUIRE(s.count() == load.count, "transfer_capacity: " + std::to_string(s.count()) + " samples but a load of " +
                                           std::to_string(load.count));
   validate(prm);
-  WB_DISPATCH(d, transfer_capacity(s, load, psi, density, prm, floor_z));
+  WB_DISPATCH(d, transfer_capacity(s, load, psi, density, dryness, prm, floor_z, dry_threshold));
 }
 
 Transfer::Transfer(const Device& device, const TransferParams& params)
@@ -196,7 +201,8 @@ void Transfer::update_capacity(const SampleView& samples, BristleLoad& load, con
   const PaintWindowView& pw = env.paint;
   const CellField psi{env.psi, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
   const CellField density{pw.density, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
-  transfer_capacity(device_, samples, load.view(), psi, density, params_, env.floor_z);
+  const CellField dryness{pw.dryness, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
+  transfer_capacity(device_, samples, load.view(), psi, density, dryness, params_, env.floor_z, env.dry_threshold);
 }
 
 void Transfer::wick(const SampleView& samples, BristleLoad& load, float dt) {
@@ -342,13 +348,15 @@ void Transfer::emit(const SampleView& samples, BristleLoad& load, ParticleStore&
   uint32_t* offset = s_u32_[1].data();
   float* mass_each = s_f32_[0].data();
   float* emitted = s_f32_[1].data();
-  d_emit_count(device_, lv, params_, count, mass_each);
+  float* swept_each = s_f32_[2].data();
+  uint32_t* swept_n = s_u32_[2].data();
+  d_emit_count(device_, samples, lv, params_, env.dt, count, mass_each, swept_each, swept_n);
   int64_t first = 0;
   const int64_t n_new = make_room(particles, count, offset, ns, first, rec.emission_dropped);
   if (n_new == 0) return;
   const ParticleView pv = particles.view();
-  d_emit_fill(device_, samples, lv, pv, offset, count, mass_each, first, n_new, step_index_, params_, env.floor_z,
-              emitted);
+  d_emit_fill(device_, samples, lv, pv, offset, count, mass_each, swept_each, swept_n, first, n_new, step_index_,
+              params_, env.floor_z, env.dt, emitted);
   rec.emitted_count = n_new;
   rec.emitted_from_bristles = reduce_sum(device_, emitted, ns, ws_);
   rec.emitted_into_particles = reduce_sum(device_, pv.m + first, n_new, ws_);

@@ -124,7 +124,8 @@ class Transfer {
   void update_distance(const SampleView& samples, const TransferEnv& env);
   /// Eq. 16: live particles slower than slow_speed in blocks farther than D0 go to the grid.
   void particles_to_grid(ParticleStore& particles, const TransferEnv& env, TransferRecord& rec);
-  /// §5.1: samples above (1 + epsilon) M_j emit particles in their lower hemisphere.
+  /// §5.1: samples above (1 + epsilon) M_j emit particles in their lower hemisphere, and samples
+  /// sliding over a surface leave the swept part of their paint along their path (env.dt).
   void emit(const SampleView& samples, BristleLoad& load, ParticleStore& particles, const TransferEnv& env,
             TransferRecord& rec);
   /// Eq. 15: cells within D0 of the bristles become particles (27 stratified candidates).
@@ -150,7 +151,7 @@ class Transfer {
   Workspace ws_;
   int64_t step_index_ = 0;
   // Per sample.
-  DeviceBuffer<uint32_t> s_u32_[2];
+  DeviceBuffer<uint32_t> s_u32_[3];
   DeviceBuffer<float> s_f32_[12];
   // Per particle.
   DeviceBuffer<float> p_moved_;
@@ -168,11 +169,12 @@ class Transfer {
 
 /// Validates and runs Eq. 12-13 for every sample (the dispatcher behind Transfer::update_capacity).
 void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadView& load, const CellField& psi,
-                       const CellField& density, const TransferParams& prm, float floor_z);
+                       const CellField& density, const CellField& dryness, const TransferParams& prm, float floor_z,
+                       float dry_threshold);
 
 #define WB_TRANSFER_BACKEND_DECLS                                                                                  \
-  void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellField density, TransferParams prm,   \
-                         float floor_z);                                                                           \
+  void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellField density, CellField dryness,  \
+                         TransferParams prm, float floor_z, float dry_threshold);                                  \
   void transfer_absorb(ParticleView p, SampleView s, BristleLoadView load, AbsorbScratch a, TransferParams prm);    \
   void transfer_absorb_apply(BristleLoadView load, AbsorbScratch a);                                               \
   void transfer_wick(BristleLoadView load, int bristles, int per, float k_dt, float* a, float* d);                 \
@@ -182,10 +184,12 @@ void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadVi
   void transfer_to_grid_mark(ParticleView p, PaintWindowView pw, DistanceBlocks db, DepositScratch acc,            \
                              TransferParams prm, float dry_threshold);                                              \
   void transfer_to_grid_apply(PaintWindowView pw, DepositScratch acc);                                             \
-  void transfer_emit_count(BristleLoadView load, TransferParams prm, uint32_t* count, float* mass_each);            \
+  void transfer_emit_count(SampleView s, BristleLoadView load, TransferParams prm, float dt, uint32_t* count,       \
+                           float* mass_each, float* swept_each, uint32_t* swept_n);                                \
   void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, const uint32_t* offset,               \
-                          const uint32_t* count, const float* mass_each, int64_t first, int64_t room,              \
-                          int64_t step_index, TransferParams prm, float floor_z, float* emitted);                  \
+                          const uint32_t* count, const float* mass_each, const float* swept_each,                  \
+                          const uint32_t* swept_n, int64_t first, int64_t room, int64_t step_index,                \
+                          TransferParams prm, float floor_z, float dt, float* emitted);                            \
   void transfer_grid_count(PaintWindowView pw, DistanceBlocks db, KeepBox keep, TransferParams prm,                \
                            float dry_threshold, uint32_t* count);                                                                        \
   void transfer_grid_emit(PaintWindowView pw, MacView vel, ParticleView p, const uint32_t* count,                   \

@@ -12,8 +12,8 @@ namespace wb::WB_BACKEND_NS {
 
 // --- Eq. 12-13: capacity ----------------------------------------------------------------
 
-void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellField density, TransferParams prm,
-                       float floor_z) {
+void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellField density, CellField dryness,
+                       TransferParams prm, float floor_z, float dry_threshold) {
   const float mu = prm.mu, M_max = prm.M_max, M_min = prm.M_min, cm = prm.cell_mass();
   const float thr = prm.surface_density, step = prm.march_step;
   parallel_for(s.count(), [=] WB_HD(int64_t j) {
@@ -25,6 +25,9 @@ void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellFi
     load.potential[j] = Mp;
     load.capacity[j] = surface_capacity(Mp, R, r, cm);
     load.radius[j] = R;
+    // The solid below (canvas, dried paint): what the swept contact slides over. Wet paint
+    // thicker than the load sphere carries the sample above it (it ploughs, Eq. 13 emits).
+    load.gap[j] = surface_distance(x, R, floor_z, density, thr, step, dryness, dry_threshold);
   });
 }
 
@@ -113,20 +116,27 @@ void transfer_absorb(ParticleView p, SampleView s, BristleLoadView load, AbsorbS
     const float mj = load.m[j], Mj = load.capacity[j];
     const Vec3 ck(p.pigment_r[k], p.pigment_y[k], p.pigment_b[k]);
     if (mj < Mj && limit > 0) {
+      // A sample touching a surface shares the paint lying there (film splitting, as when it
+      // deposits: swept_deposit); away from surfaces it takes the whole particle (Eq. 14).
+      const float take = load.gap[j] < R ? (1.f - prm.split) * mk : mk;
       // Tickets enforce the per-step limit; the claimed mass reproduces the sequential test
       // "m_j < M_j before this particle" of §5.1 (a rejected claim only makes later ones stricter).
       const uint32_t t = atomic_add(&a.ticket[j], 1u);
-      if (t < limit) {
-        const float before = atomic_add(&a.claimed[j], mk);
+      if (t < limit && take > 0.f) {
+        const float before = atomic_add(&a.claimed[j], take);
         if (mj + before < Mj) {
-          p.dead[k] = 1u;
-          a.moved[k] = mk;
-          atomic_add(&a.acc_m[j], mk);
-          atomic_add(&a.acc_c[0][j], mk * ck.x);
-          atomic_add(&a.acc_c[1][j], mk * ck.y);
-          atomic_add(&a.acc_c[2][j], mk * ck.z);
-          atomic_add(&a.acc_b[j], mk * pigment_brightness(ck));
-          atomic_add(&a.acc_oil[j], mk * p.oil[k]);
+          if (take < mk) {
+            p.m[k] = mk - take;
+          } else {
+            p.dead[k] = 1u;
+          }
+          a.moved[k] = take;
+          atomic_add(&a.acc_m[j], take);
+          atomic_add(&a.acc_c[0][j], take * ck.x);
+          atomic_add(&a.acc_c[1][j], take * ck.y);
+          atomic_add(&a.acc_c[2][j], take * ck.z);
+          atomic_add(&a.acc_b[j], take * pigment_brightness(ck));
+          atomic_add(&a.acc_oil[j], take * p.oil[k]);
           atomic_add(&a.counters[0], int32_t(1));
           return;
         }
@@ -266,20 +276,34 @@ void transfer_to_grid_apply(PaintWindowView pw, DepositScratch acc) {
 
 // --- §5.1: emission -------------------------------------------------------------------------
 
-void transfer_emit_count(BristleLoadView load, TransferParams prm, uint32_t* count, float* mass_each) {
-  const float eps = prm.epsilon, emit_mass = prm.emit_mass;
+void transfer_emit_count(SampleView s, BristleLoadView load, TransferParams prm, float dt, uint32_t* count,
+                         float* mass_each, float* swept_each, uint32_t* swept_n) {
+  const float eps = prm.epsilon, emit_mass = prm.emit_mass, split = prm.split, cm = prm.cell_mass();
   const int limit = prm.emit_limit;
   parallel_for(load.count, [=] WB_HD(int64_t j) {
+    // §5.1: the load above (1 + eps) M_j leaves, at most emit_limit particles a step.
     float me = 0.f;
-    count[j] = uint32_t(emission_count(load.m[j], load.capacity[j], eps, emit_mass, limit, me));
+    const int n = emission_count(load.m[j], load.capacity[j], eps, emit_mass, limit, me);
+    // Swept contact: what the sample leaves on the surface it slid over this step.
+    const Vec3 v = s.v[j];
+    const float travel = sqrtf(v.x * v.x + v.y * v.y) * dt;
+    const float left = load.m[j] - float(n) * me;
+    const float deposit = swept_deposit(left, load.gap[j], travel, split, cm);
+    float se = 0.f;
+    const int ns = swept_count(deposit, travel, emit_mass, se);
+    count[j] = uint32_t(n + ns);
     mass_each[j] = me;
+    swept_each[j] = se;
+    swept_n[j] = uint32_t(ns);
   });
 }
 
 void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, const uint32_t* offset,
-                        const uint32_t* count, const float* mass_each, int64_t first, int64_t room, int64_t step_index,
-                        TransferParams prm, float floor_z, float* emitted) {
+                        const uint32_t* count, const float* mass_each, const float* swept_each,
+                        const uint32_t* swept_n, int64_t first, int64_t room, int64_t step_index, TransferParams prm,
+                        float floor_z, float dt, float* emitted) {
   const int P = prm.emit_pattern;
+  const float cm = prm.cell_mass();
   parallel_for(load.count, [=] WB_HD(int64_t j) {
     emitted[j] = 0.f;
     const int n = int(count[j]);
@@ -288,14 +312,29 @@ void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, cons
     const int64_t left = room - off;
     const int n_eff = left <= 0 ? 0 : (left < n ? int(left) : n);
     if (n_eff == 0) return;
-    const float me = mass_each[j];
+    const int n_swept = int(swept_n[j]), n_static = n - n_swept;
     const Vec3 xj = s.x[j], vj = s.v[j];
-    const float R = load.radius[j];
+    const Vec3 vt(vj.x, vj.y, 0.f);
+    const float R = load.radius[j], r = load.gap[j];
+    // Footprint half-width of the paint sphere on the surface (swept_deposit's cap).
+    const float Rm = load_radius(load.m[j], cm);
+    const float a = sqrtf(maxf(Rm * Rm - r * r, 0.f));
+    float out = 0.f;
     for (int i = 0; i < n_eff; ++i) {
       const int64_t k = first + off + i;
-      p.x[k] = emission_position(xj, R, j, step_index, n, i, P, floor_z);
-      p.v[k] = vj;  // "the new particles share the same attributes as the sample, including the velocity"
-      p.m[k] = me;
+      if (i < n_static) {
+        p.x[k] = emission_position(xj, R, j, step_index, n_static, i, P, floor_z);
+        p.v[k] = vj;  // "the new particles share the same attributes as the sample, including the velocity"
+        p.m[k] = mass_each[j];
+      } else {
+        // Left on the surface along the path slid this step, at rest with it.
+        const int q = i - n_static;
+        const int64_t slot = (j + step_index * int64_t(n_swept) + int64_t(q)) % int64_t(P);
+        p.x[k] = swept_position(xj, vt, dt, a, r, q, n_swept, emission_pattern_point(int(slot), P), floor_z);
+        p.v[k] = Vec3();
+        p.m[k] = swept_each[j];
+      }
+      out += p.m[k];
       p.pigment_r[k] = load.pigment_r[j];
       p.pigment_y[k] = load.pigment_y[j];
       p.pigment_b[k] = load.pigment_b[j];
@@ -303,7 +342,7 @@ void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, cons
       p.dryness[k] = 0.f;  // paint on the brush is kept wet
     }
     const float m_old = load.m[j];
-    const float m_new = m_old - float(n_eff) * me;
+    const float m_new = maxf(m_old - out, 0.f);
     load.m[j] = m_new;
     emitted[j] = m_old - m_new;
   });
