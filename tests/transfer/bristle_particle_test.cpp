@@ -47,18 +47,26 @@ TEST(TransferSweep, DepositScalesWithDistanceSlidNotSteps) {
   const TransferParams p;
   const float cm = p.cell_mass(), m = p.M_max, split = 0.5f;
   // Proportional to the distance slid: one step of 4 cells leaves what two of 2 cells leave.
-  const float one = swept_deposit(m, 0.f, 4.f, split, cm);
-  const float half = swept_deposit(m, 0.f, 2.f, split, cm);
+  const float one = swept_deposit(m, 0.f, 0.f, 4.f, split, cm);
+  const float half = swept_deposit(m, 0.f, 0.f, 2.f, split, cm);
   EXPECT_NEAR(one, 2.f * half, 1e-6f * one);
   EXPECT_NEAR(one, split * cm * segment_area(load_radius(m, cm), 0.f) * 4.f, 1e-6f * one);
   // Not sliding, or not reaching the surface (a light load's sphere above it), leaves nothing.
-  EXPECT_EQ(swept_deposit(m, 0.f, 0.f, split, cm), 0.f);
-  EXPECT_EQ(swept_deposit(0.01f * m, 0.5f, 4.f, split, cm), 0.f) << "dry brush: the paint does not reach";
-  EXPECT_GT(swept_deposit(m, 0.5f, 4.f, split, cm), 0.f);
+  EXPECT_EQ(swept_deposit(m, 0.f, 0.f, 0.f, split, cm), 0.f);
+  EXPECT_EQ(swept_deposit(0.01f * m, 0.5f, 0.f, 4.f, split, cm), 0.f) << "dry brush: the paint does not reach";
+  EXPECT_GT(swept_deposit(m, 0.5f, 0.f, 4.f, split, cm), 0.f);
   // Never more than the load.
-  EXPECT_LE(swept_deposit(m, 0.f, 1e4f, split, cm), m);
+  EXPECT_LE(swept_deposit(m, 0.f, 0.f, 1e4f, split, cm), m);
+  // Wet paint already under the sample splits back: the deposit falls as the film thickens and
+  // stops where the two balance, split A = (1 - split) 2a film.
+  const float Rm = load_radius(m, cm);
+  const float balance = split * segment_area(Rm, 0.f) / ((1.f - split) * 2.f * Rm);
+  EXPECT_NEAR(balance, 0.59f, 0.01f) << "a full, pressed sample lays 0.59 cells";
+  EXPECT_LT(swept_deposit(m, 0.f, 0.5f * balance, 4.f, split, cm), one);
+  EXPECT_GT(swept_deposit(m, 0.f, 0.5f * balance, 4.f, split, cm), 0.f);
+  EXPECT_EQ(swept_deposit(m, 0.f, balance * 1.01f, 4.f, split, cm), 0.f);
   // split = 0 is the paper's model: nothing leaves by sliding.
-  EXPECT_EQ(swept_deposit(m, 0.f, 4.f, 0.f, cm), 0.f);
+  EXPECT_EQ(swept_deposit(m, 0.f, 0.f, 4.f, 0.f, cm), 0.f);
 }
 
 TEST(TransferSweep, ParticlesLayTheTrailAlongThePath) {
@@ -73,7 +81,8 @@ TEST(TransferSweep, ParticlesLayTheTrailAlongThePath) {
   const float dt = 1.f / 60.f;
   float lo = 1e9f, hi = -1e9f;
   for (int i = 0; i < 10; ++i) {
-    const Vec3 q = swept_position(x, vt, dt, 0.5f, 1.5f, i, 10, emission_pattern_point(i, 16), 0.f);
+    const Vec3 q = swept_position(x, vt, dt, 0.5f, 1.5f, i, 10, emission_pattern_point(i, 16), 0.f, Vec3(0, 0, 0),
+                                  Vec3(256, 256, 0));
     lo = std::min(lo, q.x), hi = std::max(hi, q.x);
     EXPECT_NEAR(q.z, 2.f - 1.5f + 0.25f, 1e-5f);
   }

@@ -26,6 +26,15 @@ WB_HD WB_INLINE int32_t atomic_add(int32_t* addr, int32_t v) {
 #endif
 }
 
+WB_HD WB_INLINE int64_t atomic_add(int64_t* addr, int64_t v) {
+#if defined(__CUDA_ARCH__)
+  // Two's complement: the unsigned 64-bit add is the signed one.
+  return int64_t(atomicAdd(reinterpret_cast<unsigned long long*>(addr), static_cast<unsigned long long>(v)));
+#else
+  return std::atomic_ref<int64_t>(*addr).fetch_add(v, std::memory_order_relaxed);
+#endif
+}
+
 WB_HD WB_INLINE uint32_t atomic_add(uint32_t* addr, uint32_t v) {
 #if defined(__CUDA_ARCH__)
   return atomicAdd(reinterpret_cast<unsigned*>(addr), v);

@@ -72,6 +72,8 @@ class Grid {
   /// Rasterised particle volume (cell-centred volume fraction, device; nullable) that joins the
   /// grid density when cells are classified (the joint density of §4.3). Valid until the next call.
   void set_particle_density(const float* density) { particle_density_ = density; }
+  /// This step's particle density on the window (cell fractions), or null before the joint fields.
+  const float* particle_density() const { return particle_density_; }
 
   // --- stages (call in this order; step() does) ---
   /// Window to `new_origin` (scatter, shift velocity, gather). Returns whether it moved.

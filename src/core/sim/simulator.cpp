@@ -210,6 +210,7 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
     }
     TransferEnv env = transfer_env();
     env.dt = dt;  // wicking along the bristles over this step
+    env.particle_density = grid_->particle_density();  // this step's raster, if any
     const TransferRecord moved = transfer_->step(brush_->samples(), *load_, particles_, env);
     const TransferRecord pre = rec;  // particles deposited before the window moved
     rec = moved;

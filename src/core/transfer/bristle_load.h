@@ -23,7 +23,8 @@
   X(potential, "potential capacity M'_j of Eq. 12, kg (last transfer step)") \
   X(capacity, "capacity M_j of Eq. 13, kg (last transfer step)")             \
   X(radius, "load radius R_j, cells (last transfer step)")                  \
-  X(gap, "distance to the solid below (canvas, dried paint), cells, in [0, R_j] (last transfer step)")
+  X(gap, "distance to the solid below (canvas, dried paint), cells, in [0, R_j] (last transfer step)") \
+  X(film, "wet paint on the solid under the sample, up to it: column volume per area, cells (last step)")
 
 namespace wb {
 

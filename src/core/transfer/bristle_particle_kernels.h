@@ -124,10 +124,33 @@ WB_HD WB_INLINE float segment_area(float R, float r) {
 /// cap's cross-section, the segment A(R_m, r); the film splits between bristle and surface and
 /// `split` of it stays on the surface. Proportional to the distance slid, not to the steps taken;
 /// a lightly loaded sample whose paint does not reach the surface leaves nothing (dry brush).
-WB_HD WB_INLINE float swept_deposit(float m, float r, float travel, float split, float cell_mass) {
+///
+/// Film splitting goes both ways: wet paint already on the surface (`film` cells thick under the
+/// sample) splits too, and (1 - split) of the film the footprint (width 2a, a = sqrt(R_m^2 - r^2))
+/// sweeps goes back to the bristle. The net deposit per cell slid is therefore
+/// split A(R_m, r) - (1 - split) 2a min(film, R_m): a loaded bristle lays a film up to the
+/// thickness where the two balance (0.59 cells under a full, pressed sample at split 0.5) and
+/// no thicker, however many bristles or samples pass. Only the deposit is made here; the
+/// pick-up is the absorption of Eq. 14 with the same split.
+WB_HD WB_INLINE float swept_deposit(float m, float r, float film, float travel, float split, float cell_mass) {
   if (!(m > 0.f) || !(travel > 0.f)) return 0.f;
   const float Rm = load_radius(m, cell_mass);
-  return minf(m, split * cell_mass * segment_area(Rm, r) * travel);
+  const float a = sqrtf(maxf(Rm * Rm - r * r, 0.f));
+  const float net = split * segment_area(Rm, r) - (1.f - split) * 2.f * a * clampf(film, 0.f, Rm);
+  return minf(m, maxf(net, 0.f) * cell_mass * travel);
+}
+
+/// Wet paint under a sample at x: the column integral of `density` (grid plus particles, cell
+/// fractions) from the solid `gap` cells below it up to it, in steps of `step` cells (midpoint
+/// rule): the film thickness the sample meets, thin films of any density included.
+WB_HD WB_INLINE float film_below(Vec3 x, float gap, const CellField& density, const CellField& particles, float step) {
+  float film = 0.f;
+  for (float s = 0.f; s < gap; s += step) {
+    const float h = minf(step, gap - s);
+    const Vec3 p(x.x, x.y, x.z - s - 0.5f * h);
+    film += (cell_field_at(density, p) + cell_field_at(particles, p)) * h;
+  }
+  return film;
 }
 
 /// Particles that carry a swept deposit: mass_each at most emit_mass, at most two per cell slid
@@ -144,13 +167,15 @@ WB_HD WB_INLINE int swept_count(float deposit, float travel, float emit_mass, fl
 /// Position of the i-th of n particles of a swept deposit: spread along the sample's path over
 /// the step, from x_j - v_t dt to x_j (v_t: the velocity along the surface), across the cap's
 /// footprint (half-width a = sqrt(R_m^2 - r^2)) by pattern point `slot`, a quarter cell above
-/// the surface r_j below the sample (never below the canvas).
+/// the surface r_j below the sample (never below the canvas), and inside the columns [lo, hi)
+/// of the active window: particles live only there (a path that began outside the window, which
+/// moved with the brush, ends its trail at the window's wall).
 WB_HD WB_INLINE Vec3 swept_position(Vec3 x_j, Vec3 v_t, float dt, float a, float r, int i, int n, Vec3 pattern,
-                                    float floor_z) {
+                                    float floor_z, Vec3 lo, Vec3 hi) {
   const float u = (float(i) + 0.5f) / float(n);
   Vec3 p = x_j - v_t * (dt * (1.f - u));
-  p.x += pattern.x * a;
-  p.y += pattern.y * a;
+  p.x = clampf(p.x + pattern.x * a, lo.x + 0.5f, hi.x - 0.5f);
+  p.y = clampf(p.y + pattern.y * a, lo.y + 0.5f, hi.y - 0.5f);
   p.z = maxf(x_j.z - r, floor_z) + 0.25f;
   return p;
 }

@@ -45,9 +45,9 @@ void d_emit_count(const Device& d, SampleView s, BristleLoadView l, TransferPara
 void d_emit_fill(const Device& d, SampleView s, BristleLoadView l, ParticleView p, const uint32_t* offset,
                  const uint32_t* count, const float* mass_each, const float* swept_each, const uint32_t* swept_n,
                  int64_t first, int64_t room, int64_t step_index, TransferParams prm, float floor_z, float dt,
-                 float* emitted) {
+                 PaintWindowView pw, float* emitted) {
   WB_DISPATCH(d, transfer_emit_fill(s, l, p, offset, count, mass_each, swept_each, swept_n, first, room, step_index,
-                                    prm, floor_z, dt, emitted));
+                                    prm, floor_z, dt, pw, emitted));
 }
 void d_grid_count(const Device& d, PaintWindowView pw, DistanceBlocks db, KeepBox keep, TransferParams prm, float dry,
                   uint32_t* count) {
@@ -120,12 +120,12 @@ double TransferRecord::max_closure_error() const {
 }
 
 void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadView& load, const CellField& psi,
-                       const CellField& density, const CellField& dryness, const TransferParams& prm, float floor_z,
-                       float dry_threshold) {
+                       const CellField& density, const CellField& dryness, const CellField& particles,
+                       const TransferParams& prm, float floor_z, float dry_threshold) {
   WB_REQUIRE(s.count() == load.count, "transfer_capacity: " + std::to_string(s.count()) + " samples but a load of " +
                                           std::to_string(load.count));
   validate(prm);
-  WB_DISPATCH(d, transfer_capacity(s, load, psi, density, dryness, prm, floor_z, dry_threshold));
+  WB_DISPATCH(d, transfer_capacity(s, load, psi, density, dryness, particles, prm, floor_z, dry_threshold));
 }
 
 Transfer::Transfer(const Device& device, const TransferParams& params)
@@ -135,6 +135,7 @@ Transfer::Transfer(const Device& device, const TransferParams& params)
   for (auto& b : s_f32_) b.set_device(device);
   for (auto& b : c_u32_) b.set_device(device);
   for (auto& b : c_f32_) b.set_device(device);
+  for (auto& b : c_i64_) b.set_device(device);
   p_moved_.set_device(device);
   occ_.set_device(device);
   d2_.set_device(device);
@@ -151,6 +152,7 @@ void Transfer::ensure_samples(int64_t n) {
 void Transfer::ensure_cells(int64_t n) {
   for (auto& b : c_u32_) b.resize(size_t(n));
   for (auto& b : c_f32_) b.resize(size_t(n));
+  for (auto& b : c_i64_) b.resize(size_t(n));
 }
 void Transfer::ensure_particles(int64_t n) { p_moved_.resize(size_t(n)); }
 
@@ -202,7 +204,9 @@ void Transfer::update_capacity(const SampleView& samples, BristleLoad& load, con
   const CellField psi{env.psi, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
   const CellField density{pw.density, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
   const CellField dryness{pw.dryness, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
-  transfer_capacity(device_, samples, load.view(), psi, density, dryness, params_, env.floor_z, env.dry_threshold);
+  const CellField particles{env.particle_density, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
+  transfer_capacity(device_, samples, load.view(), psi, density, dryness, particles, params_, env.floor_z,
+                    env.dry_threshold);
 }
 
 void Transfer::wick(const SampleView& samples, BristleLoad& load, float dt) {
@@ -304,15 +308,17 @@ void Transfer::particles_to_grid(ParticleStore& particles, const TransferEnv& en
   const int64_t np = particles.size(), nc = env.paint.size();
   ensure_cells(nc);
   ensure_particles(np);
-  for (auto& b : c_f32_) b.fill_zero();
+  for (auto& b : c_i64_) b.fill_zero();
   p_moved_.fill_zero();
   counters_.fill_zero();
   DepositScratch acc{};
-  acc.rho = c_f32_[0].data();
-  for (int c = 0; c < 3; ++c) acc.c[c] = c_f32_[1 + c].data();
-  acc.b = c_f32_[4].data();
-  acc.oil = c_f32_[5].data();
-  acc.dryness = c_f32_[6].data();
+  acc.rho = c_i64_[0].data();
+  for (int c = 0; c < 3; ++c) acc.c[c] = c_i64_[1 + c].data();
+  acc.b = c_i64_[4].data();
+  acc.oil = c_i64_[5].data();
+  acc.dryness = c_i64_[6].data();
+  acc.added = c_f32_[0].data();
+  c_f32_[0].fill_zero();
   acc.moved = p_moved_.data();
   acc.counter = counters_.data();
   acc.keep = env.keep;
@@ -324,7 +330,7 @@ void Transfer::particles_to_grid(ParticleStore& particles, const TransferEnv& en
   counters_.copy_to_host(&count, 1);
   rec.to_grid_count = count;
   rec.to_grid_from_particles = reduce_sum(device_, p_moved_.data(), np, ws_);
-  rec.to_grid_into_grid = reduce_sum(device_, acc.rho, nc, ws_) * double(params_.cell_mass());
+  rec.to_grid_into_grid = reduce_sum(device_, acc.added, nc, ws_) * double(params_.cell_mass());
 }
 
 int64_t Transfer::make_room(ParticleStore& particles, const uint32_t* count, uint32_t* offset, int64_t n,
@@ -356,7 +362,7 @@ void Transfer::emit(const SampleView& samples, BristleLoad& load, ParticleStore&
   if (n_new == 0) return;
   const ParticleView pv = particles.view();
   d_emit_fill(device_, samples, lv, pv, offset, count, mass_each, swept_each, swept_n, first, n_new, step_index_,
-              params_, env.floor_z, env.dt, emitted);
+              params_, env.floor_z, env.dt, env.paint, emitted);
   rec.emitted_count = n_new;
   rec.emitted_from_bristles = reduce_sum(device_, emitted, ns, ws_);
   rec.emitted_into_particles = reduce_sum(device_, pv.m + first, n_new, ws_);

@@ -26,6 +26,9 @@ namespace wb {
 struct TransferEnv {
   PaintWindowView paint{};     ///< the active window's paint; §5.2 changes density, pigment, oil, dryness
   const float* psi = nullptr;  ///< bristle density psi on the same window (Brush::rasterize); null: psi = 0
+  /// Particle density on the same window this step (cell fractions; null: none), so that the
+  /// wet film under a sample counts the paint particles hold too (swept contact).
+  const float* particle_density = nullptr;
   MacView velocity{};          ///< window MAC velocity for new grid particles; u == nullptr: at rest
   float floor_z = 0.f;         ///< canvas surface height, cells (ParticleParams::floor_z)
   float dry_threshold = 0.95f; ///< dryness at which paint is solid (GridParams::dry_threshold)
@@ -85,13 +88,17 @@ struct AbsorbScratch {
   int32_t* counters; ///< [0] absorbed, [1] bleeding
 };
 
-/// Per-cell accumulators of Eq. 16 (density units = cell fractions).
+/// Per-cell accumulators of Eq. 16 (density units = cell fractions), in the fixed point of
+/// to_fixed: integer sums do not depend on the order the particles arrive in, so the same
+/// particles always give the same cells, on any thread count (a save of the same state is the
+/// same file).
 struct DepositScratch {
-  float* rho;      ///< sum m_k W / cell_mass
-  float* c[3];     ///< sum (m_k W / cell_mass) c_k
-  float* b;        ///< sum (m_k W / cell_mass) brightness(c_k)
-  float* oil;
-  float* dryness;
+  int64_t* rho;    ///< sum m_k W / cell_mass
+  int64_t* c[3];   ///< sum (m_k W / cell_mass) c_k
+  int64_t* b;      ///< sum (m_k W / cell_mass) brightness(c_k)
+  int64_t* oil;
+  int64_t* dryness;
+  float* added;    ///< per cell: the density added (written by the apply pass, for the books)
   float* moved;    ///< per particle: mass sent to the grid
   int32_t* counter;
   KeepBox keep;             ///< particles outside it are deposited regardless (TransferEnv::keep)
@@ -158,6 +165,7 @@ class Transfer {
   // Per cell.
   DeviceBuffer<uint32_t> c_u32_[2];
   DeviceBuffer<float> c_f32_[7];
+  DeviceBuffer<int64_t> c_i64_[7];
   // Distance blocks.
   DeviceBuffer<int32_t> occ_;
   DeviceBuffer<float> d2_, d2_tmp_, edt_z_;
@@ -169,12 +177,12 @@ class Transfer {
 
 /// Validates and runs Eq. 12-13 for every sample (the dispatcher behind Transfer::update_capacity).
 void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadView& load, const CellField& psi,
-                       const CellField& density, const CellField& dryness, const TransferParams& prm, float floor_z,
-                       float dry_threshold);
+                       const CellField& density, const CellField& dryness, const CellField& particles,
+                       const TransferParams& prm, float floor_z, float dry_threshold);
 
 #define WB_TRANSFER_BACKEND_DECLS                                                                                  \
   void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellField density, CellField dryness,  \
-                         TransferParams prm, float floor_z, float dry_threshold);                                  \
+                         CellField particles, TransferParams prm, float floor_z, float dry_threshold);             \
   void transfer_absorb(ParticleView p, SampleView s, BristleLoadView load, AbsorbScratch a, TransferParams prm);    \
   void transfer_absorb_apply(BristleLoadView load, AbsorbScratch a);                                               \
   void transfer_wick(BristleLoadView load, int bristles, int per, float k_dt, float* a, float* d);                 \
@@ -189,7 +197,7 @@ void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadVi
   void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, const uint32_t* offset,               \
                           const uint32_t* count, const float* mass_each, const float* swept_each,                  \
                           const uint32_t* swept_n, int64_t first, int64_t room, int64_t step_index,                \
-                          TransferParams prm, float floor_z, float dt, float* emitted);                            \
+                          TransferParams prm, float floor_z, float dt, PaintWindowView pw, float* emitted);        \
   void transfer_grid_count(PaintWindowView pw, DistanceBlocks db, KeepBox keep, TransferParams prm,                \
                            float dry_threshold, uint32_t* count);                                                                        \
   void transfer_grid_emit(PaintWindowView pw, MacView vel, ParticleView p, const uint32_t* count,                   \

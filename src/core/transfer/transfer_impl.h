@@ -13,7 +13,7 @@ namespace wb::WB_BACKEND_NS {
 // --- Eq. 12-13: capacity ----------------------------------------------------------------
 
 void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellField density, CellField dryness,
-                       TransferParams prm, float floor_z, float dry_threshold) {
+                       CellField particles, TransferParams prm, float floor_z, float dry_threshold) {
   const float mu = prm.mu, M_max = prm.M_max, M_min = prm.M_min, cm = prm.cell_mass();
   const float thr = prm.surface_density, step = prm.march_step;
   parallel_for(s.count(), [=] WB_HD(int64_t j) {
@@ -27,7 +27,9 @@ void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellFi
     load.radius[j] = R;
     // The solid below (canvas, dried paint): what the swept contact slides over. Wet paint
     // thicker than the load sphere carries the sample above it (it ploughs, Eq. 13 emits).
-    load.gap[j] = surface_distance(x, R, floor_z, density, thr, step, dryness, dry_threshold);
+    const float gap = surface_distance(x, R, floor_z, density, thr, step, dryness, dry_threshold);
+    load.gap[j] = gap;
+    load.film[j] = film_below(x, gap, density, particles, step);
   });
 }
 
@@ -239,13 +241,13 @@ void transfer_to_grid_mark(ParticleView p, PaintWindowView pw, DistanceBlocks db
     const float a = mk * inv_cm;  // density units
     const int cells = for_each_kernel_cell(pw, q, h, dry_threshold, [&](int64_t id, float w) {
       const float add = a * w;  // Eq. 16: m_k W(p_k - x_c, h)
-      atomic_add(&acc.rho[id], add);
-      atomic_add(&acc.c[0][id], add * ck.x);
-      atomic_add(&acc.c[1][id], add * ck.y);
-      atomic_add(&acc.c[2][id], add * ck.z);
-      atomic_add(&acc.b[id], add * bk);
-      atomic_add(&acc.oil[id], add * oil);
-      atomic_add(&acc.dryness[id], add * dry);
+      atomic_add(&acc.rho[id], to_fixed(add));
+      atomic_add(&acc.c[0][id], to_fixed(add * ck.x));
+      atomic_add(&acc.c[1][id], to_fixed(add * ck.y));
+      atomic_add(&acc.c[2][id], to_fixed(add * ck.z));
+      atomic_add(&acc.b[id], to_fixed(add * bk));
+      atomic_add(&acc.oil[id], to_fixed(add * oil));
+      atomic_add(&acc.dryness[id], to_fixed(add * dry));
     });
     if (cells > 0) {
       p.dead[k] = 1u;
@@ -257,19 +259,21 @@ void transfer_to_grid_mark(ParticleView p, PaintWindowView pw, DistanceBlocks db
 
 void transfer_to_grid_apply(PaintWindowView pw, DepositScratch acc) {
   parallel_for(pw.size(), [=] WB_HD(int64_t c) {
-    const float add = acc.rho[c];
+    const float add = from_fixed(acc.rho[c]);
+    acc.added[c] = add;
     if (!(add > 0.f)) return;
     const float rho = maxf(pw.density[c], 0.f);
     const float tot = rho + add;
     const Vec3 cold(pw.pigment_r[c], pw.pigment_y[c], pw.pigment_b[c]);
     // Pigment: Algorithm 2 with weights = the cell's mass and the added mass; oil and
     // dryness: mass-weighted (the "linear interpolation" of §5.2).
-    const Vec3 cn = mix_batch(cold, rho, Vec3(acc.c[0][c], acc.c[1][c], acc.c[2][c]), acc.b[c], add);
+    const Vec3 cn = mix_batch(cold, rho, Vec3(from_fixed(acc.c[0][c]), from_fixed(acc.c[1][c]), from_fixed(acc.c[2][c])),
+                              from_fixed(acc.b[c]), add);
     pw.pigment_r[c] = cn.x;
     pw.pigment_y[c] = cn.y;
     pw.pigment_b[c] = cn.z;
-    pw.oil[c] = (rho * pw.oil[c] + acc.oil[c]) / tot;
-    pw.dryness[c] = (rho * pw.dryness[c] + acc.dryness[c]) / tot;
+    pw.oil[c] = (rho * pw.oil[c] + from_fixed(acc.oil[c])) / tot;
+    pw.dryness[c] = (rho * pw.dryness[c] + from_fixed(acc.dryness[c])) / tot;
     pw.density[c] = pw.density[c] + add;
   });
 }
@@ -288,7 +292,7 @@ void transfer_emit_count(SampleView s, BristleLoadView load, TransferParams prm,
     const Vec3 v = s.v[j];
     const float travel = sqrtf(v.x * v.x + v.y * v.y) * dt;
     const float left = load.m[j] - float(n) * me;
-    const float deposit = swept_deposit(left, load.gap[j], travel, split, cm);
+    const float deposit = swept_deposit(left, load.gap[j], load.film[j], travel, split, cm);
     float se = 0.f;
     const int ns = swept_count(deposit, travel, emit_mass, se);
     count[j] = uint32_t(n + ns);
@@ -301,8 +305,9 @@ void transfer_emit_count(SampleView s, BristleLoadView load, TransferParams prm,
 void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, const uint32_t* offset,
                         const uint32_t* count, const float* mass_each, const float* swept_each,
                         const uint32_t* swept_n, int64_t first, int64_t room, int64_t step_index, TransferParams prm,
-                        float floor_z, float dt, float* emitted) {
+                        float floor_z, float dt, PaintWindowView pw, float* emitted) {
   const int P = prm.emit_pattern;
+  const Vec3 lo(float(pw.ox), float(pw.oy), 0.f), hi(float(pw.ox + pw.nx), float(pw.oy + pw.ny), 0.f);
   const float cm = prm.cell_mass();
   parallel_for(load.count, [=] WB_HD(int64_t j) {
     emitted[j] = 0.f;
@@ -330,7 +335,7 @@ void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, cons
         // Left on the surface along the path slid this step, at rest with it.
         const int q = i - n_static;
         const int64_t slot = (j + step_index * int64_t(n_swept) + int64_t(q)) % int64_t(P);
-        p.x[k] = swept_position(xj, vt, dt, a, r, q, n_swept, emission_pattern_point(int(slot), P), floor_z);
+        p.x[k] = swept_position(xj, vt, dt, a, r, q, n_swept, emission_pattern_point(int(slot), P), floor_z, lo, hi);
         p.v[k] = Vec3();
         p.m[k] = swept_each[j];
       }

@@ -48,10 +48,9 @@ struct TransferParams {
   /// splitting: a liquid film between two separating surfaces divides about equally). The sample
   /// leaves split * rho0 * A(R_m, r) * (distance slid): A is the segment of its paint sphere
   /// (radius R_m of its load) that the surface r cells below cuts off, the cap of Eq. 13.
-  /// Range [0, 1]; film splitting suggests 0.5. Default 0, the paper's model (paint leaves only
-  /// through Eq. 13): at 0.5 a round brush pressed in place piles paint under its centre
-  /// (docs/TRANSFER.md "Swept contact"), so the swept contact is not yet the default.
-  float split = 0.f;
+  /// Default 0.5 (a liquid film between two parting surfaces divides about equally), range
+  /// [0, 1]; 0 gives the paper's model (paint leaves only through Eq. 13).
+  float split = 0.5f;
 
   // --- bristle <-> particle (§5.1) ---
   /// Most particles one sample absorbs per step. Default 8, range [0, 1024]. §5.1 ("a limit on
