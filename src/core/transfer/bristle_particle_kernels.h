@@ -132,12 +132,16 @@ WB_HD WB_INLINE float segment_area(float R, float r) {
 /// thickness where the two balance (0.59 cells under a full, pressed sample at split 0.5) and
 /// no thicker, however many bristles or samples pass. Only the deposit is made here; the
 /// pick-up is the absorption of Eq. 14 with the same split.
+/// This is what the sample's paint would leave if its load stayed m all along the path; the
+/// wick solve takes it from the bristle implicitly (sigma = deposit / m, a sink in
+/// transfer_wick), so a fast stroke draws paint down the bristle within the step instead of
+/// emptying the contact sample and waiting for the next one.
 WB_HD WB_INLINE float swept_deposit(float m, float r, float film, float travel, float split, float cell_mass) {
   if (!(m > 0.f) || !(travel > 0.f)) return 0.f;
   const float Rm = load_radius(m, cell_mass);
   const float a = sqrtf(maxf(Rm * Rm - r * r, 0.f));
   const float net = split * segment_area(Rm, r) - (1.f - split) * 2.f * a * clampf(film, 0.f, Rm);
-  return minf(m, maxf(net, 0.f) * cell_mass * travel);
+  return maxf(net, 0.f) * cell_mass * travel;
 }
 
 /// Wet paint under a sample at x: the column integral of `density` (grid plus particles, cell
@@ -154,10 +158,12 @@ WB_HD WB_INLINE float film_below(Vec3 x, float gap, const CellField& density, co
 }
 
 /// Particles that carry a swept deposit: mass_each at most emit_mass, at most two per cell slid
-/// (the trail is laid at the grid's resolution whatever the speed). Returns n and sets mass_each.
+/// (the trail is laid at the grid's resolution whatever the speed). A deposit below a thousandth
+/// of an emitted particle (1e-12 kg, 1e-4 of a cell) stays on the bristle: it would only breed
+/// particles lighter than the float load it leaves can even register. Returns n, sets mass_each.
 WB_HD WB_INLINE int swept_count(float deposit, float travel, float emit_mass, float& mass_each) {
   mass_each = 0.f;
-  if (!(deposit > 0.f) || !(emit_mass > 0.f)) return 0;
+  if (!(deposit >= 1e-3f * emit_mass) || !(emit_mass > 0.f)) return 0;
   const float most = fmaxf(1.f, ceilf(2.f * travel));
   const float n = fminf(fmaxf(ceilf(deposit / emit_mass), 1.f), most);
   mass_each = deposit / n;

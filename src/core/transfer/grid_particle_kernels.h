@@ -32,10 +32,10 @@ struct CellField {
   int ox, oy, oz;  ///< canvas cell of the field's (0,0,0)
 };
 
-/// Fixed point of order-independent sums (DepositScratch): 2^-32 per unit, exact for any float
-/// of at least 2^-32 (its scaled value is an integer) and far from overflow (2^31 units).
-WB_HD WB_INLINE int64_t to_fixed(float v) { return llrintf(v * 4294967296.f); }
-WB_HD WB_INLINE float from_fixed(int64_t v) { return float(double(v) * (1.0 / 4294967296.0)); }
+/// Fixed point of order-independent sums (DepositScratch): 2^-40 per unit (9e-13 of a cell,
+/// 7e-21 kg), exact for any float of at least 2^-40 and far from overflow (2^23 cells a cell).
+WB_HD WB_INLINE int64_t to_fixed(float v) { return llrintf(v * 1099511627776.f); }
+WB_HD WB_INLINE float from_fixed(int64_t v) { return float(double(v) * (1.0 / 1099511627776.0)); }
 
 /// Trilinear value of a cell-centred field at canvas position p; nodes outside the field read 0.
 WB_HD WB_INLINE float cell_field_at(const CellField& g, Vec3 p) {

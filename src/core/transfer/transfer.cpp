@@ -121,11 +121,11 @@ double TransferRecord::max_closure_error() const {
 
 void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadView& load, const CellField& psi,
                        const CellField& density, const CellField& dryness, const CellField& particles,
-                       const TransferParams& prm, float floor_z, float dry_threshold) {
+                       const TransferParams& prm, float floor_z, float dry_threshold, float dt) {
   WB_REQUIRE(s.count() == load.count, "transfer_capacity: " + std::to_string(s.count()) + " samples but a load of " +
                                           std::to_string(load.count));
   validate(prm);
-  WB_DISPATCH(d, transfer_capacity(s, load, psi, density, dryness, particles, prm, floor_z, dry_threshold));
+  WB_DISPATCH(d, transfer_capacity(s, load, psi, density, dryness, particles, prm, floor_z, dry_threshold, dt));
 }
 
 Transfer::Transfer(const Device& device, const TransferParams& params)
@@ -165,7 +165,7 @@ TransferRecord Transfer::step(const SampleView& samples, BristleLoad& load, Part
     WB_PROFILE_SCOPE("transfer.capacity");
     update_capacity(samples, load, env);
   }
-  if (env.dt > 0.f && params_.wick_rate > 0.f) {
+  if (env.dt > 0.f) {  // also with wick_rate 0: the swept contact's sink is solved there
     WB_PROFILE_SCOPE("transfer.wick");
     wick(samples, load, env.dt);
   }
@@ -206,7 +206,7 @@ void Transfer::update_capacity(const SampleView& samples, BristleLoad& load, con
   const CellField dryness{pw.dryness, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
   const CellField particles{env.particle_density, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
   transfer_capacity(device_, samples, load.view(), psi, density, dryness, particles, params_, env.floor_z,
-                    env.dry_threshold);
+                    env.dry_threshold, env.dt);
 }
 
 void Transfer::wick(const SampleView& samples, BristleLoad& load, float dt) {
@@ -214,7 +214,7 @@ void Transfer::wick(const SampleView& samples, BristleLoad& load, float dt) {
   WB_REQUIRE(ns == load.size(), "Transfer::wick: " + std::to_string(ns) + " samples but a load of " +
                                     std::to_string(load.size()));
   WB_REQUIRE(std::isfinite(dt) && dt >= 0.f, "Transfer::wick: dt must be finite and >= 0");
-  if (ns == 0 || dt == 0.f || params_.wick_rate == 0.f || samples.per_bristle < 2) return;
+  if (ns == 0 || dt == 0.f) return;
   ensure_samples(ns);
   d_wick(device_, load.view(), samples.bristles, samples.per_bristle, params_.wick_rate * dt, s_f32_[0].data(),
          s_f32_[1].data());

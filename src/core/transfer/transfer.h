@@ -178,11 +178,11 @@ class Transfer {
 /// Validates and runs Eq. 12-13 for every sample (the dispatcher behind Transfer::update_capacity).
 void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadView& load, const CellField& psi,
                        const CellField& density, const CellField& dryness, const CellField& particles,
-                       const TransferParams& prm, float floor_z, float dry_threshold);
+                       const TransferParams& prm, float floor_z, float dry_threshold, float dt);
 
 #define WB_TRANSFER_BACKEND_DECLS                                                                                  \
   void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellField density, CellField dryness,  \
-                         CellField particles, TransferParams prm, float floor_z, float dry_threshold);             \
+                         CellField particles, TransferParams prm, float floor_z, float dry_threshold, float dt);   \
   void transfer_absorb(ParticleView p, SampleView s, BristleLoadView load, AbsorbScratch a, TransferParams prm);    \
   void transfer_absorb_apply(BristleLoadView load, AbsorbScratch a);                                               \
   void transfer_wick(BristleLoadView load, int bristles, int per, float k_dt, float* a, float* d);                 \

@@ -13,7 +13,7 @@ namespace wb::WB_BACKEND_NS {
 // --- Eq. 12-13: capacity ----------------------------------------------------------------
 
 void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellField density, CellField dryness,
-                       CellField particles, TransferParams prm, float floor_z, float dry_threshold) {
+                       CellField particles, TransferParams prm, float floor_z, float dry_threshold, float dt) {
   const float mu = prm.mu, M_max = prm.M_max, M_min = prm.M_min, cm = prm.cell_mass();
   const float thr = prm.surface_density, step = prm.march_step;
   parallel_for(s.count(), [=] WB_HD(int64_t j) {
@@ -29,7 +29,14 @@ void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellFi
     // thicker than the load sphere carries the sample above it (it ploughs, Eq. 13 emits).
     const float gap = surface_distance(x, R, floor_z, density, thr, step, dryness, dry_threshold);
     load.gap[j] = gap;
-    load.film[j] = film_below(x, gap, density, particles, step);
+    const float film = film_below(x, gap, density, particles, step);
+    load.film[j] = film;
+    // Swept contact: the share of its load the sample would leave sliding this step (sigma_j of
+    // the wick's sink).
+    const Vec3 v = s.v[j];
+    const float m = load.m[j];
+    const float travel = sqrtf(v.x * v.x + v.y * v.y) * dt;
+    load.sweep[j] = m > 0.f ? swept_deposit(m, gap, film, travel, prm.split, cm) / m : 0.f;
   });
 }
 
@@ -44,15 +51,21 @@ void transfer_wick(BristleLoadView load, int bristles, int per, float k_dt, floa
       bristles,
       [=] WB_HD(int64_t b) {
         const int64_t o = b * per;
-        const float* Mp = load.potential + o;
+        // Saturation against the capacity M_j of Eq. 13: a contact sample that emitted down to
+        // M_j is as full as its neighbours, so paint flows to it only as it loses paint by
+        // sliding (swept contact), not at a rate per second (a held brush does not leak).
+        const float* Mp = load.capacity + o;
         float* m = load.m + o;
         float* sc = a + o;  // c'_i of the Thomas sweep
         float* sd = d + o;  // d'_i, then s_i
-        // Forward sweep: row i is (-g_{i-1}) s_{i-1} + (M'_i + g_{i-1} + g_i) s_i + (-g_i) s_{i+1} = m_i.
+        // Forward sweep: row i is (-g_{i-1}) s_{i-1} + (M_i (1 + sigma_i) + g_{i-1} + g_i) s_i
+        // + (-g_i) s_{i+1} = m_i, with the swept contact's sink sigma_i M_i s_i (backward Euler).
+        const float* sigma = load.sweep + o;
         float g_prev = 0.f;
         for (int i = 0; i < per; ++i) {
           const float g = i + 1 < per ? wick_conductance(k_dt, Mp[i], Mp[i + 1]) : 0.f;
-          const float diag = maxf(Mp[i], 1e-30f) + g_prev + g - (i > 0 ? g_prev * sc[i - 1] : 0.f);
+          const float diag = maxf(Mp[i], 1e-30f) * (1.f + maxf(sigma[i], 0.f)) + g_prev + g -
+                             (i > 0 ? g_prev * sc[i - 1] : 0.f);
           sc[i] = g / diag;  // minus the eliminated upper coefficient (-g_i / diag)
           sd[i] = (m[i] + (i > 0 ? g_prev * sd[i - 1] : 0.f)) / diag;
           g_prev = g;
@@ -85,6 +98,10 @@ void transfer_wick(BristleLoadView load, int bristles, int per, float k_dt, floa
           const float lose = maxf(-F_left, 0.f) + maxf(F, 0.f);
           const float keep = maxf(mi - lose, 0.f);
           const float m_new = maxf(mi + F_left - F, 0.f);
+          // What the sink took: sigma M s = sigma / (1 + sigma) of the sample's paint after the
+          // flow; it stays on the sample until the emission pass lays it along the path.
+          const float sg = maxf(sigma[i], 0.f);
+          load.sweep[o + i] = m_new * sg / (1.f + sg);
           c_left = ci;
           oil_left = oil_i;
           F_left = F;
@@ -120,7 +137,10 @@ void transfer_absorb(ParticleView p, SampleView s, BristleLoadView load, AbsorbS
     if (mj < Mj && limit > 0) {
       // A sample touching a surface shares the paint lying there (film splitting, as when it
       // deposits: swept_deposit); away from surfaces it takes the whole particle (Eq. 14).
-      const float take = load.gap[j] < R ? (1.f - prm.split) * mk : mk;
+      // A remainder below a thousandth of an emitted particle (1e-12 kg, 1e-4 of a cell) is
+      // taken too: splitting it again and again would only breed ever lighter particles.
+      float take = load.gap[j] < R ? (1.f - prm.split) * mk : mk;
+      if (mk - take < 1e-3f * prm.emit_mass) take = mk;
       // Tickets enforce the per-step limit; the claimed mass reproduces the sequential test
       // "m_j < M_j before this particle" of §5.1 (a rejected claim only makes later ones stricter).
       const uint32_t t = atomic_add(&a.ticket[j], 1u);
@@ -282,7 +302,7 @@ void transfer_to_grid_apply(PaintWindowView pw, DepositScratch acc) {
 
 void transfer_emit_count(SampleView s, BristleLoadView load, TransferParams prm, float dt, uint32_t* count,
                          float* mass_each, float* swept_each, uint32_t* swept_n) {
-  const float eps = prm.epsilon, emit_mass = prm.emit_mass, split = prm.split, cm = prm.cell_mass();
+  const float eps = prm.epsilon, emit_mass = prm.emit_mass;
   const int limit = prm.emit_limit;
   parallel_for(load.count, [=] WB_HD(int64_t j) {
     // §5.1: the load above (1 + eps) M_j leaves, at most emit_limit particles a step.
@@ -292,7 +312,7 @@ void transfer_emit_count(SampleView s, BristleLoadView load, TransferParams prm,
     const Vec3 v = s.v[j];
     const float travel = sqrtf(v.x * v.x + v.y * v.y) * dt;
     const float left = load.m[j] - float(n) * me;
-    const float deposit = swept_deposit(left, load.gap[j], load.film[j], travel, split, cm);
+    const float deposit = minf(load.sweep[j], left);  // the wick solve's deposit
     float se = 0.f;
     const int ns = swept_count(deposit, travel, emit_mass, se);
     count[j] = uint32_t(n + ns);

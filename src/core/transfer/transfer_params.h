@@ -36,11 +36,11 @@ struct TransferParams {
 
   // --- wicking along the bristles (beyond the paper: docs/TRANSFER.md "Wicking") ---
   /// Conductance k of the capillary flow between neighbouring samples of one bristle, 1/s:
-  /// the flux on an edge is k dt min(M'_a, M'_b) (s_a - s_b) with saturation s = m / M'
-  /// (Eq. 12's potential capacity), solved implicitly per bristle. The paint a contact sample
-  /// emits (Eq. 13 cuts its capacity) is refilled from the rest of its bristle, so a loaded
-  /// brush keeps painting until it runs dry. Diffusion length sqrt(2 k t) samples: 63 in 1 s
-  /// at the default 2000. 0 turns wicking off (the paper's model). Range [0, 1e6].
+  /// the flux on an edge is k dt min(M_a, M_b) (s_a - s_b) with saturation s = m / M (Eq. 13's
+  /// capacity), solved implicitly per bristle. The paint a sliding contact sample leaves (swept
+  /// contact) is refilled from the rest of its bristle, so a loaded brush keeps painting until it
+  /// runs dry. Diffusion length sqrt(2 k t) samples: 63 in 1 s at the default 2000. 0 turns
+  /// wicking off (the paper's model). Range [0, 1e6].
   float wick_rate = 2000.f;
 
   // --- swept contact (beyond the paper: docs/TRANSFER.md "Swept contact") ---
