@@ -3,6 +3,7 @@
 #include "core/io/document.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <zip.h>
@@ -12,6 +13,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -201,6 +203,7 @@ TileStore decode_volume(const uint8_t* p, size_t size, const Device& device, con
   std::set<int> seen;
   const uint8_t* data = p + header;
   const uint64_t data_size = size - header;
+  uint64_t next_off = 0;
   for (uint32_t k = 0; k < count; ++k) {
     const uint8_t* e = p + kFixedHeader + size_t(k) * kEntryBytes;
     const uint32_t tx = get_u32(e), ty = get_u32(e + 4);
@@ -210,6 +213,10 @@ TileStore decode_volume(const uint8_t* p, size_t size, const Device& device, con
     if (tx >= uint32_t(canvas.tiles_x()) || ty >= uint32_t(canvas.tiles_y())) WB_THROW(w + ": " + tn + " outside the canvas");
     if (!seen.insert(int(ty) * canvas.tiles_x() + int(tx)).second) WB_THROW(w + ": " + tn + " stored twice");
     if (off > data_size || zn > data_size - off) WB_THROW(w + " is truncated (" + tn + " data missing)");
+    // Tiles are stored back to back in table order: no two tiles share bytes, so each tile's
+    // decompression is paid for by its own bytes in the file.
+    if (off != next_off) WB_THROW(w + ": " + tn + " data overlaps another tile or leaves a gap (file damaged)");
+    next_off = off + zn;
     if (crc(data + off, size_t(zn)) != sum) WB_THROW(w + ": " + tn + " checksum mismatch (file damaged)");
     const size_t got = ZSTD_decompress(raw.data(), raw.size(), data + off, size_t(zn));
     if (ZSTD_isError(got)) WB_THROW(w + ": " + tn + " does not decompress: " + ZSTD_getErrorName(got));
@@ -227,12 +234,34 @@ TileStore decode_volume(const uint8_t* p, size_t size, const Device& device, con
 
 // --- atomic file write ---------------------------------------------------------------------
 
+namespace {
+// Temporary files of saves to `target` whose process is gone (killed mid-save: it could not
+// remove its own) are removed by the next save. Their names carry the writer's process id:
+// `.NAME.tmp-PID-XXXXXX`; a file of a process still running (a concurrent save) is kept.
+void remove_stale_temporaries(const std::filesystem::path& dir, const std::string& prefix) {
+  std::error_code ec;
+  for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string rest = name.substr(prefix.size());
+    const size_t dash = rest.find('-');
+    if (dash == 0 || dash == std::string::npos || rest.size() != dash + 7) continue;
+    if (rest.find_first_not_of("0123456789") != dash) continue;
+    const long pid = std::strtol(rest.c_str(), nullptr, 10);
+    if (pid <= 0 || pid == long(::getpid())) continue;
+    if (::kill(pid_t(pid), 0) != 0 && errno == ESRCH) ::unlink(it->path().c_str());
+  }
+}
+}  // namespace
+
 void write_file_atomic(const std::string& path, const std::vector<uint8_t>& bytes,
                        const std::function<void(const std::string&)>& hook) {
   namespace fs = std::filesystem;
   const fs::path target(path);
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  std::string tmpl = (dir / ("." + target.filename().string() + ".tmp-XXXXXX")).string();
+  const std::string prefix = "." + target.filename().string() + ".tmp-";
+  remove_stale_temporaries(dir, prefix);
+  std::string tmpl = (dir / (prefix + std::to_string(::getpid()) + "-XXXXXX")).string();
   int fd = mkstemp(tmpl.data());
   if (fd < 0) WB_THROW(path + ": cannot create a temporary file in " + dir.string() + ": " + std::strerror(errno));
   const std::string tmp = tmpl;
