@@ -37,7 +37,7 @@ class DocumentTest : public BackendTest {
     fill_volume(c, 0, 0, d.width, d.height / 2 + 3, [&](int x, int y, int z) {
       PaintCell p;
       // Deterministic per cell (fill_volume may run tiles in any order).
-      std::mt19937 r(seed ^ unsigned(x * 73856093) ^ unsigned(y * 19349663) ^ unsigned(z * 83492791));
+      std::mt19937 r(seed ^ unsigned(x) * 73856093u ^ unsigned(y) * 19349663u ^ unsigned(z) * 83492791u);
       std::uniform_real_distribution<float> v(0.f, 1.f);
       if (v(r) < 0.3f) return p;
       p.density = v(r) * 1.3f;
