@@ -50,8 +50,9 @@ if [ "$what" = all ] || [ "$what" = fuzz ]; then
       harness=${name#fuzz_}
       work=$(mktemp -d)
       log="$fuzz/smoke-$harness.log"
+      # One process on one core (no -jobs: with it libFuzzer writes its output to ./fuzz-N.log).
       # New inputs go to the temporary folder (first); the committed corpus is only read.
-      if "$fuzz/bin/$name" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -workers=1 -jobs=1 \
+      if "$fuzz/bin/$name" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
           -artifact_prefix="$work/" -print_final_stats=1 "$work" "$WB_ROOT/tests/fuzz/corpus/$harness" > "$log" 2>&1; then
         echo "hardening: fuzz $harness: $(sed -n 's/^stat::number_of_executed_units: *//p' "$log") runs in ${seconds} s, no finding"
       else

@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <functional>
@@ -92,27 +93,35 @@ TEST_F(SaveKillTest, KilledSavesLeaveThePreviousPaintingOrTheNewOne) {
   const Image old_img = flat_image(d, 40), new_img = flat_image(d, 200);
   save_painting(path_, old_canvas, old_img, {{"version", "old"}});
   const std::vector<uint8_t> old_bytes = read_file(path_);
-  // The complete new file, and how long one save takes in a child process.
+  // The complete new file, and how long one save takes in a child process (the longest of
+  // three, measured again every 10 kills: the machine's load changes it).
   const std::string new_path = (dir_ / "new.ora").string();
-  const auto t0 = std::chrono::steady_clock::now();
-  ASSERT_EQ(in_child([&] {
-              save_painting(new_path, new_canvas, new_img, {{"version", "new"}});
-              return 0;
-            }),
-            0);
-  const double save_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  auto timed_save = [&] {
+    const auto t0 = std::chrono::steady_clock::now();
+    EXPECT_EQ(in_child([&] {
+                save_painting(new_path, new_canvas, new_img, {{"version", "new"}});
+                return 0;
+              }),
+              0);
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+  double save_s = std::max({timed_save(), timed_save(), timed_save()});
   const std::vector<uint8_t> new_bytes = read_file(new_path);
   fs::remove(new_path);
   const std::vector<uint8_t> old_volume = encode_volume(old_canvas), new_volume = encode_volume(new_canvas);
   ASSERT_NE(old_volume, new_volume);
   std::printf("[          ] a save of %zu bytes takes %.3f s in a child process\n", new_bytes.size(), save_s);
 
-  // 100 kills at moments spread evenly over 1.1 x the save's duration, each jittered.
+  // 100 kills at moments spread evenly over 1.2 x the save's duration, each jittered.
   std::mt19937 rng(15);
   std::uniform_real_distribution<double> jitter(0.0, 1.0);
   int old_seen = 0, new_seen = 0, temporaries_left = 0;
   for (int k = 0; k < 100; ++k) {
-    const double at = save_s * 1.1 * (k + jitter(rng)) / 100.0;
+    if (k % 10 == 9) {
+      save_s = std::max(save_s, timed_save());
+      fs::remove(new_path);
+    }
+    const double at = save_s * 1.2 * (k + jitter(rng)) / 100.0;
     const pid_t pid = ::fork();
     ASSERT_GE(pid, 0);
     if (pid == 0) {
@@ -144,9 +153,9 @@ TEST_F(SaveKillTest, KilledSavesLeaveThePreviousPaintingOrTheNewOne) {
     write_file_atomic(path_, old_bytes);
     EXPECT_TRUE(temporaries().empty()) << "kill " << k << ": a temporary file survived the next save";
   }
-  std::printf("[          ] 100 kills: %d left the previous painting, %d the new one, %d a temporary file "
-              "(removed by the next save)\n",
-              old_seen, new_seen, temporaries_left);
+  std::printf("[          ] 100 kills over %.3f s: %d left the previous painting, %d the new one, %d a "
+              "temporary file (removed by the next save)\n",
+              save_s * 1.2, old_seen, new_seen, temporaries_left);
   EXPECT_GE(old_seen, 50) << "the kills did not spread over the save";
 
   // Most of a save is encoding in memory; to be sure of a kill while the temporary file is
