@@ -10,7 +10,9 @@ WB_BUILD="${WB_BUILD:-$WB_ROOT/build}"
 # against the packages behind everything CMake finds.
 WB_PACKAGES=(cmake ninja-build g++ pkg-config libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libcli11-dev libpng-dev libzstd-dev libzip-dev zlib1g-dev
-  qt6-base-dev libqt6opengl6-dev xvfb xauth libgl1-mesa-dri)
+  qt6-base-dev libqt6opengl6-dev xvfb xauth libgl1-mesa-dri
+  # Hardening (docs/RELIABILITY.md): clang with libFuzzer and its OpenMP for the fuzz harnesses.
+  clang libclang-rt-dev libomp-dev)
 
 wb_install_deps() {
   local missing=()

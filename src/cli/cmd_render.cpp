@@ -5,6 +5,7 @@
 #include <chrono>
 #include <ctime>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <sstream>
 
@@ -151,7 +152,10 @@ void register_render(CLI::App& app) {
       const Image merged = o->camera == "top" && cam.width == dims.width && cam.height == dims.height && o->zoom == 1.f
                                ? img
                                : renderer.render(*canvas, Camera::top(dims));
-      save_painting(o->save, *canvas, merged, {{"source", o->test_volume.empty() ? o->painting : o->test_volume}});
+      // The source file's name only: a painting records no path of the machine that made it.
+      const std::string source =
+          o->test_volume.empty() ? std::filesystem::path(o->painting).filename().string() : o->test_volume;
+      save_painting(o->save, *canvas, merged, {{"source", source}});
       std::printf("wrote %s\n", o->save.c_str());
     }
     return 0;

@@ -224,7 +224,10 @@ int run_replay(const ReplayArgs& a) {
   if (!a.save.empty()) {
     const Image full = renderer.render(sim.canvas(), Camera::top(sim.canvas().dims()));
     save_painting(a.save, sim.canvas(), full,
-                  nlohmann::json{{"generator", "wetbrush replay"}, {"stroke", a.strokes}, {"device", device.to_string()}});
+                  // The stroke file's name only: a painting records no path of the machine that made it.
+                  nlohmann::json{{"generator", "wetbrush replay"},
+                                 {"stroke", std::filesystem::path(a.strokes).filename().string()},
+                                 {"device", device.to_string()}});
   }
 
   const Profiler& prof = sim.profiler();

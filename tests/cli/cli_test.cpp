@@ -2,6 +2,7 @@
 // message and a non-zero exit (never a crash), and a replay writes its image and stats.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <zip.h>
 
 #include <array>
 #include <cstdio>
@@ -9,6 +10,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+
+#include "core/io/document.h"
 
 namespace wb::test {
 namespace {
@@ -125,6 +128,53 @@ TEST(Cli, BenchReportsEveryStageTheStepRateAndMemory) {
   for (const auto& [name, st] : j["stages"].items())
     EXPECT_LE(st["median_ms"].get<double>(), step["p90_ms"].get<double>() * 1.01 + 1e-3) << name << " longer than a step";
   EXPECT_NE(run_cli("bench --device cpu " + data("strokes/bad/empty.json")).exit_code, 0);
+  std::filesystem::remove_all(dir);
+}
+
+// Privacy (docs/RELIABILITY.md): a saved painting records no path of the machine that made it,
+// only the file names the user chose; checked in every entry of the archive, uncompressed.
+namespace {
+std::string archive_text(const std::string& path) {
+  int err = 0;
+  zip_t* za = zip_open(path.c_str(), ZIP_RDONLY, &err);
+  if (!za) return {};
+  std::string all;
+  for (zip_int64_t i = 0; i < zip_get_num_entries(za, 0); ++i) {
+    zip_stat_t st;
+    zip_stat_index(za, zip_uint64_t(i), 0, &st);
+    std::string b(size_t(st.size), '\0');
+    zip_file_t* f = zip_fopen_index(za, zip_uint64_t(i), 0);
+    if (f && !b.empty()) zip_fread(f, b.data(), b.size());
+    if (f) zip_fclose(f);
+    all += std::string(st.name) + "\n" + b + "\n";
+  }
+  zip_close(za);
+  return all;
+}
+}  // namespace
+
+TEST(Cli, SavedPaintingsRecordNoPath) {
+  const auto dir = temp_dir("privacy");
+  ASSERT_TRUE(dir.is_absolute());
+  const std::string stroke = (dir / "private-stroke.json").string();
+  std::ofstream(stroke) << R"({"format": "wetbrush-stroke", "version": 1, "canvas": {"width": 64, "height": 48},
+    "samples": [{"t": 0.0, "x": 30, "y": 24, "pressure": 0.0}, {"t": 0.05, "x": 34, "y": 24, "pressure": 0.5}]})";
+  const std::string ora = (dir / "p.ora").string();
+  const RunResult r = run_cli("replay --device cpu -q " + stroke + " --window 32,32,8 -o " + (dir / "p.png").string() +
+                              " --save " + ora);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Painting p = load_painting(ora, Device(DeviceType::CPU));
+  EXPECT_EQ(p.metadata.at("stroke"), "private-stroke.json");
+  const std::string text = archive_text(ora);
+  ASSERT_NE(text.find("wetbrush/metadata.json"), std::string::npos);
+  EXPECT_EQ(text.find(dir.string()), std::string::npos) << "the painting records " << dir << ":\n" << p.metadata.dump();
+
+  // A painting rendered and saved again names its source file, not where it lies.
+  const std::string again = (dir / "again.ora").string();
+  const RunResult r2 = run_cli("render --device cpu " + ora + " -o " + (dir / "again.png").string() + " --save " + again);
+  ASSERT_EQ(r2.exit_code, 0) << r2.output;
+  EXPECT_EQ(load_painting(again, Device(DeviceType::CPU)).metadata.at("source"), "p.ora");
+  EXPECT_EQ(archive_text(again).find(dir.string()), std::string::npos);
   std::filesystem::remove_all(dir);
 }
 

@@ -14,36 +14,13 @@
 #include "core/io/document.h"
 #include "core/io/png.h"
 #include "core/render/test_volumes.h"
+#include "io/test_zip.h"
 
 namespace wb::test {
 
 namespace fs = std::filesystem;
 
 namespace {
-// A zip built entry by entry (stored), for fixtures other programs or damage would produce.
-std::vector<uint8_t> make_zip(const std::vector<std::pair<std::string, std::vector<uint8_t>>>& entries) {
-  zip_error_t ze;
-  zip_error_init(&ze);
-  zip_source_t* src = zip_source_buffer_create(nullptr, 0, 0, &ze);
-  zip_source_keep(src);
-  zip_t* za = zip_open_from_source(src, ZIP_TRUNCATE, &ze);
-  for (const auto& [name, data] : entries) {
-    zip_source_t* s = zip_source_buffer(za, data.data(), data.size(), 0);
-    const zip_int64_t i = zip_file_add(za, name.c_str(), s, ZIP_FL_ENC_UTF_8);
-    zip_set_file_compression(za, zip_uint64_t(i), ZIP_CM_STORE, 0);
-  }
-  zip_close(za);
-  zip_stat_t st;
-  zip_source_stat(src, &st);
-  zip_source_open(src);
-  std::vector<uint8_t> out(size_t(st.size));
-  zip_source_read(src, out.data(), out.size());
-  zip_source_close(src);
-  zip_source_free(src);
-  return out;
-}
-std::vector<uint8_t> bytes_of(const std::string& s) { return {s.begin(), s.end()}; }
-
 std::string fresh_dir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("wetbrush_doc_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(d);
@@ -60,7 +37,7 @@ class DocumentTest : public BackendTest {
     fill_volume(c, 0, 0, d.width, d.height / 2 + 3, [&](int x, int y, int z) {
       PaintCell p;
       // Deterministic per cell (fill_volume may run tiles in any order).
-      std::mt19937 r(seed ^ unsigned(x * 73856093) ^ unsigned(y * 19349663) ^ unsigned(z * 83492791));
+      std::mt19937 r(seed ^ unsigned(x) * 73856093u ^ unsigned(y) * 19349663u ^ unsigned(z) * 83492791u);
       std::uniform_real_distribution<float> v(0.f, 1.f);
       if (v(r) < 0.3f) return p;
       p.density = v(r) * 1.3f;

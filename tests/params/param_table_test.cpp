@@ -2,6 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <set>
+#include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "core/params/param_table.h"
 
@@ -60,6 +63,25 @@ TEST(ParamTable, JsonRoundTripAndUnknownKeys) {
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find("grid.bogus"), std::string::npos);
   EXPECT_THROW(params_from_json(b, nlohmann::json{{"grid", {{"alpha", "x"}}}}, warnings), Error);
+}
+
+// A parameter file nesting objects a million deep (a hostile or broken file) reads as one
+// warning in bounded time: the reader never descends deeper than the deepest parameter id
+// (render.light_dir.x), so its stack stays small.
+TEST(ParamTable, DeeplyNestedFileIsOneWarning) {
+  const int depth = 1000000;
+  std::string text;
+  text.reserve(size_t(depth) * 6 + 16);
+  for (int i = 0; i < depth; ++i) text += "{\"a\":";
+  text += "1";
+  text.append(size_t(depth), '}');
+  const nlohmann::json j = nlohmann::json::parse(text);
+  SimParams p;
+  std::vector<std::string> warnings;
+  params_from_json(p, j, warnings);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("unknown parameter group 'a.a.a'"), std::string::npos) << warnings[0];
+  EXPECT_EQ(params_to_json(p), params_to_json(SimParams{}));
 }
 
 }  // namespace wb::test

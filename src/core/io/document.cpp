@@ -3,6 +3,7 @@
 #include "core/io/document.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <zip.h>
@@ -12,12 +13,14 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <memory>
 #include <set>
 
 #include "core/exec/error.h"
+#include "core/io/limits.h"
 #include "core/io/png.h"
 
 namespace wb {
@@ -107,7 +110,9 @@ std::vector<uint8_t> read_entry(zip_t* za, zip_int64_t idx, const std::string& n
   zip_stat_init(&st);
   if (zip_stat_index(za, zip_uint64_t(idx), 0, &st) != 0 || !(st.valid & ZIP_STAT_SIZE))
     WB_THROW(what + ": cannot read entry '" + name + "' of the archive");
-  if (st.size > max_bytes) WB_THROW(what + ": entry '" + name + "' is implausibly large (" + std::to_string(st.size) + " bytes)");
+  if (st.size > max_bytes)
+    WB_THROW(what + ": entry '" + name + "' declares " + std::to_string(st.size) + " bytes uncompressed, more than the " +
+             std::to_string(max_bytes) + " bytes allowed (refused before reading)");
   zip_file_t* f = zip_fopen_index(za, zip_uint64_t(idx), 0);
   if (!f) WB_THROW(what + ": cannot open entry '" + name + "': " + zip_strerror(za));
   std::vector<uint8_t> b(size_t(st.size));
@@ -158,7 +163,8 @@ std::vector<uint8_t> encode_volume(const TileStore& canvas) {
   return head;
 }
 
-TileStore decode_volume(const uint8_t* p, size_t size, const Device& device, const std::string& what) {
+TileStore decode_volume(const uint8_t* p, size_t size, const Device& device, const std::string& what,
+                        const LoadLimits& limits) {
   const std::string w = what + ": paint volume (" + kVolumeEntry + ")";
   if (size < kFixedHeader || std::memcmp(p, kVolumeMagic, 8) != 0) WB_THROW(w + " has no volume header (wrong magic)");
   const uint32_t version = get_u32(p + 8);
@@ -172,12 +178,23 @@ TileStore decode_volume(const uint8_t* p, size_t size, const Device& device, con
   if (width == 0 || height == 0 || depth == 0 || width > 65536 || height > 65536 || depth > 1024)
     WB_THROW(w + ": canvas size " + std::to_string(width) + " x " + std::to_string(height) + " x " +
              std::to_string(depth) + " out of range");
+  if (uint64_t(width) * height > uint64_t(kMaxCanvasCells))
+    WB_THROW(w + ": canvas " + std::to_string(width) + " x " + std::to_string(height) + " has more than " +
+             std::to_string(kMaxCanvasCells) + " cells (16384 x 16384): refused");
   const uint64_t max_tiles = uint64_t((width + kTileSize - 1) / kTileSize) * ((height + kTileSize - 1) / kTileSize);
   if (count > max_tiles) WB_THROW(w + ": more tiles (" + std::to_string(count) + ") than the canvas has");
   if (header > size) WB_THROW(w + " is truncated (tile table incomplete)");
   if (crc(p, header - 4) != get_u32(p + header - 4)) WB_THROW(w + ": header checksum mismatch (file damaged)");
   if (tile != uint32_t(kTileSize)) WB_THROW(w + ": tile size " + std::to_string(tile) + " unsupported");
   if (fields != uint32_t(kPaintFieldCount)) WB_THROW(w + ": " + std::to_string(fields) + " fields per cell, expected 6");
+  // Every tile decodes to 16 x 16 x depth cells, whatever its compressed size: the paint the
+  // table declares is known here, before anything is allocated or decompressed.
+  const uint64_t tile_bytes = uint64_t(kTileSize) * kTileSize * depth * 14;
+  const uint64_t paint_bytes = uint64_t(count) * tile_bytes;
+  if (paint_bytes > limits.max_paint_bytes)
+    WB_THROW(w + ": " + std::to_string(count) + " tiles of a " + std::to_string(depth) + "-cell-deep canvas hold " +
+             std::to_string(paint_bytes >> 20) + " MiB of paint, more than the " +
+             std::to_string(limits.max_paint_bytes >> 20) + " MiB a painting may hold (refused)");
 
   TileStore canvas(device, CanvasDims{int(width), int(height), int(depth)});
   const size_t n = size_t(canvas.tile_cells());
@@ -186,6 +203,7 @@ TileStore decode_volume(const uint8_t* p, size_t size, const Device& device, con
   std::set<int> seen;
   const uint8_t* data = p + header;
   const uint64_t data_size = size - header;
+  uint64_t next_off = 0;
   for (uint32_t k = 0; k < count; ++k) {
     const uint8_t* e = p + kFixedHeader + size_t(k) * kEntryBytes;
     const uint32_t tx = get_u32(e), ty = get_u32(e + 4);
@@ -195,6 +213,10 @@ TileStore decode_volume(const uint8_t* p, size_t size, const Device& device, con
     if (tx >= uint32_t(canvas.tiles_x()) || ty >= uint32_t(canvas.tiles_y())) WB_THROW(w + ": " + tn + " outside the canvas");
     if (!seen.insert(int(ty) * canvas.tiles_x() + int(tx)).second) WB_THROW(w + ": " + tn + " stored twice");
     if (off > data_size || zn > data_size - off) WB_THROW(w + " is truncated (" + tn + " data missing)");
+    // Tiles are stored back to back in table order: no two tiles share bytes, so each tile's
+    // decompression is paid for by its own bytes in the file.
+    if (off != next_off) WB_THROW(w + ": " + tn + " data overlaps another tile or leaves a gap (file damaged)");
+    next_off = off + zn;
     if (crc(data + off, size_t(zn)) != sum) WB_THROW(w + ": " + tn + " checksum mismatch (file damaged)");
     const size_t got = ZSTD_decompress(raw.data(), raw.size(), data + off, size_t(zn));
     if (ZSTD_isError(got)) WB_THROW(w + ": " + tn + " does not decompress: " + ZSTD_getErrorName(got));
@@ -212,12 +234,34 @@ TileStore decode_volume(const uint8_t* p, size_t size, const Device& device, con
 
 // --- atomic file write ---------------------------------------------------------------------
 
+namespace {
+// Temporary files of saves to `target` whose process is gone (killed mid-save: it could not
+// remove its own) are removed by the next save. Their names carry the writer's process id:
+// `.NAME.tmp-PID-XXXXXX`; a file of a process still running (a concurrent save) is kept.
+void remove_stale_temporaries(const std::filesystem::path& dir, const std::string& prefix) {
+  std::error_code ec;
+  for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string rest = name.substr(prefix.size());
+    const size_t dash = rest.find('-');
+    if (dash == 0 || dash == std::string::npos || rest.size() != dash + 7) continue;
+    if (rest.find_first_not_of("0123456789") != dash) continue;
+    const long pid = std::strtol(rest.c_str(), nullptr, 10);
+    if (pid <= 0 || pid == long(::getpid())) continue;
+    if (::kill(pid_t(pid), 0) != 0 && errno == ESRCH) ::unlink(it->path().c_str());
+  }
+}
+}  // namespace
+
 void write_file_atomic(const std::string& path, const std::vector<uint8_t>& bytes,
                        const std::function<void(const std::string&)>& hook) {
   namespace fs = std::filesystem;
   const fs::path target(path);
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  std::string tmpl = (dir / ("." + target.filename().string() + ".tmp-XXXXXX")).string();
+  const std::string prefix = "." + target.filename().string() + ".tmp-";
+  remove_stale_temporaries(dir, prefix);
+  std::string tmpl = (dir / (prefix + std::to_string(::getpid()) + "-XXXXXX")).string();
   int fd = mkstemp(tmpl.data());
   if (fd < 0) WB_THROW(path + ": cannot create a temporary file in " + dir.string() + ": " + std::strerror(errno));
   const std::string tmp = tmpl;
@@ -323,21 +367,26 @@ void save_painting(const std::string& path, const TileStore& canvas, const Image
   write_file_atomic(path, bytes, options.fault_hook);
 }
 
-Painting load_painting(const std::string& path, const Device& device) {
+Painting load_painting(const std::string& path, const Device& device, const LoadLimits& limits) {
   std::vector<uint8_t> file;
   try {
     file = read_file(path);
   } catch (const Error&) {
     WB_THROW(path + ": cannot open the painting file");
   }
-  if (file.empty()) WB_THROW(path + ": empty file, not an OpenRaster painting");
+  return load_painting_bytes(file.data(), file.size(), path, device, limits);
+}
+
+Painting load_painting_bytes(const uint8_t* bytes, size_t size, const std::string& path, const Device& device,
+                             const LoadLimits& limits) {
+  if (size == 0) WB_THROW(path + ": empty file, not an OpenRaster painting");
   static const uint8_t png_sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  if (file.size() >= 8 && std::memcmp(file.data(), png_sig, 8) == 0)
+  if (size >= 8 && std::memcmp(bytes, png_sig, 8) == 0)
     WB_THROW(path + ": this is a PNG image, not an OpenRaster painting (.ora)");
 
   zip_error_t ze;
   zip_error_init(&ze);
-  zip_source_t* src = zip_source_buffer_create(file.data(), file.size(), 0, &ze);
+  zip_source_t* src = zip_source_buffer_create(bytes, size, 0, &ze);
   if (!src) WB_THROW(path + ": " + zip_message(&ze));
   zip_t* raw = zip_open_from_source(src, ZIP_RDONLY | ZIP_CHECKCONS, &ze);
   if (!raw) {
@@ -362,11 +411,11 @@ Painting load_painting(const std::string& path, const Device& device) {
   if (vi < 0)
     WB_THROW(path + ": an OpenRaster image without a wetbrush paint volume (" + kVolumeEntry +
              "), made by another program: wetbrush needs the 3D paint");
-  const auto vol = read_entry(za.get(), vi, kVolumeEntry, path, uint64_t(1) << 36);
-  Painting p{decode_volume(vol.data(), vol.size(), device, path), nlohmann::json::object()};
+  const auto vol = read_entry(za.get(), vi, kVolumeEntry, path, limits.max_volume_entry_bytes);
+  Painting p{decode_volume(vol.data(), vol.size(), device, path, limits), nlohmann::json::object()};
   const zip_int64_t mi = zip_name_locate(za.get(), kMetadataEntry, 0);
   if (mi >= 0) {
-    const auto m = read_entry(za.get(), mi, kMetadataEntry, path, uint64_t(1) << 26);
+    const auto m = read_entry(za.get(), mi, kMetadataEntry, path, limits.max_metadata_bytes);
     try {
       p.metadata = nlohmann::json::parse(m.begin(), m.end());
     } catch (const nlohmann::json::exception& e) {

@@ -41,13 +41,32 @@ struct SaveOptions {
 void save_painting(const std::string& path, const TileStore& canvas, const Image& merged,
                    const nlohmann::json& metadata, const SaveOptions& options = {});
 
+/// What reading an untrusted painting may cost (docs/RELIABILITY.md "Resource limits"). Every
+/// size is checked against these before the memory is allocated, so a hostile file is refused
+/// in bounded time and memory; a file within them reads as before.
+struct LoadLimits {
+  /// Uncompressed size of the volume entry as the ZIP declares it (it is stored, so a real one
+  /// is about as large as its compressed tiles).
+  uint64_t max_volume_entry_bytes = uint64_t(1) << 30;
+  /// Uncompressed size of wetbrush/metadata.json.
+  uint64_t max_metadata_bytes = uint64_t(16) << 20;
+  /// Decoded paint: tiles x 16 x 16 x depth cells x 14 bytes (also never more than the whole
+  /// canvas the file declares, since a tile may be stored once).
+  uint64_t max_paint_bytes = uint64_t(4) << 30;
+};
+
 /// Reads a painting onto `device`. Truncated, corrupted, foreign or newer-version files are
-/// rejected with a wb::Error that names the file and what is wrong.
-Painting load_painting(const std::string& path, const Device& device);
+/// rejected with a wb::Error that names the file and what is wrong; files beyond `limits` are
+/// refused before their memory is allocated.
+Painting load_painting(const std::string& path, const Device& device, const LoadLimits& limits = {});
+/// The same from the file's bytes in memory; `what` names it in messages.
+Painting load_painting_bytes(const uint8_t* bytes, size_t size, const std::string& what, const Device& device,
+                             const LoadLimits& limits = {});
 
 /// The volume entry alone (exposed for tests and tools).
 std::vector<uint8_t> encode_volume(const TileStore& canvas);
-TileStore decode_volume(const uint8_t* bytes, size_t size, const Device& device, const std::string& what);
+TileStore decode_volume(const uint8_t* bytes, size_t size, const Device& device, const std::string& what,
+                        const LoadLimits& limits = {});
 
 /// Writes bytes to `path` atomically (temporary file, fsync, rename, directory fsync).
 void write_file_atomic(const std::string& path, const std::vector<uint8_t>& bytes,

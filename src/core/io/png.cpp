@@ -102,7 +102,7 @@ std::vector<uint8_t> encode_png_gray16(const uint16_t* pixels, int width, int he
   return encode(rows, width, height, PNG_COLOR_TYPE_GRAY, 16, 6, text);
 }
 
-PngPixels decode_png(const uint8_t* bytes, size_t size, const std::string& what) {
+PngPixels decode_png(const uint8_t* bytes, size_t size, const std::string& what, uint64_t max_decoded_bytes) {
   if (size < 8 || png_sig_cmp(bytes, 0, 8) != 0) WB_THROW(what + ": not a PNG image");
   std::string err;
   png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &err, png_error_fn, png_warning_fn);
@@ -128,6 +128,13 @@ PngPixels decode_png(const uint8_t* bytes, size_t size, const std::string& what)
   if (ct == PNG_COLOR_TYPE_GRAY && png_get_bit_depth(png, info) < 8) png_set_expand_gray_1_2_4_to_8(png);
   if (png_get_valid(png, info, PNG_INFO_tRNS)) png_set_tRNS_to_alpha(png);
   png_read_update_info(png, info);
+  // The header declares the size: check what it decodes to before allocating it.
+  const uint64_t decoded = uint64_t(png_get_rowbytes(png, info)) * h;
+  if (decoded > max_decoded_bytes) {
+    err = std::to_string(w) + " x " + std::to_string(h) + " pixels decode to " + std::to_string(decoded >> 20) +
+          " MiB, more than the " + std::to_string(max_decoded_bytes >> 20) + " MiB allowed (refused)";
+    png_longjmp(png, 1);
+  }
   px.width = int(w);
   px.height = int(h);
   px.channels = png_get_channels(png, info);

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "core/io/limits.h"
+
 namespace wb {
 
 /// Raw pixels as decoded: `channels` interleaved samples per pixel, 8 or 16 bits each
@@ -22,8 +24,10 @@ std::vector<uint8_t> encode_png8(const uint8_t* pixels, int width, int height, i
 std::vector<uint8_t> encode_png_gray16(const uint16_t* pixels, int width, int height,
                                        const std::vector<std::pair<std::string, std::string>>& text = {});
 /// Decodes a PNG held in memory (any colour type; palette and grey < 8 bits expanded to 8 bits).
-/// `what` names the source in error messages.
-PngPixels decode_png(const uint8_t* bytes, size_t size, const std::string& what);
+/// `what` names the source in error messages. An image that would decode to more than
+/// `max_decoded_bytes` is refused from its header, before the pixels are allocated.
+PngPixels decode_png(const uint8_t* bytes, size_t size, const std::string& what,
+                     uint64_t max_decoded_bytes = kMaxPngDecodedBytes);
 
 void write_png8(const std::string& path, const uint8_t* pixels, int width, int height, int channels);
 void write_png_gray16(const std::string& path, const uint16_t* pixels, int width, int height,

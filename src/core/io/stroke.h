@@ -75,6 +75,9 @@ struct Stroke {
 /// Throws wb::Error naming the file and the line / sample on any problem.
 Stroke load_stroke(const std::string& path);
 
+/// What load_stroke does with the file's text: rejects binary data, then reads the format the
+/// first non-blank byte names. `source` names it in messages.
+Stroke parse_stroke_text(std::string_view text, const std::string& source);
 /// The JSON stroke format from text; `source` names it in messages.
 Stroke parse_stroke_json(std::string_view text, const std::string& source);
 /// MyPaint event dump (`t x y pressure [xtilt ytilt]` per line) from text.

@@ -22,6 +22,7 @@
 #include "core/io/brush_json.h"
 #include "core/io/pen_pose.h"
 #include "core/io/stroke.h"
+#include "core/io/limits.h"
 
 namespace wb {
 
@@ -335,6 +336,9 @@ Stroke parse_stroke_json(std::string_view text, const std::string& source) {
     st.canvas.width = c.integer("width", 1, 65536);
     st.canvas.height = c.integer("height", 1, 65536);
     st.canvas.depth = c.integer_or("depth", 64, 1, 1024);
+    if (int64_t(st.canvas.width) * st.canvas.height > kMaxCanvasCells)
+      c.fail("canvas " + std::to_string(st.canvas.width) + " x " + std::to_string(st.canvas.height) + " has more than " +
+             std::to_string(kMaxCanvasCells) + " cells (16384 x 16384): refused");
     if (c.has("paper_rgb")) st.paper_rgb = c.triple("paper_rgb", 0.0, 1.0);
     c.warn_unknown(st.warnings);
   }
@@ -470,7 +474,10 @@ Stroke load_stroke(const std::string& path) {
   if (!in) WB_THROW("cannot open stroke file '" + path + "': " + std::strerror(errno));
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) WB_THROW("cannot read stroke file '" + path + "'");
+  return parse_stroke_text(text, path);
+}
 
+Stroke parse_stroke_text(std::string_view text, const std::string& path) {
   // Text only: control bytes other than tab / newline / carriage return mean binary data.
   size_t line = 1;
   for (size_t i = 0; i < text.size(); ++i) {
@@ -484,7 +491,7 @@ Stroke load_stroke(const std::string& path) {
     }
   }
   size_t first = 0;
-  if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) first = 3;  // UTF-8 byte order mark
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") first = 3;  // UTF-8 byte order mark
   while (first < text.size() && std::isspace(static_cast<unsigned char>(text[first]))) ++first;
   if (first == text.size()) WB_THROW(path + ": empty file (no JSON object and no MyPaint events)");
   if (text[first] == '{' || text[first] == '[') return parse_stroke_json(text, path);

@@ -1,6 +1,8 @@
 #include "core/params/param_table.h"
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <type_traits>
 
 #include "core/exec/error.h"
@@ -184,13 +186,22 @@ nlohmann::json params_to_json(const SimParams& p) {
 }
 
 void params_from_json(SimParams& p, const nlohmann::json& j, std::vector<std::string>& warnings) {
-  std::function<void(const nlohmann::json&, const std::string&)> walk = [&](const nlohmann::json& node,
-                                                                             const std::string& prefix) {
+  // No parameter id has more levels than the table's deepest one, so the walk never descends
+  // further: a file nesting objects a million deep is one warning, not a stack overflow.
+  static const int max_levels = [] {
+    int m = 1;
+    for (const ParamInfo& info : param_table())
+      m = std::max(m, 1 + int(std::count(info.id.begin(), info.id.end(), '.')));
+    return m;
+  }();
+  std::function<void(const nlohmann::json&, const std::string&, int)> walk = [&](const nlohmann::json& node,
+                                                                                  const std::string& prefix, int level) {
     WB_REQUIRE(node.is_object(), "parameters: '" + prefix + "' must be an object");
     for (auto it = node.begin(); it != node.end(); ++it) {
       const std::string id = prefix.empty() ? it.key() : prefix + "." + it.key();
       if (it->is_object()) {
-        walk(*it, id);
+        if (level + 1 < max_levels) walk(*it, id, level + 1);
+        else warnings.push_back("unknown parameter group '" + id + "' ignored (no parameter is nested this deep)");
       } else if (find_param(id)) {
         WB_REQUIRE(it->is_number() || it->is_boolean(), "parameter " + id + ": expected a number");
         set_param(p, id, it->is_boolean() ? (it->get<bool>() ? 1.0 : 0.0) : it->get<double>());
@@ -199,7 +210,7 @@ void params_from_json(SimParams& p, const nlohmann::json& j, std::vector<std::st
       }
     }
   };
-  walk(j, "");
+  walk(j, "", 0);
 }
 
 }  // namespace wb
