@@ -85,7 +85,7 @@ WB_HD WB_INLINE Vec3 mix_batch(Vec3 c_self, float w_self, Vec3 sum_wc, float sum
 }
 
 /// Edge conductance of the wicking flow between samples a and b of one bristle, kg per unit
-/// saturation: k dt min(M'_a, M'_b) (docs/TRANSFER.md "Wicking").
+/// saturation: k dt min(M_a, M_b) (docs/TRANSFER.md "Wicking").
 WB_HD WB_INLINE float wick_conductance(float k_dt, float Mp_a, float Mp_b) { return k_dt * minf(Mp_a, Mp_b); }
 
 /// Colour bleeding (§5.1): a particle of mass m_k within R_j of a sample that does not absorb it
