@@ -5,44 +5,11 @@
 #include <cmath>
 #include <vector>
 
-#include "backend_fixture.h"
-#include "core/io/pen_pose.h"
-#include "core/sim/simulator.h"
+#include "sim/sim_fixture.h"
 
 namespace wb::test {
 namespace {
 
-class SimulatorTest : public BackendTest {
- protected:
-  SimConfig small_config() const {
-    SimConfig c;
-    c.device = device_;
-    c.canvas = CanvasDims{256, 256, 16};
-    c.window = Int3{48, 48, 16};
-    c.brush = default_brush(BrushShape::Round);
-    c.brush.bristles = 40;
-    c.brush.length = 40.f;
-    c.brush.width = c.brush.thickness = 12.f;
-    c.brush.samples_per_bristle = 64;
-    c.params.particles.D0 = 12.f;
-    c.params.particles.D1 = 6.f;
-    return c;
-  }
-  static BrushPose pose_at(const BrushSpec& b, float x, float y, float pressure, bool down = true) {
-    PenSample s;
-    s.x = x;
-    s.y = y;
-    s.pressure = pressure;
-    s.down = down;
-    return pose_from_pen(s, b);
-  }
-  static PaintLoad red() {
-    PaintLoad p;
-    p.ryb[0] = 0.9f, p.ryb[1] = 0.1f, p.ryb[2] = 0.05f;
-    p.load = 1.f;
-    return p;
-  }
-};
 
 TEST_F(SimulatorTest, CleanBrushLeavesNoPaint) {
   const SimConfig c = small_config();

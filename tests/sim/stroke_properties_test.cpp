@@ -5,9 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "backend_fixture.h"
-#include "core/io/pen_pose.h"
-#include "core/sim/simulator.h"
+#include "sim/sim_fixture.h"
 
 namespace wb::test {
 namespace {
@@ -16,52 +14,26 @@ constexpr float kDt = 1.f / 60.f;
 constexpr int kW = 240, kH = 64;
 constexpr float kY = 32.f, kX0 = 30.f, kX1 = 200.f;
 
-class StrokePropertiesTest : public BackendTest {
+class StrokePropertiesTest : public SimulatorTest {
  protected:
-  SimConfig config() const {
-    SimConfig c;
-    c.device = device_;
-    c.canvas = CanvasDims{kW, kH, 16};
-    c.window = Int3{48, 48, 16};
-    c.brush = default_brush(BrushShape::Round);
-    c.brush.bristles = 40;
-    c.brush.length = 40.f;
-    c.brush.width = c.brush.thickness = 12.f;
-    c.brush.samples_per_bristle = 64;
-    c.params.particles.D0 = 12.f;
-    c.params.particles.D1 = 6.f;
-    return c;
-  }
-  static BrushPose pose_at(const BrushSpec& b, float x, float pressure, bool down = true) {
-    PenSample s;
-    s.x = x;
-    s.y = kY;
-    s.pressure = pressure;
-    s.down = down;
-    return pose_from_pen(s, b);
-  }
-
   /// Column paint (cells) per canvas column after a straight stroke along x at `speed` cells/s,
   /// its sub-steps moving at most `max_move` cells; the brush lands, drags, lifts.
   std::vector<float> paint_stroke(float speed, float max_move) {
-    const SimConfig c = config();
-    Simulator sim(c, pose_at(c.brush, kX0, 0.f, false));
-    PaintLoad red;
-    red.ryb[0] = 0.9f, red.ryb[1] = 0.1f, red.ryb[2] = 0.05f;
-    red.load = 1.f;
-    sim.load_paint(red);
+    const SimConfig c = small_config(CanvasDims{kW, kH, 16});
+    Simulator sim(c, pose_at(c.brush, kX0, kY, 0.f, false));
+    sim.load_paint(red());
     const float p = 0.6f;
-    for (int i = 1; i <= 4; ++i) sim.step(pose_at(c.brush, kX0, p * 0.25f * float(i)), kDt);
+    for (int i = 1; i <= 4; ++i) sim.step(pose_at(c.brush, kX0, kY, p * 0.25f * float(i)), kDt);
     const int substeps = std::max(1, int(std::ceil(speed * kDt / max_move)));
-    std::vector<BrushPose> poses(static_cast<size_t>(substeps), pose_at(c.brush, kX0, p));
+    std::vector<BrushPose> poses(static_cast<size_t>(substeps), pose_at(c.brush, kX0, kY, p));
     float x = kX0;
     while (x < kX1) {
       for (int k = 0; k < substeps; ++k)
-        poses[size_t(k)] = pose_at(c.brush, std::min(kX1, x + speed * kDt * float(k + 1) / float(substeps)), p);
+        poses[size_t(k)] = pose_at(c.brush, std::min(kX1, x + speed * kDt * float(k + 1) / float(substeps)), kY, p);
       sim.step(poses.data(), substeps, kDt);
       x += speed * kDt;
     }
-    for (int i = 0; i < 6; ++i) sim.step(pose_at(c.brush, kX1, 0.f, false), kDt);
+    for (int i = 0; i < 6; ++i) sim.step(pose_at(c.brush, kX1, kY, 0.f, false), kDt);
     sim.settle();
     EXPECT_LT(std::abs(sim.books().max_drift()), 1e-4);
     EXPECT_EQ(sim.counters().nonfinite_events, 0);
