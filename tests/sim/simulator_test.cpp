@@ -62,6 +62,7 @@ TEST_F(SimulatorTest, DraggedBrushKeepsPaintingWithWickingAndGridOnlyHoldsNoPart
   auto drag = [&](float wick, bool particles, int64_t* held_max) {
     SimConfig c = small_config();
     c.params.transfer.wick_rate = wick;
+    if (wick == 0.f) c.params.transfer.wick_slide = 0.f;  // the paper's model: no flow along a bristle
     c.particles = particles;
     Simulator sim(c, pose_at(c.brush, 100, 128, 0.f, false));
     sim.load_paint(red());

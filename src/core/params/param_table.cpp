@@ -107,6 +107,7 @@ std::vector<ParamInfo> build_table() {
       WB_PARAM(transfer.slow_speed, "Slow speed", "cells/s", "§5.2", 0, 1e4, "Particles slower than this go back to the grid"),
       WB_PARAM(transfer.return_margin, "Return margin", "cells", "§5.2", 0, 100, "Particles go back to the grid only this far beyond D0"),
       WB_PARAM(transfer.wick_rate, "Wicking", "1/s", "", 0, 1e6, "Capillary flow of paint along a bristle towards its emptier samples"),
+      WB_PARAM(transfer.wick_slide, "Drag pumping", "1/cell", "", 0, 1e5, "Paint drawn along a bristle towards its contact per cell the bristle slides"),
       WB_PARAM(render.step, "Ray step", "cells", "§6", 0.05, 2, "Ray-march step"),
       WB_PARAM(render.threshold, "Surface density", "", "§6", 0.01, 1, "Density at which the surface is found"),
       WB_PARAM(render.penetration_per_oil, "Oil penetration", "cells", "§6", 0, 100,

@@ -157,13 +157,18 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
   grid_->set_particle_density(nullptr);  // last step's raster is stale
 
   // --- 1-2. Brush (§4.1) in sub-steps, then its samples ------------------------------------
+  const Vec3 footprint_before = footprint_centre(brush_->pose(), config_.brush.length);
   brush_stage(poses, substeps, dt);
   TransferRecord rec;
 
   // --- 3. Window: follow the brush; rasterise the bristles into it (boundary of §4.2) -----
   {
     WB_PROFILE_SCOPE("window");
-    const Int3 next = grid_->window().origin_for(footprint_centre(brush_->pose(), config_.brush.length),
+    // Centred on the middle of the step's path: the paint the bristles sweep over the step
+    // (swept contact, laid from where each sample was to where it is) lies inside the window
+    // for a path up to the window less the footprint and its rims (docs/TRANSFER.md).
+    const Vec3 footprint_after = footprint_centre(brush_->pose(), config_.brush.length);
+    const Int3 next = grid_->window().origin_for(0.5f * (footprint_before + footprint_after),
                                                  config_.params.grid.window_snap);
     if (particles_.size() > 0) deposit_leaving_particles(next, rec);
     grid_->move_window(next);

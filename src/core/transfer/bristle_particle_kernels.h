@@ -85,8 +85,14 @@ WB_HD WB_INLINE Vec3 mix_batch(Vec3 c_self, float w_self, Vec3 sum_wc, float sum
 }
 
 /// Edge conductance of the wicking flow between samples a and b of one bristle, kg per unit
-/// saturation: k dt min(M_a, M_b) (docs/TRANSFER.md "Wicking").
-WB_HD WB_INLINE float wick_conductance(float k_dt, float Mp_a, float Mp_b) { return k_dt * minf(Mp_a, Mp_b); }
+/// saturation: (k dt + k_slide l) min(M_a, M_b), l the distance the edge slid over the step
+/// (capillary flow per second plus drag pumping per cell slid; docs/TRANSFER.md "Wicking").
+WB_HD WB_INLINE float wick_conductance(float k_dt, float k_slide, float slid, float Mp_a, float Mp_b) {
+  return (k_dt + k_slide * slid) * minf(Mp_a, Mp_b);
+}
+
+/// Distance a sample slid along the canvas over a step, cells: its velocity's xy part times dt.
+WB_HD WB_INLINE float slid_distance(Vec3 v, float dt) { return sqrtf(v.x * v.x + v.y * v.y) * dt; }
 
 /// Colour bleeding (§5.1): a particle of mass m_k within R_j of a sample that does not absorb it
 /// exchanges e = bleed min(m_k, m_j) of colour with the sample; masses are unchanged.

@@ -18,8 +18,9 @@ namespace {
 void d_absorb(const Device& d, ParticleView p, SampleView s, BristleLoadView l, AbsorbScratch a, TransferParams prm) {
   WB_DISPATCH(d, transfer_absorb(p, s, l, a, prm));
 }
-void d_wick(const Device& d, BristleLoadView l, int bristles, int per, float k_dt, float* a, float* b) {
-  WB_DISPATCH(d, transfer_wick(l, bristles, per, k_dt, a, b));
+void d_wick(const Device& d, SampleView s, BristleLoadView l, int bristles, int per, float k_dt, float k_slide,
+            float dt, float* a, float* b) {
+  WB_DISPATCH(d, transfer_wick(s, l, bristles, per, k_dt, k_slide, dt, a, b));
 }
 void d_absorb_apply(const Device& d, BristleLoadView l, AbsorbScratch a) { WB_DISPATCH(d, transfer_absorb_apply(l, a)); }
 void d_occupancy(const Device& d, SampleView s, DistanceBlocks db, int32_t* occ, int ox, int oy, int oz) {
@@ -77,6 +78,7 @@ void validate(const TransferParams& p) {
   WB_REQUIRE(in(p.march_step, 0.05f, 1.f), "TransferParams: march_step must lie in [0.05, 1] cells");
   WB_REQUIRE(in(p.return_margin, 0.f, 100.f), "TransferParams: return_margin must lie in [0, 100] cells");
   WB_REQUIRE(in(p.wick_rate, 0.f, 1e6f), "TransferParams: wick_rate must lie in [0, 1e6] 1/s");
+  WB_REQUIRE(in(p.wick_slide, 0.f, 1e5f), "TransferParams: wick_slide must lie in [0, 1e5] per cell slid");
   WB_REQUIRE(p.absorb_limit >= 0 && p.absorb_limit <= 1024, "TransferParams: absorb_limit must lie in [0, 1024]");
   WB_REQUIRE(p.emit_limit >= 0 && p.emit_limit <= 64, "TransferParams: emit_limit must lie in [0, 64]");
   WB_REQUIRE(in(p.emit_mass, 1e-20f, p.M_max), "TransferParams: emit_mass must lie in (0, M_max] kg");
@@ -216,8 +218,8 @@ void Transfer::wick(const SampleView& samples, BristleLoad& load, float dt) {
   WB_REQUIRE(std::isfinite(dt) && dt >= 0.f, "Transfer::wick: dt must be finite and >= 0");
   if (ns == 0 || dt == 0.f) return;
   ensure_samples(ns);
-  d_wick(device_, load.view(), samples.bristles, samples.per_bristle, params_.wick_rate * dt, s_f32_[0].data(),
-         s_f32_[1].data());
+  d_wick(device_, samples, load.view(), samples.bristles, samples.per_bristle, params_.wick_rate * dt,
+         params_.wick_slide, dt, s_f32_[0].data(), s_f32_[1].data());
 }
 
 void Transfer::absorb(const SampleView& samples, BristleLoad& load, ParticleStore& particles, TransferRecord& rec) {

@@ -185,7 +185,8 @@ void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadVi
                          CellField particles, TransferParams prm, float floor_z, float dry_threshold, float dt);   \
   void transfer_absorb(ParticleView p, SampleView s, BristleLoadView load, AbsorbScratch a, TransferParams prm);    \
   void transfer_absorb_apply(BristleLoadView load, AbsorbScratch a);                                               \
-  void transfer_wick(BristleLoadView load, int bristles, int per, float k_dt, float* a, float* d);                 \
+  void transfer_wick(SampleView s, BristleLoadView load, int bristles, int per, float k_dt, float k_slide, float dt, \
+                     float* a, float* d);                 \
   void transfer_distance_occupancy(SampleView s, DistanceBlocks db, int32_t* occ, int ox, int oy, int oz);         \
   void transfer_distance_init(const int32_t* occ, float* d2, int64_t n);                                           \
   void transfer_distance_pass(DistanceBlocks db, int axis, const float* src, float* dst, int32_t* v, float* z);    \

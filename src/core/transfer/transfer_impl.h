@@ -35,7 +35,7 @@ void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellFi
     // the wick's sink).
     const Vec3 v = s.v[j];
     const float m = load.m[j];
-    const float travel = sqrtf(v.x * v.x + v.y * v.y) * dt;
+    const float travel = slid_distance(v, dt);
     load.sweep[j] = m > 0.f ? swept_deposit(m, gap, film, travel, prm.split, cm) / m : 0.f;
   });
 }
@@ -46,7 +46,8 @@ void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellFi
 // algorithm; the matrix is an M-matrix, so s stays >= 0 and the bristle's mass is kept), then
 // the edge fluxes from the new saturations carry colour and oil upwind from the old values.
 // a, d are per-sample scratch (the eliminated diagonal and right-hand side).
-void transfer_wick(BristleLoadView load, int bristles, int per, float k_dt, float* a, float* d) {
+void transfer_wick(SampleView s, BristleLoadView load, int bristles, int per, float k_dt, float k_slide, float dt,
+                   float* a, float* d) {
   parallel_for(
       bristles,
       [=] WB_HD(int64_t b) {
@@ -61,9 +62,15 @@ void transfer_wick(BristleLoadView load, int bristles, int per, float k_dt, floa
         // Forward sweep: row i is (-g_{i-1}) s_{i-1} + (M_i (1 + sigma_i) + g_{i-1} + g_i) s_i
         // + (-g_i) s_{i+1} = m_i, with the swept contact's sink sigma_i M_i s_i (backward Euler).
         const float* sigma = load.sweep + o;
+        const Vec3* v = s.v + o;
+        // Conductance of edge i (samples i, i + 1); the drag term uses the edge's mean slide.
+        const auto edge = [&](int i) {
+          const float slid = 0.5f * (slid_distance(v[i], dt) + slid_distance(v[i + 1], dt));
+          return wick_conductance(k_dt, k_slide, slid, Mp[i], Mp[i + 1]);
+        };
         float g_prev = 0.f;
         for (int i = 0; i < per; ++i) {
-          const float g = i + 1 < per ? wick_conductance(k_dt, Mp[i], Mp[i + 1]) : 0.f;
+          const float g = i + 1 < per ? edge(i) : 0.f;
           const float diag = maxf(Mp[i], 1e-30f) * (1.f + maxf(sigma[i], 0.f)) + g_prev + g -
                              (i > 0 ? g_prev * sc[i - 1] : 0.f);
           sc[i] = g / diag;  // minus the eliminated upper coefficient (-g_i / diag)
@@ -76,7 +83,7 @@ void transfer_wick(BristleLoadView load, int bristles, int per, float k_dt, floa
         Vec3 c_left(0.f, 0.f, 0.f);
         float oil_left = 0.f, F_left = 0.f;
         for (int i = 0; i < per; ++i) {
-          const float F = i + 1 < per ? wick_conductance(k_dt, Mp[i], Mp[i + 1]) * (sd[i] - sd[i + 1]) : 0.f;
+          const float F = i + 1 < per ? edge(i) * (sd[i] - sd[i + 1]) : 0.f;
           const Vec3 ci(load.pigment_r[o + i], load.pigment_y[o + i], load.pigment_b[o + i]);
           const float oil_i = load.oil[o + i];
           const float mi = m[i];
@@ -309,8 +316,7 @@ void transfer_emit_count(SampleView s, BristleLoadView load, TransferParams prm,
     float me = 0.f;
     const int n = emission_count(load.m[j], load.capacity[j], eps, emit_mass, limit, me);
     // Swept contact: what the sample leaves on the surface it slid over this step.
-    const Vec3 v = s.v[j];
-    const float travel = sqrtf(v.x * v.x + v.y * v.y) * dt;
+    const float travel = slid_distance(s.v[j], dt);
     const float left = load.m[j] - float(n) * me;
     const float deposit = minf(load.sweep[j], left);  // the wick solve's deposit
     float se = 0.f;

@@ -42,6 +42,13 @@ struct TransferParams {
   /// runs dry. Diffusion length sqrt(2 k t) samples: 63 in 1 s at the default 2000. 0 turns
   /// wicking off (the paper's model). Range [0, 1e6].
   float wick_rate = 2000.f;
+  /// Drag pumping, per cell slid: the surface sliding under a bristle shears the paint around
+  /// its contact and draws paint along the bristle towards it. Added to the conductance of an
+  /// edge as k_slide * (distance the two samples slid over the step, mean), so the supply to
+  /// the contact per cell of stroke is the same at any speed (docs/TRANSFER.md "Wicking").
+  /// Diffusion length sqrt(2 k_slide L) samples after L cells slid: 14 samples per cell at the
+  /// default 100. 0 leaves only the capillary flow. Range [0, 1e5].
+  float wick_slide = 100.f;
 
   // --- swept contact (beyond the paper: docs/TRANSFER.md "Swept contact") ---
   /// Share of the paint a bristle sample sweeps over a surface that stays on the surface (film
