@@ -3,6 +3,10 @@
 // and covers its track. Small brush, short strokes (CI on two CPU cores).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "sim/sim_fixture.h"
@@ -17,29 +21,63 @@ constexpr float kY = 32.f, kX0 = 30.f, kX1 = 200.f;
 /// load lays about 30 mm of track, then runs out).
 constexpr int kBody0 = int(kX0) + 30, kBody1 = int(kX0) + 110;
 
+/// A straight stroke along x at y = kY: the brush lands in 4 steps, drags from kX0 to kX1 at
+/// `speed` cells/s, lifts.
+struct Stroke {
+  float speed = 800.f;     ///< cells/s
+  float max_move = 2.f;    ///< most cells a sub-step moves
+  float pressure = 0.6f;
+  float twist = 0.f;       ///< degrees: 90 pulls a flat broadside (its width across the stroke)
+  float load = 1.f;
+  std::optional<BrushSpec> brush;  ///< none: the scene's small round brush
+  bool particles = true;   ///< false: grid-only paint (Fig. 7a/c)
+};
+
 class StrokePropertiesTest : public SimulatorTest {
  protected:
-  /// Column paint (cells) per canvas column after a straight stroke along x at `speed` cells/s,
-  /// its sub-steps moving at most `max_move` cells; the brush lands, drags, lifts.
-  std::vector<float> paint_stroke(float speed, float max_move) {
+  /// A small flat (a fifth of the default flat's 12 mm): 60 bristles, 6 mm long, 3.2 mm wide.
+  static BrushSpec small_flat() {
+    BrushSpec b = default_brush(BrushShape::Flat);
+    b.bristles = 60;
+    b.length = 30.f;
+    b.width = 16.f;
+    b.thickness = 4.f;
+    b.samples_per_bristle = 48;
+    return b;
+  }
+
+  /// Column paint (cells) per canvas column after `st`; `sim_out` receives the canvas if set.
+  std::vector<float> paint_stroke(const Stroke& st) {
     SimConfig c = small_config(CanvasDims{kW, kH, 16});
-    if (getenv("WICK")) c.params.transfer.wick_rate = atof(getenv("WICK"));
-    Simulator sim(c, pose_at(c.brush, kX0, kY, 0.f, false));
-    sim.load_paint(red());
-    const float p = 0.6f;
-    for (int i = 1; i <= 4; ++i) sim.step(pose_at(c.brush, kX0, kY, p * 0.25f * float(i)), kDt);
-    const int substeps = std::max(1, int(std::ceil(speed * kDt / max_move)));
-    std::vector<BrushPose> poses(static_cast<size_t>(substeps), pose_at(c.brush, kX0, kY, p));
+    if (st.brush) c.brush = *st.brush;
+    c.particles = st.particles;
+    auto pose = [&](float x, float p, bool down = true) {
+      PenSample s;
+      s.x = x, s.y = kY, s.pressure = p, s.twist = st.twist, s.down = down;
+      return pose_from_pen(s, c.brush);
+    };
+    Simulator sim(c, pose(kX0, 0.f, false));
+    PaintLoad paint = red();
+    paint.load = st.load;
+    sim.load_paint(paint);
+    for (int i = 1; i <= 4; ++i) sim.step(pose(kX0, st.pressure * 0.25f * float(i)), kDt);
+    const int substeps = std::max(1, int(std::ceil(st.speed * kDt / st.max_move)));
+    std::vector<BrushPose> poses(static_cast<size_t>(substeps), pose(kX0, st.pressure));
     float x = kX0;
     while (x < kX1) {
       for (int k = 0; k < substeps; ++k)
-        poses[size_t(k)] = pose_at(c.brush, std::min(kX1, x + speed * kDt * float(k + 1) / float(substeps)), kY, p);
+        poses[size_t(k)] = pose(std::min(kX1, x + st.speed * kDt * float(k + 1) / float(substeps)), st.pressure);
       sim.step(poses.data(), substeps, kDt);
-      x += speed * kDt;
+      x += st.speed * kDt;
     }
-    for (int i = 0; i < 6; ++i) sim.step(pose_at(c.brush, kX1, kY, 0.f, false), kDt);
-    std::printf("brush left %.3g kg of %.3g\n", sim.books().steps().back().census.bristles, sim.books().expected_total());
+    for (int i = 0; i < 6; ++i) sim.step(pose(kX1, 0.f, false), kDt);
     sim.settle();
+    if (std::getenv("WB_STROKE_BOOKS")) {
+      const PaintCensus cs = sim.census();
+      std::printf("books: expected %.4g kg, census %.4g (bristles %.3g, particles %.3g, grid %.3g), canvas %.1f cells\n",
+                  sim.books().expected_total(), cs.total(), cs.bristles, cs.particles, cs.grid,
+                  sim.canvas().total_density(ws_));
+    }
     EXPECT_LT(std::abs(sim.books().max_drift()), 1e-4);
     EXPECT_EQ(sim.counters().nonfinite_events, 0);
     PaintWindow w(device_, Int3{kW, kH, 16});
@@ -49,31 +87,36 @@ class StrokePropertiesTest : public SimulatorTest {
     for (int z = 0; z < 16; ++z)
       for (int y = 0; y < kH; ++y)
         for (int xx = 0; xx < kW; ++xx) col[size_t(y) * kW + xx] += host[0][(size_t(z) * kH + y) * kW + xx];
-    if (getenv("PROFILE")) {
-      for (int x0 = 0; x0 < kW; x0 += 10) {
-        double v = 0;
-        for (int y = 0; y < kH; ++y)
-          for (int x = x0; x < x0 + 10; ++x) v += col[size_t(y) * kW + x];
-        std::printf("%5.1f", v / 10);
+    if (const char* dir = std::getenv("WB_STROKE_DUMP")) {  // column paint as an 8-bit PGM, 40 levels a cell
+      static int serial = 0;
+      const std::string name = std::string(dir) + "/stroke_" + std::to_string(serial++) + ".pgm";
+      if (FILE* f = std::fopen(name.c_str(), "wb")) {
+        std::fprintf(f, "P5 %d %d 255\n", kW, kH);
+        for (float v : col) std::fputc(int(std::min(255.f, v * 40.f)), f);
+        std::fclose(f);
       }
-      std::printf("\n");
-    }
-    if (getenv("DUMP")) {
-      char name[64];
-      std::snprintf(name, sizeof name, "/tmp/probe/col_%d_%d.pgm", int(speed), int(max_move));
-      FILE* f = std::fopen(name, "wb");
-      std::fprintf(f, "P5 %d %d 255\n", kW, kH);
-      for (float v : col) std::fputc(int(std::min(255.f, v * 40.f)), f);
-      std::fclose(f);
     }
     return col;
   }
-  /// Share of the track's central band (half the brush width) holding at least a tenth of a
+  std::vector<float> paint_stroke(float speed, float max_move) {
+    Stroke st;
+    st.speed = speed, st.max_move = max_move;
+    return paint_stroke(st);
+  }
+  /// Paint per cell of track (cells^2) at each column x: the column paint summed across y.
+  static std::vector<double> per_length(const std::vector<float>& col) {
+    std::vector<double> v(kW, 0.0);
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x) v[size_t(x)] += col[size_t(y) * kW + x];
+    return v;
+  }
+  /// Share of the cells of rows [y0, y1] and columns [x0, x1) holding at least a tenth of a
   /// cell of paint.
-  static double coverage(const std::vector<float>& col) {
+  static double coverage(const std::vector<float>& col, int x0 = kBody0, int x1 = kBody1, int y0 = int(kY) - 3,
+                         int y1 = int(kY) + 3) {
     int n = 0, covered = 0;
-    for (int y = int(kY) - 3; y <= int(kY) + 3; ++y)
-      for (int x = kBody0; x < kBody1; ++x, ++n) covered += col[size_t(y) * kW + x] >= 0.1f;
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x < x1; ++x, ++n) covered += col[size_t(y) * kW + x] >= 0.1f;
     return double(covered) / n;
   }
 };
@@ -122,6 +165,28 @@ TEST_F(StrokePropertiesTest, SameStrokeAtAnySpeedLaysTheSameLayer) {
   const double lo = *std::min_element(per_length, per_length + 3), hi = *std::max_element(per_length, per_length + 3);
   EXPECT_LE(hi, 2 * lo) << "volume per unit length within a factor of 2 across speeds";
   for (double c : cover) EXPECT_GE(c, 0.9);
+}
+
+TEST_F(StrokePropertiesTest, OneLoadRunsOutAlongALongStroke) {
+  // The small flat pulled broadside over the whole 34 mm track at 120 mm/s with one load: the
+  // load runs down along the stroke, and its end breaks into dry-brush coverage.
+  Stroke st;
+  st.speed = 600.f;
+  st.brush = small_flat();
+  st.twist = 90.f;
+  st.load = 0.6f;
+  const std::vector<float> col = paint_stroke(st);
+  const std::vector<double> v = per_length(col);
+  const int q = (int(kX1) - int(kX0)) / 4;
+  double first = 0, last = 0;
+  for (int x = int(kX0); x < int(kX0) + q; ++x) first += v[size_t(x)];
+  for (int x = int(kX1) - q; x < int(kX1); ++x) last += v[size_t(x)];
+  const double end_cover = coverage(col, int(kX1) - q, int(kX1), int(kY) - 5, int(kY) + 5);
+  std::printf("paint per unit length: first quarter %.2f, last quarter %.2f cells^2 (%.0f %%); last quarter covered %.0f %%\n",
+              first / q, last / q, 100 * last / first, 100 * end_cover);
+  EXPECT_LT(last, 0.6 * first) << "the load runs down";
+  EXPECT_LT(end_cover, 0.9) << "the end breaks into dry-brush coverage";
+  EXPECT_GT(last, 0.0) << "but still paints";
 }
 
 }  // namespace

@@ -9,12 +9,16 @@ namespace wb::test {
 
 class WickTest : public TransferTest {
  protected:
-  static SampleView layout(int bristles, int per) {
-    SampleView s{};
-    s.bristles = bristles;
-    s.per_bristle = per;
-    return s;
+  /// `bristles` straight bristles of `per` samples sliding along the canvas at `vel` cells/s.
+  SampleView layout(int bristles, int per, Vec3 vel = Vec3()) {
+    HostSamples h;
+    h.resize(bristles, per);
+    for (int b = 0; b < bristles; ++b)
+      straight_bristle(h, b, Vec3(10.f + b, 10.f, 1.f), Vec3(0.f, 0.f, 1.f), Vec3(1.f, 0.f, 0.f), 0.5f, vel, Vec3());
+    samples_.upload(h);
+    return samples_.view();
   }
+  DeviceSamples samples_{device_};
   static BristleLoadHost random_load(int n, std::mt19937& rng, const TransferParams& prm) {
     std::uniform_real_distribution<float> U(0.f, 1.f);
     BristleLoadHost h;
@@ -103,6 +107,36 @@ TEST_F(WickTest, FeedsAnEmptiedTipWithTheBristlesColour) {
   EXPECT_FLOAT_EQ(a.pigment_y[per - 1], 0.f);
   // Saturation rises monotonically from the tip up.
   for (int i = 1; i < per; ++i) EXPECT_GE(a.m[i], a.m[i - 1] * (1 - 1e-5f));
+}
+
+TEST_F(WickTest, SlidingPumpsPaintDownAHeldBristleDoesNotLeak) {
+  // Drag pumping: with no rate per second, an emptied tip refills only while the bristle
+  // slides, by an amount set by the distance slid, not by the time taken.
+  const int per = 32;
+  TransferParams prm;
+  prm.wick_rate = 0.f;
+  prm.wick_slide = 100.f;
+  BristleLoadHost h;
+#define WB_X(name, doc) h.name.assign(size_t(per), 0.f);
+  WB_BRISTLE_LOAD_FIELDS(WB_X)
+#undef WB_X
+  for (int i = 0; i < per; ++i) {
+    h.potential[i] = h.capacity[i] = prm.M_max;
+    h.radius[i] = 0.75f;
+    h.m[i] = i == 0 ? 0.f : prm.M_max;
+  }
+  Transfer t(device_, prm);
+  auto tip_after = [&](Vec3 vel, float dt) {
+    BristleLoad load(device_, per, prm);
+    load.from_host(h);
+    t.wick(layout(1, per, vel), load, dt);
+    return load.to_host().m[0];
+  };
+  EXPECT_EQ(tip_after(Vec3(), 1.f / 60.f), 0.f) << "a bristle at rest does not pump";
+  const float slow = tip_after(Vec3(30.f, 0.f, 0.f), 1.f / 15.f);   // 2 cells slid in 1/15 s
+  const float fast = tip_after(Vec3(120.f, 0.f, 0.f), 1.f / 60.f);  // 2 cells slid in 1/60 s
+  EXPECT_GT(slow, 0.3f * prm.M_max) << "two cells of sliding refill the tip";
+  EXPECT_NEAR(fast, slow, 1e-4f * prm.M_max) << "the same distance slid pumps the same paint";
 }
 
 TEST_F(WickTest, RejectsBadInput) {

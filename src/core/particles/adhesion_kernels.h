@@ -138,7 +138,12 @@ WB_HD WB_INLINE void adhesion_update(Vec3& p, Vec3& v, const SampleFrame* sample
   const Vec3 a_k = gravity + friction_accel(v, d, delta, dt);
   const Vec3 p_canvas = canvas_frame_step(p, v, a_k, dt);
   Vec3 p_new = p_canvas;
-  if (sample && d_B < D1) p_new = adhesion_blend(local_frame_step(p, v, a_k, *sample, beta_L, dt), p_canvas, d_B, D1);
+  // Paint the canvas holds (Eq. 8's weight) does not also follow a bristle: without this a
+  // particle lying under a bristle tip takes (1 - beta_L) of the tip's motion when the brush
+  // lifts or lands (the handle moves ~25 cells in one step), keeps that velocity once it is
+  // past D1, and lands up to 3 brush radii away (docs/PARTICLES.md "The canvas holds").
+  const float w = adhesion_weight(d_B, D1) * (1.f - friction_weight(d, delta));
+  if (sample && w > 0.f) p_new = p_canvas + (local_frame_step(p, v, a_k, *sample, beta_L, dt) - p_canvas) * w;
   // The particle cannot enter the solid; the projection only sees the solid on the grid.
   const float zs = solid_surface_z(solid, p_new);
   if (p_new.z < zs) p_new.z = zs;
