@@ -1,0 +1,278 @@
+// Properties of a stroke over paint already on the canvas, measured on the paint the stroke
+// leaves: a white brush drawn through wet red carries pink past it. Small brush, short
+// strokes (CI on two CPU cores).
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <functional>
+#include <vector>
+
+#include "core/render/renderer.h"
+#include "sim/sim_fixture.h"
+
+namespace wb::test {
+namespace {
+
+constexpr float kDt = 1.f / 60.f;
+constexpr int kDepth = 16;
+constexpr float kY = 32.f;
+
+// Diagnosis: WB_LAYER_VERBOSE=1 prints per-step figures (2: also by ridge phase) (where the paint is, what the bristles
+// absorb and emit, where they touch); the WB_LAYER_* overrides below re-run a test with one
+// parameter changed, to tell the causes of a failure apart.
+int verbose() { return std::getenv("WB_LAYER_VERBOSE") ? std::atoi(std::getenv("WB_LAYER_VERBOSE")) : 0; }
+float env_or(const char* name, float fallback) {
+  const char* v = std::getenv(name);
+  return v ? float(std::atof(v)) : fallback;
+}
+
+class LayerPropertiesTest : public SimulatorTest {
+ protected:
+  using CellFn = std::function<PaintCell(int x, int y, int z)>;
+
+  SimConfig layer_config(CanvasDims canvas) const {
+    SimConfig c = small_config(canvas);
+    c.particles = env_or("WB_LAYER_PARTICLES", 1.f) != 0.f;
+    c.brush.bristle_radius = env_or("WB_LAYER_BRISTLE_RADIUS", c.brush.bristle_radius);
+    c.params.particles.delta = env_or("WB_LAYER_DELTA", c.params.particles.delta);
+    c.params.particles.D1 = env_or("WB_LAYER_D1", c.params.particles.D1);
+    c.params.grid.dry_threshold = env_or("WB_LAYER_DRY_THRESHOLD", c.params.grid.dry_threshold);
+    c.params.transfer.absorb_limit = int(env_or("WB_LAYER_ABSORB_LIMIT", float(c.params.transfer.absorb_limit)));
+    c.params.transfer.bleed = env_or("WB_LAYER_BLEED", c.params.transfer.bleed);
+    return c;
+  }
+
+  /// Writes `cell` into every tile of the canvas (tiles left all empty are not allocated) and
+  /// reloads the simulator's window from the canvas.
+  static void write_layer(Simulator& sim, const CellFn& cell) {
+    TileStore& canvas = sim.canvas();
+    const size_t n = size_t(canvas.tile_cells());
+    for (int ty = 0; ty < canvas.tiles_y(); ++ty)
+      for (int tx = 0; tx < canvas.tiles_x(); ++tx) {
+        TileData t;
+        t.tile_x = tx, t.tile_y = ty;
+        t.density.assign(n, 0.f);
+        for (auto* f : {&t.pigment_r, &t.pigment_y, &t.pigment_b, &t.oil, &t.dryness}) f->assign(n, 0);
+        bool any = false;
+        for (int z = 0; z < canvas.dims().depth; ++z)
+          for (int ly = 0; ly < kTileSize; ++ly)
+            for (int lx = 0; lx < kTileSize; ++lx) {
+              const PaintCell c = cell(tx * kTileSize + lx, ty * kTileSize + ly, z);
+              if (c.density <= 0.f) continue;
+              const size_t i = (size_t(z) * kTileSize + ly) * kTileSize + lx;
+              t.density[i] = c.density;
+              t.pigment_r[i] = encode_unorm16(c.pigment_r);
+              t.pigment_y[i] = encode_unorm16(c.pigment_y);
+              t.pigment_b[i] = encode_unorm16(c.pigment_b);
+              t.oil[i] = encode_unorm16(c.oil);
+              t.dryness[i] = encode_unorm16(c.dryness);
+              any = true;
+            }
+        if (any) canvas.write_tile(t);
+      }
+    sim.grid().window().reload();
+  }
+
+  /// The books from the census taken after the layer was written: the simulator opened its
+  /// books on an empty canvas, so their own drift counts the layer as paint from nowhere.
+  struct Books {
+    double start = 0, external0 = 0;
+    void open(Simulator& sim) {
+      start = sim.census().total();
+      external0 = sim.books().external_total();
+    }
+    /// Largest |census - expected| / expected over the steps recorded since open().
+    double max_drift(const Simulator& sim) const {
+      double ext = 0, worst = 0;
+      for (const PaintStep& s : sim.books().steps()) {
+        ext += s.external;
+        const double expected = start + ext - external0;
+        worst = std::max(worst, std::fabs(s.census.total() - expected) / expected);
+      }
+      return worst;
+    }
+  };
+
+  /// A straight stroke along y = kY from x0 to x1 at `speed` cells/s (sub-steps of at most 2
+  /// cells) at pen pressure `p`: the brush lands in 4 steps, drags, lifts in 6; then settle().
+  static void drag(Simulator& sim, float x0, float x1, float speed, float p) {
+    const BrushSpec& b = sim.config().brush;
+    for (int i = 1; i <= 4; ++i) sim.step(pose_at(b, x0, kY, p * 0.25f * float(i)), kDt);
+    const int substeps = std::max(1, int(std::ceil(speed * kDt / 2.f)));
+    std::vector<BrushPose> poses(static_cast<size_t>(substeps));
+    for (float x = x0; x < x1; x += speed * kDt) {
+      for (int k = 0; k < substeps; ++k)
+        poses[size_t(k)] = pose_at(b, std::min(x1, x + speed * kDt * float(k + 1) / float(substeps)), kY, p);
+      sim.step(poses.data(), substeps, kDt);
+      if (verbose()) {
+        const PaintStep& st = sim.books().steps().back();
+        int low = 0;
+        float zmin = 1e9f;
+        const auto xs = sim.brush().samples_to_host();
+        for (const Vec3& q : xs) low += q.z < 4.f, zmin = std::min(zmin, q.z);
+        std::vector<Vec3> px(size_t(sim.particles().size()));
+        sim.particles().x.copy_to_host(px.data(), px.size());
+        double pz = 0;
+        for (const Vec3& q : px) pz += q.z;
+        if (std::fabs(x - 0.5f * (x0 + x1)) < 0.5f * speed * kDt) {
+          // Bristles as the grid sees them (psi, bristle volume per cell) in the paint's lowest
+          // 4 cells: how much of the footprint is an obstacle.
+          const Int3 o = sim.grid().window().origin(), n = sim.grid().window().dims();
+          const size_t cells = size_t(n.x) * n.y * n.z;
+          std::vector<float> psi(cells), vx(cells), vy(cells), vz(cells);
+          sim.brush().rasterize(o, n, psi.data(), vx.data(), vy.data(), vz.data());
+          double sum = 0, peak = 0;
+          int touched = 0, columns = 0;
+          for (int y = 0; y < n.y; ++y)
+            for (int xx = 0; xx < n.x; ++xx) {
+              bool any = false;
+              for (int z = 0; z < 4; ++z) {
+                const float v = psi[(size_t(z) * n.y + y) * n.x + xx];
+                sum += v, peak = std::max(peak, double(v)), touched += v > 0, any |= v > 0;
+              }
+              columns += any;
+            }
+          std::printf("  psi in z 0..4: %d cells touched, %d columns, sum %.2f cells, mean %.3f, peak %.3f\n", touched,
+                      columns, sum, sum / std::max(touched, 1), peak);
+        }
+        if (verbose() >= 2) {
+          // Over ridges across x (period 8, ridge x mod 8 < 4): particle mass by x mod 8 (0-3 over ridges) and high (z >= 3) or low; the
+          // lowest sample of each bristle by x mod 8.
+          std::vector<float> pm(size_t(sim.particles().size()));
+          sim.particles().m.copy_to_host(pm.data(), pm.size());
+          double hi[8] = {}, lo[8] = {};
+          int tips_lo[8] = {}, tips_hi[8] = {};
+          for (size_t k = 0; k < px.size(); ++k) {
+            const int ph = int(std::floor(px[k].x)) & 7;
+            (px[k].z >= 3.f ? hi : lo)[ph] += pm[k] / 8e-9;
+          }
+          const int per = sim.config().brush.samples_per_bristle;
+          for (size_t b = 0; b * per < xs.size(); ++b) {
+            Vec3 low = xs[b * per];
+            for (int j = 0; j < per; ++j) if (xs[b * per + j].z < low.z) low = xs[b * per + j];
+            const int ph = int(std::floor(low.x)) & 7;
+            (low.z < 2.f ? tips_lo : tips_hi)[ph] += 1;
+          }
+          const BristleLoadHost lh = sim.load().to_host();
+          double dep_hi[8] = {}, dep_lo[8] = {}, dep = 0;
+          for (size_t j = 0; j < xs.size(); ++j) {
+            const int ph = int(std::floor(xs[j].x)) & 7;
+            (xs[j].z >= 2.f ? dep_hi : dep_lo)[ph] += lh.sweep[j] / 8e-9;
+            dep += lh.sweep[j];
+          }
+          {
+            float zr = 1e9f, gr = 1e9f, zv = 1e9f, gv = 1e9f;
+            int near_r = 0, near_v = 0;
+            for (size_t j = 0; j < xs.size(); ++j) {
+              const bool on_ridge = (int(std::floor(xs[j].x)) & 7) < 4;
+              const float m = lh.m[j];
+              const float Rm = std::cbrt(3.f * m / (4.f * 3.14159f * 1000.f)) / 2e-4f;
+              if (on_ridge) zr = std::min(zr, xs[j].z), gr = std::min(gr, lh.gap[j]), near_r += xs[j].z < 3.f + Rm;
+              else zv = std::min(zv, xs[j].z), gv = std::min(gv, lh.gap[j]), near_v += xs[j].z < Rm;
+            }
+            std::printf("  over ridges: lowest sample z %.2f, least gap %.2f, %d within R_m of the top; over valleys: "
+                        "lowest z %.2f, least gap %.2f, %d within R_m of the floor\n", zr, gr, near_r, zv, gv, near_v);
+          }
+          std::printf("  swept deposit %.3g kg of %.3g emitted; by sample x mod 8, z >= 2 / < 2 (cells):", dep,
+                      sim.books().steps().back().transfer.emitted_from_bristles);
+          for (int i = 0; i < 8; ++i) std::printf(" %.2f/%.2f", dep_hi[i], dep_lo[i]);
+          std::printf("\n");
+          std::printf("  particles (cells) high/low by x mod 8:");
+          for (int i = 0; i < 8; ++i) std::printf(" %.2f/%.2f", hi[i], lo[i]);
+          std::printf("; lowest sample of each bristle, z >= 2 / < 2 by x mod 8:");
+          for (int i = 0; i < 8; ++i) std::printf(" %d/%d", tips_hi[i], tips_lo[i]);
+          std::printf("\n");
+        }
+        std::printf("  x %5.1f: bristles %.3g kg, particles %.3g kg (%lld, mean z %.2f), absorbed %.3g emitted %.3g "
+                    "to particles %.3g to grid %.3g; samples below z 4: %d of %zu, lowest %.2f\n",
+                    x, st.census.bristles, st.census.particles, (long long)sim.particles().size(),
+                    px.empty() ? 0.0 : pz / double(px.size()), st.transfer.absorbed_from_particles,
+                    st.transfer.emitted_from_bristles, st.transfer.to_particles_from_grid,
+                    st.transfer.to_grid_from_particles, low, xs.size(), zmin);
+      }
+    }
+    for (int i = 0; i < 6; ++i) sim.step(pose_at(b, x1, kY, 0.f, false), kDt);
+    sim.settle();
+  }
+
+  /// Host copy of the whole canvas (fields in WB_PAINT_FIELDS order).
+  std::vector<std::vector<float>> canvas_fields(Simulator& sim) {
+    const CanvasDims d = sim.canvas().dims();
+    PaintWindow w(device_, Int3{d.width, d.height, d.depth});
+    sim.canvas().gather(w);
+    return w.to_host();
+  }
+};
+
+// --- pick-up -----------------------------------------------------------------------------------
+
+TEST_F(LayerPropertiesTest, WhiteBrushCarriesRedPastAWetRedBand) {
+  // A wet red band across the path (12 cells wide, 3 thick, oil 0.3); a brush loaded with
+  // white (RYB 0, no pigment) dragged through it at 60 mm/s, pressure 0.6.
+  constexpr int kW = 224, kH = 64, kBand0 = 64, kBand1 = 76;
+  constexpr float kX0 = 24.f, kX1 = 184.f;
+  SimConfig c = layer_config(CanvasDims{kW, kH, kDepth});
+  Simulator sim(c, pose_at(c.brush, kX0, kY, 0.f, false));
+  const PaintLoad r = red();
+  write_layer(sim, [&](int x, int, int z) {
+    PaintCell p;
+    if (x >= kBand0 && x < kBand1 && z < 3)
+      p.density = 1.f, p.pigment_r = r.ryb[0], p.pigment_y = r.ryb[1], p.pigment_b = r.ryb[2], p.oil = 0.3f;
+    return p;
+  });
+  PaintLoad white;
+  white.ryb[0] = white.ryb[1] = white.ryb[2] = 0.f;
+  white.load = 1.f;
+  sim.load_paint(white);
+  Books books;
+  books.open(sim);
+  drag(sim, kX0, kX1, 300.f, 0.6f);
+  const double drift = books.max_drift(sim);
+  std::printf("books from the layer: drift %.2e\n", drift);
+  EXPECT_LT(drift, 1e-4);
+  EXPECT_EQ(sim.counters().nonfinite_events, 0);
+  const auto f = canvas_fields(sim);
+  Renderer renderer(device_);
+  const FloatImage albedo = renderer.render_albedo(sim.canvas());
+  // Over the track's central band, x in [x0, x1): the paint's red pigment share (red pigment
+  // per unit paint, over cells holding paint) and the mean albedo of columns holding at least
+  // 0.1 cell of paint.
+  struct Look {
+    double red = 0, paint = 0, rgb[3] = {0, 0, 0};
+    int columns = 0;
+  };
+  const auto look = [&](int x0, int x1) {
+    Look l;
+    for (int y = int(kY) - 4; y <= int(kY) + 4; ++y)
+      for (int x = x0; x < x1; ++x) {
+        double col = 0;
+        for (int z = 0; z < kDepth; ++z) {
+          const size_t i = (size_t(z) * kH + y) * kW + x;
+          col += f[0][i];
+          l.red += f[0][i] * f[1][i];
+        }
+        l.paint += col;
+        if (col < 0.1) continue;
+        ++l.columns;
+        for (int k = 0; k < 3; ++k) l.rgb[k] += albedo.at(x, y, k);
+      }
+    l.red /= std::max(l.paint, 1e-9);
+    for (double& v : l.rgb) v /= std::max(l.columns, 1);
+    return l;
+  };
+  const Look before = look(int(kX0) + 12, kBand0 - 8), after = look(kBand1 + 8, kBand1 + 48);
+  const auto redness = [](const Look& l) { return l.rgb[0] - 0.5 * (l.rgb[1] + l.rgb[2]); };
+  std::printf("before the band: %.1f cells of paint, red share %.3f, albedo %.3f %.3f %.3f (%d columns)\n",
+              before.paint, before.red, before.rgb[0], before.rgb[1], before.rgb[2], before.columns);
+  std::printf("after the band:  %.1f cells of paint, red share %.3f, albedo %.3f %.3f %.3f (%d columns)\n",
+              after.paint, after.red, after.rgb[0], after.rgb[1], after.rgb[2], after.columns);
+  // Tolerance: past the band the paint holds at least 0.05 red pigment per unit paint (white
+  // with a twentieth of the band's red), and looks pink: red exceeds the mean of green and blue
+  // by at least 0.04 of albedo (10 of 255) more than the white trail before the band does.
+  EXPECT_GE(after.columns, 40) << "the brush left paint past the band";
+  EXPECT_GE(after.red, 0.05) << "red carried past the band";
+  EXPECT_GE(redness(after) - redness(before), 0.04) << "the paint past the band looks pink";
+}
+
+}  // namespace
+}  // namespace wb::test
