@@ -10,29 +10,57 @@
 
 namespace wb::WB_BACKEND_NS {
 
-void render_top_map(RenderVolume v, int x0, int y0, int w, int h, uint16_t* top) {
+void render_top_map(RenderVolume v, RenderParams P, int x0, int y0, int w, int h, uint16_t* top, FilmColumn* film) {
   parallel_for(int64_t(w) * h, [=] WB_HD(int64_t i) {
     const int x = x0 + int(i % w), y = y0 + int(i / w);
+    // One pass down the whole column: its top, and its paint as a film (the integral of density,
+    // the density-weighted mean paint, how thin its densest cell is).
     int t = 0;
+    float sum = 0.f, dmax = 0.f, r = 0.f, yy = 0.f, b = 0.f, oil = 0.f, dry = 0.f;
     if (!v.has_win && !v.has_splat) {
-      // Tiles only: one slot lookup, then a strided scan down the column.
+      // Tiles only: one slot lookup, then a strided walk down the column.
       const int32_t slot = v.tiles.slot_of_tile[(y / kTileSize) * v.tiles.tiles_x + x / kTileSize];
       if (slot >= 0) {
-        const float* col = v.tiles.density + int64_t(slot) * v.tiles.tile_cells() + v.tiles.cell_offset(x % kTileSize, y % kTileSize, 0);
-        for (int z = v.tiles.depth - 1; z >= 0; --z)
-          if (col[int64_t(z) * kTileSize * kTileSize] > 0.f) {
-            t = z + 1;
-            break;
-          }
+        const int64_t a0 = int64_t(slot) * v.tiles.tile_cells() + v.tiles.cell_offset(x % kTileSize, y % kTileSize, 0);
+        for (int z = 0; z < v.tiles.depth; ++z) {
+          const int64_t a = a0 + int64_t(z) * kTileSize * kTileSize;
+          const float d = v.tiles.density[a];
+          if (!(d > 0.f)) continue;
+          t = z + 1;
+          sum += d;
+          dmax = d > dmax ? d : dmax;
+          r += d * decode_unorm16(v.tiles.pigment_r[a]);
+          yy += d * decode_unorm16(v.tiles.pigment_y[a]);
+          b += d * decode_unorm16(v.tiles.pigment_b[a]);
+          oil += d * decode_unorm16(v.tiles.oil[a]);
+          dry += d * decode_unorm16(v.tiles.dryness[a]);
+        }
       }
     } else {
-      for (int z = v.tiles.depth - 1; z >= 0; --z)
-        if (cell_density_raw(v, x, y, z) > 0.f) {
-          t = z + 1;
-          break;
-        }
+      for (int z = 0; z < v.tiles.depth; ++z) {
+        const RenderCell c = cell_full_raw(v, x, y, z);
+        if (!(c.density > 0.f)) continue;
+        t = z + 1;
+        sum += c.density;
+        dmax = c.density > dmax ? c.density : dmax;
+        r += c.density * c.r;
+        yy += c.density * c.y;
+        b += c.density * c.b;
+        oil += c.density * c.oil;
+        dry += c.density * c.dryness;
+      }
     }
-    top[i] = uint16_t(t);
+    FilmColumn f{sum, 0, 0, 0, 0, 0, 0};
+    if (sum > 0.f) {
+      const float s = 1.f / sum;
+      f = FilmColumn{sum, encode_unorm16(r * s), encode_unorm16(yy * s), encode_unorm16(b * s),
+                     encode_unorm16(oil * s), encode_unorm16(dry * s), encode_unorm16(column_thinness(P, dmax))};
+      // Densities above 1 pack more paint than the cells hold: rays must start above that film.
+      const int tf = int(ceilf(sum));
+      t = tf > t ? tf : t;
+    }
+    top[i] = uint16_t(t < 65535 ? t : 65535);
+    film[i] = f;
   });
 }
 
