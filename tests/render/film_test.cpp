@@ -28,6 +28,11 @@ Vec3 px(const Image& img, int x, int y) {
   return Vec3(p[0] / 255.f, p[1] / 255.f, p[2] / 255.f);
 }
 Vec3 rgb_at(const FloatImage& f, int x, int y) { return Vec3(f.at(x, y, 0), f.at(x, y, 1), f.at(x, y, 2)); }
+/// Share of the way from `ground` to `paint` that colour `c` lies (projected onto that line).
+float coverage(Vec3 c, Vec3 ground, Vec3 paint) {
+  const Vec3 d = paint - ground;
+  return dot(c - ground, d) / dot(d, d);
+}
 float maxdiff(Vec3 a, Vec3 b) { return std::max({std::fabs(a.x - b.x), std::fabs(a.y - b.y), std::fabs(a.z - b.z)}); }
 
 /// A layer of paint `t` cells thick lying on the canvas, as the grid holds one: full cells up to
@@ -88,6 +93,71 @@ TEST_F(FilmTest, HeightExportIsTheFilmThickness) {
     for (int y = 0; y < kN; ++y)
       for (int x = 0; x < kN; ++x)
         if (x < kLo - 2 || y < kLo - 2 || x >= kHi + 2 || y >= kHi + 2) ASSERT_EQ(h.at(x, y), 0.f) << "bare canvas";
+  }
+}
+
+TEST_F(FilmTest, HeightExportOfPaintSpreadThinOverSeveralCells) {
+  // The same paint volume spread evenly over 1 to 4 cells of the column (density t / n each, no
+  // cell at the threshold): the exported height is the paint volume t, however it is spread.
+  Renderer r(device_);
+  for (float t : {0.1f, 0.3f, 0.45f})
+    for (int n : {1, 2, 3, 4}) {
+      TileStore c(device_, CanvasDims{kN, kN, 16});
+      fill_volume(c, kLo, kLo, kHi, kHi, [=](int, int, int z) {
+        PaintCell p = layer(float(n), z, kPigment, 0.1f);
+        p.density *= t / float(n);
+        return p;
+      });
+      const FloatImage h = r.render_height_map(c);
+      float worst = 0.f;
+      for (int y = kIn0; y < kIn1; ++y)
+        for (int x = kIn0; x < kIn1; ++x) worst = std::max(worst, std::fabs(h.at(x, y) - t));
+      std::printf("paint %.2f cells spread over %d cells: largest |height - %.2f| %.5f\n", t, n, t, worst);
+      EXPECT_LT(worst, 1e-3f) << "paint " << t << " over " << n << " cells";
+    }
+}
+
+TEST_F(FilmTest, CanvasCoveredIncreasinglyWithThickness) {
+  // Uniform films of 0.1, 0.3, 0.6 and 2 cells: how far the rendered colour has gone from the
+  // lit primed canvas to the lit paint, in the shaded image (no AO or highlight, 8-bit) and in
+  // the float albedo. Beer-Lambert with the default hiding thickness 0.2 cells predicts
+  // 0.859, 0.997, 1.000, 1.000.
+  Renderer r(device_);
+  r.params().ao_rays = 0;
+  r.params().specular = 0.f;
+  const RenderParams& P = r.params();
+  const Vec3 paint = ryb_to_rgb(kPigment);
+  const Vec3 lit_paint = lit_up(P, paint), lit_canvas = lit_up(P, P.paper_rgb);
+  float prev_shaded = -1.f, prev_albedo = -1.f;
+  for (float t : {0.1f, 0.3f, 0.6f, 2.f}) {
+    TileStore c = film(t);
+    const Image img = r.render(c, Camera::top(c.dims()));
+    const FloatImage a = r.render_albedo(c);
+    float shaded = 0.f, albedo = 0.f;
+    for (int y = kIn0; y < kIn1; ++y)
+      for (int x = kIn0; x < kIn1; ++x) {
+        shaded += coverage(px(img, x, y), lit_canvas, lit_paint);
+        albedo += coverage(rgb_at(a, x, y), P.paper_rgb, paint);
+      }
+    shaded /= float((kIn1 - kIn0) * (kIn1 - kIn0));
+    albedo /= float((kIn1 - kIn0) * (kIn1 - kIn0));
+    const float expect = 1.f - std::pow(50.f, -t / P.film_hiding);
+    std::printf("film %.1f cells: canvas covered %.4f (shaded), %.4f (albedo), Beer-Lambert %.4f\n", t, shaded,
+                albedo, expect);
+    EXPECT_NEAR(albedo, expect, 0.01f) << "film " << t;
+    EXPECT_NEAR(shaded, expect, 0.02f) << "film " << t;
+    EXPECT_GE(albedo, prev_albedo) << "film " << t << " covers less than a thinner one";
+    EXPECT_GE(shaded, prev_shaded - 1.f / 255.f) << "film " << t << " covers less than a thinner one";
+    if (t < 0.2f) {
+      EXPECT_LT(shaded, 0.92f) << "a 0.1-cell film lets the canvas show through";
+      EXPECT_GT(shaded, 0.80f) << "a 0.1-cell film is mostly paint";
+    }
+    if (t >= 2.f) {
+      EXPECT_GT(shaded, 0.995f) << "2 cells of paint hide the canvas";
+      EXPECT_LT(maxdiff(px(img, kN / 2, kN / 2), lit_paint), 2.f / 255.f) << "2 cells are the paint's colour";
+    }
+    prev_shaded = shaded;
+    prev_albedo = albedo;
   }
 }
 
@@ -184,6 +254,54 @@ TEST_F(FilmTest, ThicknessRampRisesWithoutASeam) {
     ASSERT_NEAR(h.at(x, 16), layered(x), 0.1f) << "column " << x;
   }
   std::printf("layer ramp: largest |height - thickness| %.4f\n", worst_err);
+}
+
+TEST_F(FilmTest, RampFromATenthToTwoCellsHasNoStepAtTheThreshold) {
+  // A layer rising linearly from 0.1 to 2 cells over 120 columns (0.0158 cell per column); it
+  // crosses the threshold 0.5 between columns 28 and 29. Height and colour rise monotonically and change no
+  // more at the crossing than elsewhere.
+  constexpr int kX0 = 4, kCols = 120;
+  auto thick = [](int x) { return 0.1f + 1.9f * (float(x - kX0) + 0.5f) / float(kCols); };
+  TileStore c(device_, CanvasDims{128, 32, 16});
+  fill_volume(c, kX0, 4, kX0 + kCols, 28, [&](int x, int, int z) { return layer(thick(x), z, kPigment, 0.1f); });
+  Renderer r(device_);
+  const FloatImage h = r.render_height_map(c);
+  const FloatImage a = r.render_albedo(c);
+  const Image img = r.render(c, Camera::top(c.dims()));
+  const RenderParams& P = r.params();
+  const Vec3 paint = ryb_to_rgb(kPigment);
+  const int y = 16;
+  const float nominal = 1.9f / kCols;
+  int cross = -1;
+  float worst = 0.f, at_cross = 0.f, worst_err = 0.f, worst_colour = 0.f, colour_at_cross = 0.f;
+  // Skip the ramp's two ends (its edges to the bare canvas).
+  for (int x = kX0 + 2; x + 1 < kX0 + kCols - 2; ++x) {
+    const float step = h.at(x + 1, y) - h.at(x, y);
+    const bool crossing = thick(x) < P.threshold && thick(x + 1) >= P.threshold;
+    if (crossing) cross = x;
+    worst = std::max(worst, step);
+    worst_err = std::max(worst_err, std::fabs(h.at(x, y) - thick(x)));
+    ASSERT_GE(step, -1e-4f) << "height falls at column " << x << " (thickness " << thick(x) << ")";
+    ASSERT_LE(step, 2.5f * nominal) << "height steps at column " << x << " (thickness " << thick(x) << ")";
+    ASSERT_NEAR(h.at(x, y), thick(x), 0.1f) << "column " << x;
+    // The albedo covers the canvas more and more, then stays the paint's.
+    const float ca = coverage(rgb_at(a, x, y), P.paper_rgb, paint), cb = coverage(rgb_at(a, x + 1, y), P.paper_rgb, paint);
+    ASSERT_GE(cb, ca - 1e-4f) << "coverage falls at column " << x;
+    const float dc = maxdiff(px(img, x + 1, y), px(img, x, y));
+    worst_colour = std::max(worst_colour, dc);
+    ASSERT_LE(dc, 4.f / 255.f) << "colour steps at column " << x << " (thickness " << thick(x) << ")";
+    if (std::abs(x - cross) <= 1 && cross >= 0) {
+      at_cross = std::max(at_cross, step);
+      colour_at_cross = std::max(colour_at_cross, dc);
+    }
+  }
+  ASSERT_GE(cross, 0);
+  std::printf("ramp 0.1 to 2 cells: threshold crossed at column %d; height step there %.4f, largest %.4f "
+              "(thickness step %.4f); largest |height - thickness| %.4f; colour step there %.1f/255, largest "
+              "%.1f/255\n",
+              cross, at_cross, worst, nominal, worst_err, colour_at_cross * 255.f, worst_colour * 255.f);
+  EXPECT_LE(at_cross, 1.5f * nominal) << "no step where the film meets the threshold surface";
+  EXPECT_LE(colour_at_cross, 1.f / 255.f) << "no change of colour where the film meets the threshold surface";
 }
 
 TEST_F(FilmTest, ThickRidgeKeepsItsThresholdSurface) {
