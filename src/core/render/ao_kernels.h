@@ -48,9 +48,10 @@ WB_HD WB_INLINE int local_top(const RenderVolume& v, float x, float y, float rad
 /// the film's share of the cell, min(max(F - z, 0), 1), so that a film occludes as a layer of its
 /// thickness and not as the sparse paint it is made of; the volume's density where the paint is
 /// thick, blended by thinness between. A cell denser than threshold + film_fade is in a thick
-/// column, so the film record is not fetched there.
+/// column, so the film record is not fetched there, nor above the column's top.
 WB_HD WB_INLINE float ao_density(const RenderVolume& v, const RenderParams& P, int x, int y, int z) {
-  const float rho = cell_density(v, x, y, z);
+  if (z < 0 || z >= column_top(v, x, y)) return 0.f;  // a column's film lies below its top
+  const float rho = cell_density_raw(v, x, y, z);
   if (rho >= P.threshold + P.film_fade || !v.film) return rho;
   const FilmColumn k = column_film(v, x, y);
   if (!(k.height > 0.f) || k.thin == 0) return rho;

@@ -30,10 +30,11 @@ struct SplatView {
 inline constexpr int kTopBlock = 8;  ///< cells per side of a block of the coarse top map
 
 /// The paint of one column taken as a film lying on the canvas: its thickness is the column
-/// integral of density (paint volume per unit area), its paint the density-weighted mean.
+/// integral of density (paint volume per unit area), its paint the density-weighted mean (kept
+/// for thin columns only, thin > 0: thick paint is never read as a film).
 struct FilmColumn {
   float height;                    ///< sum of the column's densities, cells
-  uint16_t r, y, b, oil, dryness;  ///< unorm16, as in the tiles
+  uint16_t r, y, b, oil, dryness;  ///< unorm16, as in the tiles; 0 in thick columns
   uint16_t thin;                   ///< column_thinness of its densest cell, unorm16
 };
 
@@ -52,6 +53,7 @@ struct RenderVolume {
   int blk_w, blk_h;
   int z_top_max;  ///< max of `top` over the map (tops count films: top >= film height)
   const FilmColumn* film;  ///< per column of the top map: the column's paint as a film
+  const uint8_t* block_film;  ///< per block: 1 if a column in it or next to it is thin (has a film)
 };
 
 /// One cell's paint, as rendered (window replaces tiles; splat adds, density-weighted).
@@ -220,6 +222,15 @@ WB_HD WB_INLINE FilmSample film_at(const RenderVolume& v, float x, float y, bool
   const int ix = int(flx), iy = int(fly);
   const float ax = fx - flx, ay = fy - fly;
   FilmSample f{0.f, 0.f, PaintSample{Vec3(0.f, 0.f, 0.f), 0.f, 0.f, 0.f}};
+  // Thick paint and bare canvas all around (the block map says so): no film, thin = 0, exactly
+  // what the four columns would give. Blocks off the map are not trusted.
+  if (v.block_film) {
+    const int lx = ix - v.top_x0, ly = iy - v.top_y0;
+    if (lx >= 0 && ly >= 0) {
+      const int bx = lx / kTopBlock, by = ly / kTopBlock;
+      if (bx < v.blk_w && by < v.blk_h && !v.block_film[by * v.blk_w + bx]) return f;
+    }
+  }
   for (int c = 0; c < 4; ++c) {
     const float w = ((c & 1) ? ax : 1.f - ax) * ((c & 2) ? ay : 1.f - ay);
     if (w <= 0.f) continue;
@@ -227,19 +238,22 @@ WB_HD WB_INLINE FilmSample film_at(const RenderVolume& v, float x, float y, bool
     const float wd = w * k.height;
     if (!(wd > 0.f)) continue;
     f.height += wd;
-    f.thin += wd * decode_unorm16(k.thin);
-    if (with_paint) {
-      f.paint.ryb += Vec3(decode_unorm16(k.r), decode_unorm16(k.y), decode_unorm16(k.b)) * wd;
-      f.paint.oil += decode_unorm16(k.oil) * wd;
-      f.paint.dryness += decode_unorm16(k.dryness) * wd;
+    const float wt = wd * decode_unorm16(k.thin);
+    f.thin += wt;
+    if (with_paint && wt > 0.f) {  // the film's paint is its thin columns' (thick ones bring theirs in the volume)
+      f.paint.ryb += Vec3(decode_unorm16(k.r), decode_unorm16(k.y), decode_unorm16(k.b)) * wt;
+      f.paint.oil += decode_unorm16(k.oil) * wt;
+      f.paint.dryness += decode_unorm16(k.dryness) * wt;
     }
   }
   if (f.height > 0.f) {
-    const float s = 1.f / f.height;
-    f.thin *= s;
-    f.paint.ryb = f.paint.ryb * s;
-    f.paint.oil *= s;
-    f.paint.dryness *= s;
+    if (f.thin > 0.f) {
+      const float s = 1.f / f.thin;
+      f.paint.ryb = f.paint.ryb * s;
+      f.paint.oil *= s;
+      f.paint.dryness *= s;
+    }
+    f.thin /= f.height;
     f.paint.density = f.height;
   }  // no paint in these columns: thin = 0 leaves the volume's density (of paint off the map)
   return f;
