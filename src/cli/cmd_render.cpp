@@ -58,7 +58,7 @@ void register_render(CLI::App& app) {
   sub->add_option("--ao-rays", o->ao_rays, "Ambient-occlusion rays per pixel (0 = off)")->capture_default_str();
   sub->add_option("--weave", o->weave, "Canvas weave height in cells (0 = flat primed canvas)")->capture_default_str();
   sub->add_option("--test-volume", o->test_volume,
-                  "Render a built-in volume instead of a file: flat, hemisphere, ridges, glaze, swatches, impasto-1024");
+                  "Render a built-in volume instead of a file: flat, hemisphere, ridges, glaze, swatches, films, impasto-1024");
   sub->add_option("--save", o->save, "Also save the rendered volume as a painting (.ora)");
   sub->add_option("--repeat", o->repeat, "Render this many times and print the median time")->capture_default_str();
   sub->add_option("--incremental", o->incremental,

@@ -10,6 +10,7 @@
 #include "core/io/png.h"
 #include "core/render/renderer.h"
 #include "core/render/test_volumes.h"
+#include "golden.h"
 
 namespace wb::test {
 
@@ -249,30 +250,13 @@ TEST_F(RenderTest, RejectsBadParameters) {
   EXPECT_THROW(r.render(c, bad), Error);
 }
 
-// Golden image: the swatches volume seen from above, compared with a tolerance. Regenerate
-// with `WB_UPDATE_GOLDEN=1 wetbrush_tests --gtest_filter=RenderTest.GoldenSwatches*`.
+// Golden image: the swatches volume seen from above, compared with a tolerance (golden.h).
+// Regenerate with `WB_UPDATE_GOLDEN=1 wetbrush_tests --gtest_filter=RenderTest.GoldenSwatches*`.
 TEST_F(RenderTest, GoldenSwatchesTopAo64) {
   TileStore c = volume("swatches");
   Renderer r(device_);
-  const Image img = r.render(c, Camera::top(c.dims()));
-  const std::string path = std::string(WB_SOURCE_DIR) + "/tests/render/golden/swatches_top_ao64.png";
-  if (std::getenv("WB_UPDATE_GOLDEN")) {
-    write_png8(path, img.rgba.data(), img.width, img.height, 4);
-    GTEST_SKIP() << "golden image written: " << path;
-  }
-  const PngPixels g = read_png(path);
-  ASSERT_EQ(g.width, img.width);
-  ASSERT_EQ(g.height, img.height);
-  ASSERT_EQ(g.channels, 4);
-  double sum = 0.0;
-  int large = 0;
-  for (size_t i = 0; i < img.rgba.size(); ++i) {
-    const int d = std::abs(int(img.rgba[i]) - int(g.data8[i]));
-    sum += d;
-    large += d > 8;
-  }
-  EXPECT_LT(sum / img.rgba.size(), 1.0) << "mean difference per sample, of 255";
-  EXPECT_LT(large, int(img.rgba.size() / 200)) << "samples off by more than 8/255";
+  expect_golden(r.render(c, Camera::top(c.dims())), "swatches_top_ao64");
+  if (updating_golden()) GTEST_SKIP() << "golden image written";
 }
 
 }  // namespace wb::test

@@ -208,7 +208,8 @@ class StudioTest : public QObject {
     QVERIFY2(near > 5.0, "the stroke left paint under its path");
     // Beyond the reach only what a few particles flicked off at landing or lift-off carry:
     // measured 0 to 0.055 cell volumes over runs (up to 1e-4 of the stroke), in flecks. Less
-    // than half a cell's paint in all cannot show: the renderer's surface is at density 0.5.
+    // than half a cell's paint in all: a few specks of film at most hundredths of a cell thick,
+    // which the renderer draws translucent (docs/RENDERING.md, "Films").
     QVERIFY2(far < 0.5, "no visible paint anywhere else");
     // The mark runs from the start of the path to its end (within a few cells).
     QVERIFY2(bx0 <= int(x0) + 4 && bx1 >= int(x1) - 4, "paint from the start of the path to its end");

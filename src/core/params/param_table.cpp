@@ -112,6 +112,8 @@ std::vector<ParamInfo> build_table() {
       WB_PARAM(render.threshold, "Surface density", "", "§6", 0.01, 1, "Density at which the surface is found"),
       WB_PARAM(render.penetration_per_oil, "Oil penetration", "cells", "§6", 0, 100,
                "How far below the surface pigment is gathered, per unit of oil"),
+      WB_PARAM(render.film_hiding, "Film hiding", "cells", "", 0.01, 100,
+               "Paint this thick hides all but 2 % of the canvas; thinner films let it through"),
       WB_PARAM(render.ao_rays, "AO rays", "", "§6", 0, 256, "Ambient-occlusion rays per hit"),
       WB_PARAM(render.ao_length, "AO length", "cells", "§6", 0, 64, "How far an AO ray looks"),
       WB_PARAM(render.ao_strength, "AO strength", "", "§6", 0, 1, "How dark full occlusion makes the ambient"),

@@ -1,6 +1,7 @@
 // Ambient occlusion of the paint surface (paper §6): 64 short rays around the hit point, each
-// recording the maximum density it reaches; occlusion is their mean. Rays are marched
-// coarsely (one sample per cell, nearest cell) because AO is the renderer's main cost.
+// recording the maximum density it reaches (films as layers of their thickness); occlusion is
+// their mean. Rays are marched coarsely (one sample per cell, nearest cell) because AO is the
+// renderer's main cost.
 #pragma once
 #include "core/render/raycast_kernels.h"
 
@@ -43,6 +44,21 @@ WB_HD WB_INLINE int local_top(const RenderVolume& v, float x, float y, float rad
   return m;
 }
 
+/// Density of cell (x, y, z) as the surface sees it (surface_density per cell): in a thin column
+/// the film's share of the cell, min(max(F - z, 0), 1), so that a film occludes as a layer of its
+/// thickness and not as the sparse paint it is made of; the volume's density where the paint is
+/// thick, blended by thinness between. A cell denser than threshold + film_fade is in a thick
+/// column, so the film record is not fetched there, nor above the column's top.
+WB_HD WB_INLINE float ao_density(const RenderVolume& v, const RenderParams& P, int x, int y, int z) {
+  if (z < 0 || z >= column_top(v, x, y)) return 0.f;  // a column's film lies below its top
+  const float rho = cell_density_raw(v, x, y, z);
+  if (rho >= P.threshold + P.film_fade || !v.film) return rho;
+  const FilmColumn k = column_film(v, x, y);
+  if (!(k.height > 0.f) || k.thin == 0) return rho;
+  const float thin = decode_unorm16(k.thin);
+  return thin * clampf(k.height - float(z), 0.f, 1.f) + (1.f - thin) * rho;
+}
+
 /// Ambient visibility in [0, 1] at hit point p with normal n: 1 - strength * mean_k max_s rho.
 /// `dirs` holds P.ao_rays directions around +z; they are turned into n's frame.
 WB_HD WB_INLINE float ambient_occlusion(const RenderVolume& v, const RenderParams& P, const Vec3* dirs, Vec3 p,
@@ -70,7 +86,7 @@ WB_HD WB_INLINE float ambient_occlusion(const RenderVolume& v, const RenderParam
         m = 1.f;  // the canvas itself occludes
         break;
       }
-      const float rho = cell_density(v, int(floorf(q.x)), int(floorf(q.y)), int(q.z));
+      const float rho = ao_density(v, P, int(floorf(q.x)), int(floorf(q.y)), int(q.z));
       m = maxf(m, rho);
       if (m >= 1.f) break;
     }

@@ -1,7 +1,9 @@
 // Ray casting of the paint volume (paper §6 "Liquid rendering"): march the density at a
 // quarter-cell step, find the surface at a density threshold (refined between the two
 // bracketing samples), normal from the density gradient, pigment and oil there, and gather
-// pigment below the surface over an oil-dependent penetration distance. Backend-free WB_HD code.
+// pigment below the surface over an oil-dependent penetration distance. Paint too thin to reach
+// the threshold is a film as thick as the paint in its column (docs/RENDERING.md "Films").
+// Backend-free WB_HD code.
 #pragma once
 #include <math.h>
 
@@ -27,6 +29,15 @@ struct SplatView {
 
 inline constexpr int kTopBlock = 8;  ///< cells per side of a block of the coarse top map
 
+/// The paint of one column taken as a film lying on the canvas: its thickness is the column
+/// integral of density (paint volume per unit area), its paint the density-weighted mean (kept
+/// for thin columns only, thin > 0: thick paint is never read as a film).
+struct FilmColumn {
+  float height;                    ///< sum of the column's densities, cells
+  uint16_t r, y, b, oil, dryness;  ///< unorm16, as in the tiles; 0 in thick columns
+  uint16_t thin;                   ///< column_thinness of its densest cell, unorm16
+};
+
 /// Everything the ray caster reads: tiles, the optional live window and particle splat
 /// (which replace resp. add to the tiles' cells), and the column-top maps that let empty
 /// space be skipped without touching the tiles.
@@ -36,11 +47,13 @@ struct RenderVolume {
   int has_win;
   SplatView splat;
   int has_splat;
-  const uint16_t* top;  ///< per column: 1 + highest z holding paint, 0 = empty column
+  const uint16_t* top;  ///< per column: 1 + highest z holding paint (and >= its film), 0 = empty
   int top_x0, top_y0, top_w, top_h;
   const uint16_t* block_top;  ///< max of `top` over kTopBlock^2 columns
   int blk_w, blk_h;
-  int z_top_max;  ///< max of `top` over the map
+  int z_top_max;  ///< max of `top` over the map (tops count films: top >= film height)
+  const FilmColumn* film;  ///< per column of the top map: the column's paint as a film
+  const uint8_t* block_film;  ///< per block: 1 if a column in it or next to it is thin (has a film)
 };
 
 /// One cell's paint, as rendered (window replaces tiles; splat adds, density-weighted).
@@ -85,10 +98,9 @@ WB_HD WB_INLINE float cell_density(const RenderVolume& v, int x, int y, int z) {
   return cell_density_raw(v, x, y, z);
 }
 
-/// All fields of cell (x, y, z).
-WB_HD WB_INLINE RenderCell cell_full(const RenderVolume& v, int x, int y, int z) {
+/// All fields of cell (x, y, z), without the column-top shortcut.
+WB_HD WB_INLINE RenderCell cell_full_raw(const RenderVolume& v, int x, int y, int z) {
   RenderCell c{0.f, 0.f, 0.f, 0.f, 0.f, 0.f};
-  if (z < 0 || z >= column_top(v, x, y)) return c;
   if (v.has_win && in_window(v.win, x, y, z)) {
     const int64_t i = v.win.index(x - v.win.ox, y - v.win.oy, z - v.win.oz);
     c = RenderCell{v.win.density[i], v.win.pigment_r[i], v.win.pigment_y[i], v.win.pigment_b[i], v.win.oil[i],
@@ -118,6 +130,12 @@ WB_HD WB_INLINE RenderCell cell_full(const RenderVolume& v, int x, int y, int z)
     }
   }
   return c;
+}
+
+/// All fields of cell (x, y, z); cells at or above their column's top are empty without a fetch.
+WB_HD WB_INLINE RenderCell cell_full(const RenderVolume& v, int x, int y, int z) {
+  if (z < 0 || z >= column_top(v, x, y)) return RenderCell{0.f, 0.f, 0.f, 0.f, 0.f, 0.f};
+  return cell_full_raw(v, x, y, z);
 }
 
 /// Trilinear density at a continuous point (cell centres at integer + 0.5); corners with
@@ -172,11 +190,136 @@ WB_HD WB_INLINE PaintSample sample_paint(const RenderVolume& v, Vec3 p) {
   return s;
 }
 
-/// Surface normal n = -grad(rho)/|grad(rho)| by central differences of the trilinear density.
-WB_HD WB_INLINE Vec3 density_normal(const RenderVolume& v, Vec3 p, float e) {
-  const Vec3 g((sample_density(v, p + Vec3(e, 0, 0)) - sample_density(v, p - Vec3(e, 0, 0))),
-               (sample_density(v, p + Vec3(0, e, 0)) - sample_density(v, p - Vec3(0, e, 0))),
-               (sample_density(v, p + Vec3(0, 0, e)) - sample_density(v, p - Vec3(0, 0, e))));
+// --- films ---------------------------------------------------------------------------------
+// Paint too thin to reach the threshold lies on the canvas as a film: the column's paint, as
+// thick as the column integral F of density (paint volume per unit area). Its solid {z <= F} is
+// the level set of film_density. A column is thin while its densest cell stays below the
+// threshold; from there to threshold + film_fade its surface density goes over from the film's
+// to the volume's, so the film turns into the threshold surface of thick paint without a jump.
+
+/// Film record of column (x, y); none off the map (no ray of the rendered tiles samples there).
+WB_HD WB_INLINE FilmColumn column_film(const RenderVolume& v, int x, int y) {
+  const int lx = x - v.top_x0, ly = y - v.top_y0;
+  if (!v.film || lx < 0 || ly < 0 || lx >= v.top_w || ly >= v.top_h) return FilmColumn{0.f, 0, 0, 0, 0, 0, 0};
+  return v.film[int64_t(ly) * v.top_w + lx];
+}
+
+/// How thin a column is for the surface: 1 while its densest cell is below the threshold, 0 from
+/// threshold + film_fade up, linear between.
+WB_HD WB_INLINE float column_thinness(const RenderParams& P, float max_density) {
+  return clampf((P.threshold + P.film_fade - max_density) / P.film_fade, 0.f, 1.f);
+}
+
+/// The film at a canvas point, bilinear between column centres (integer + 0.5).
+struct FilmSample {
+  float height;  ///< film height F, cells
+  float thin;    ///< the columns' thinness, weighted by their paint (bare columns do not vote)
+  PaintSample paint;  ///< the columns' mean paint, weighted by their paint (when asked for)
+};
+WB_HD WB_INLINE FilmSample film_at(const RenderVolume& v, float x, float y, bool with_paint) {
+  const float fx = x - 0.5f, fy = y - 0.5f;
+  const float flx = floorf(fx), fly = floorf(fy);
+  const int ix = int(flx), iy = int(fly);
+  const float ax = fx - flx, ay = fy - fly;
+  FilmSample f{0.f, 0.f, PaintSample{Vec3(0.f, 0.f, 0.f), 0.f, 0.f, 0.f}};
+  // Thick paint and bare canvas all around (the block map says so): no film, thin = 0, exactly
+  // what the four columns would give. Blocks off the map are not trusted.
+  if (v.block_film) {
+    const int lx = ix - v.top_x0, ly = iy - v.top_y0;
+    if (lx >= 0 && ly >= 0) {
+      const int bx = lx / kTopBlock, by = ly / kTopBlock;
+      if (bx < v.blk_w && by < v.blk_h && !v.block_film[by * v.blk_w + bx]) return f;
+    }
+  }
+  for (int c = 0; c < 4; ++c) {
+    const float w = ((c & 1) ? ax : 1.f - ax) * ((c & 2) ? ay : 1.f - ay);
+    if (w <= 0.f) continue;
+    const FilmColumn k = column_film(v, ix + (c & 1), iy + (c >> 1));
+    const float wd = w * k.height;
+    if (!(wd > 0.f)) continue;
+    f.height += wd;
+    const float wt = wd * decode_unorm16(k.thin);
+    f.thin += wt;
+    if (with_paint && wt > 0.f) {  // the film's paint is its thin columns' (thick ones bring theirs in the volume)
+      f.paint.ryb += Vec3(decode_unorm16(k.r), decode_unorm16(k.y), decode_unorm16(k.b)) * wt;
+      f.paint.oil += decode_unorm16(k.oil) * wt;
+      f.paint.dryness += decode_unorm16(k.dryness) * wt;
+    }
+  }
+  if (f.height > 0.f) {
+    if (f.thin > 0.f) {
+      const float s = 1.f / f.thin;
+      f.paint.ryb = f.paint.ryb * s;
+      f.paint.oil *= s;
+      f.paint.dryness *= s;
+    }
+    f.thin /= f.height;
+    f.paint.density = f.height;
+  }  // no paint in these columns: thin = 0 leaves the volume's density (of paint off the map)
+  return f;
+}
+
+/// Film height at a canvas point, cells: the one definition of the film that the image, the
+/// height, normal and albedo maps and the tile cache all go through.
+WB_HD WB_INLINE float film_height(const RenderVolume& v, float x, float y) { return film_at(v, x, y, false).height; }
+
+/// Density of the film solid at height z over a film F thick: the threshold at z = F, changing by
+/// one per cell in z as across the top of a layer of full cells; 0 where there is no film.
+WB_HD WB_INLINE float film_density(const RenderParams& P, float F, float z) {
+  return F > 0.f ? clampf(P.threshold + F - z, 0.f, 1.f) : 0.f;
+}
+
+/// Density as the surface sees it: the film's where the paint is thin, the volume's where it is
+/// thick, blended by thinness between. Films lie below z_top_max (tops count them).
+WB_HD WB_INLINE float surface_density(const RenderVolume& v, const RenderParams& P, Vec3 p) {
+  if (p.z >= float(v.z_top_max) + P.threshold) return sample_density(v, p);
+  const FilmSample f = film_at(v, p.x, p.y, false);
+  const float df = film_density(P, f.height, p.z);
+  if (f.thin >= 1.f) return df;
+  const float d = sample_density(v, p);
+  if (f.thin <= 0.f) return d;
+  return f.thin * df + (1.f - f.thin) * d;
+}
+
+/// Paint as the surface sees it: the film's and the volume's paint mixed by their shares of
+/// surface_density (density = that).
+WB_HD WB_INLINE PaintSample surface_paint(const RenderVolume& v, const RenderParams& P, Vec3 p) {
+  if (p.z >= float(v.z_top_max) + P.threshold) return sample_paint(v, p);
+  const FilmSample f = film_at(v, p.x, p.y, true);
+  if (f.thin <= 0.f) return sample_paint(v, p);
+  PaintSample k = f.paint;
+  const float wf = f.thin * film_density(P, f.height, p.z);
+  k.density = wf;
+  if (f.thin >= 1.f) return k;
+  const PaintSample s = sample_paint(v, p);
+  const float wv = (1.f - f.thin) * s.density, wt = wf + wv;
+  if (!(wt > 0.f)) return PaintSample{Vec3(0.f, 0.f, 0.f), 0.f, 0.f, 0.f};
+  k.ryb = (f.paint.ryb * wf + s.ryb * wv) / wt;
+  k.oil = (f.paint.oil * wf + s.oil * wv) / wt;
+  k.dryness = (f.paint.dryness * wf + s.dryness * wv) / wt;
+  k.density = wt;
+  return k;
+}
+
+/// Share of the ground that paint F cells thick hides (Beer–Lambert): the ground shows through
+/// as 50^(-F / film_hiding), 2 % at the hiding thickness ("complete hiding", contrast ratio 0.98).
+WB_HD WB_INLINE float film_cover(const RenderParams& P, float F) {
+  return F > 0.f ? 1.f - expf(-3.91202301f * F / P.film_hiding) : 0.f;  // ln 50
+}
+
+/// Normal of the film's height field, (-dF/dx, -dF/dy, 1) normalised, by central differences:
+/// a film tilts only as much as its thickness changes, however thin it is.
+WB_HD WB_INLINE Vec3 film_normal(const RenderVolume& v, Vec3 p, float e) {
+  const float gx = film_height(v, p.x + e, p.y) - film_height(v, p.x - e, p.y);
+  const float gy = film_height(v, p.x, p.y + e) - film_height(v, p.x, p.y - e);
+  return normalize(Vec3(-gx, -gy, 2.f * e));
+}
+
+/// Surface normal n = -grad(rho)/|grad(rho)| by central differences of the surface density.
+WB_HD WB_INLINE Vec3 density_normal(const RenderVolume& v, const RenderParams& P, Vec3 p, float e) {
+  const Vec3 g((surface_density(v, P, p + Vec3(e, 0, 0)) - surface_density(v, P, p - Vec3(e, 0, 0))),
+               (surface_density(v, P, p + Vec3(0, e, 0)) - surface_density(v, P, p - Vec3(0, e, 0))),
+               (surface_density(v, P, p + Vec3(0, 0, e)) - surface_density(v, P, p - Vec3(0, 0, e))));
   return normalize_or(-g, Vec3(0.f, 0.f, 1.f));
 }
 
@@ -201,6 +344,7 @@ struct RayHit {
   Vec3 normal;
   Vec3 albedo;  ///< unlit RGB after blending the pigment samples below the surface
   float dryness;
+  float cover;  ///< share of the ground the paint hides (film_cover); 0 off the paint
 };
 
 /// The ray of pixel (i, j) starts at height z_start above the canvas.
@@ -211,8 +355,9 @@ WB_HD WB_INLINE void pixel_ray(const CameraBasis& cam, float i, float j, Vec3& g
 
 /// Pigment gathered below the surface (§6): samples every penetration_step within
 /// L = oil * penetration_per_oil along the ray, tent-weighted w = 1 - s/L so that the surface
-/// counts most; samples below the canvas see the primed canvas. The blend is linear in RYB
-/// (glazing mixes pigment like the colour model does) and converted to RGB once.
+/// counts most; samples inside a film see its paint, samples below the canvas the primed canvas.
+/// The blend is linear in RYB (glazing mixes pigment like the colour model does) and converted
+/// to RGB once.
 WB_HD WB_INLINE Vec3 gather_pigment(const RenderVolume& v, const RenderParams& P, Vec3 hit, Vec3 dir, Vec3 n,
                                     PaintSample surf) {
   const float L = surf.oil * P.penetration_per_oil;
@@ -227,7 +372,7 @@ WB_HD WB_INLINE Vec3 gather_pigment(const RenderVolume& v, const RenderParams& P
       wsum += w;
       continue;
     }
-    const PaintSample k = sample_paint(v, q);
+    const PaintSample k = surface_paint(v, P, q);
     if (k.density < P.threshold) continue;  // an air gap along the ray: nothing to see there
     acc += k.ryb * w;
     wsum += w;
@@ -235,21 +380,24 @@ WB_HD WB_INLINE Vec3 gather_pigment(const RenderVolume& v, const RenderParams& P
   return ryb_to_rgb(acc / wsum);
 }
 
-/// Casts one ray: march from `start` along `dir` at P.step until the density reaches the
-/// threshold or the ray meets the canvas plane z = 0.
+/// Casts one ray: march the surface density from `start` along `dir` at P.step until it reaches
+/// the threshold, the last sample on the canvas plane z = 0 (where any film reaches it).
 WB_HD WB_INLINE RayHit cast_ray(const RenderVolume& v, const RenderParams& P, Vec3 start, Vec3 dir) {
   RayHit h;
   h.kind = 0;
   h.normal = Vec3(0.f, 0.f, 1.f);
   h.albedo = P.background_rgb;
   h.dryness = 1.f;
+  h.cover = 0.f;
   const float t_end = start.z / -dir.z;  // where the ray meets z = 0 (dir.z < 0)
-  float t_prev = 0.f, d_prev = sample_density(v, start);
+  float t_prev = 0.f, d_prev = surface_density(v, P, start);
   bool found = d_prev >= P.threshold;
   float t_hit = 0.f;
   if (!found) {
-    for (float t = P.step; t <= t_end + 1e-4f; t += P.step) {
-      const float d = sample_density(v, start + dir * t);
+    for (float t = P.step;; t += P.step) {
+      const bool last = t >= t_end;
+      if (last) t = t_end;
+      const float d = surface_density(v, P, start + dir * t);
       if (d >= P.threshold) {
         // Refine between the bracketing samples: linear guess, then two secant/bisection steps.
         float ta = t_prev, da = d_prev, tb = t, db = d;
@@ -257,7 +405,7 @@ WB_HD WB_INLINE RayHit cast_ray(const RenderVolume& v, const RenderParams& P, Ve
         for (int k = 0; k < 3; ++k) {
           tm = ta + (tb - ta) * clampf((P.threshold - da) / maxf(db - da, 1e-6f), 0.f, 1.f);
           if (k == 2) break;
-          const float dm = sample_density(v, start + dir * tm);
+          const float dm = surface_density(v, P, start + dir * tm);
           if (dm >= P.threshold) {
             tb = tm;
             db = dm;
@@ -270,6 +418,7 @@ WB_HD WB_INLINE RayHit cast_ray(const RenderVolume& v, const RenderParams& P, Ve
         found = true;
         break;
       }
+      if (last) break;
       t_prev = t;
       d_prev = d;
     }
@@ -277,23 +426,30 @@ WB_HD WB_INLINE RayHit cast_ray(const RenderVolume& v, const RenderParams& P, Ve
   if (found) {
     h.kind = 2;
     h.pos = start + dir * t_hit;
-    h.normal = density_normal(v, h.pos, P.normal_eps);
+    // The normal of the film where the paint is thin, of the density where it is thick.
+    const FilmSample f = film_at(v, h.pos.x, h.pos.y, false);
+    if (f.thin >= 1.f) {
+      h.normal = film_normal(v, h.pos, P.normal_eps);
+    } else if (f.thin <= 0.f) {
+      h.normal = density_normal(v, P, h.pos, P.normal_eps);
+    } else {
+      h.normal = normalize(lerp(density_normal(v, P, h.pos, P.normal_eps), film_normal(v, h.pos, P.normal_eps), f.thin));
+    }
     // Pigment just inside the surface.
-    const PaintSample surf = sample_paint(v, h.pos - h.normal * 0.5f);
+    const PaintSample surf = surface_paint(v, P, h.pos - h.normal * 0.5f);
     h.dryness = surf.dryness;
     h.albedo = gather_pigment(v, P, h.pos, dir, h.normal, surf);
+    // A thin film lets some of the ground through; thick paint hides it.
+    h.cover = f.thin * film_cover(P, f.height) + (1.f - f.thin);
+    if (h.cover < 1.f) h.albedo = lerp(P.paper_rgb, h.albedo, h.cover);
     return h;
   }
   const Vec3 g = start + dir * t_end;
   if (g.x < 0.f || g.y < 0.f || g.x >= float(v.tiles.width) || g.y >= float(v.tiles.height)) return h;
-  h.kind = 1;
+  h.kind = 1;  // bare canvas: no paint in these columns
   h.pos = Vec3(g.x, g.y, 0.f);
   h.normal = weave_normal(P, g.x, g.y);
-  // Paint too thin to reach the threshold stains the canvas by its density.
-  const PaintSample film = sample_paint(v, Vec3(g.x, g.y, 0.5f));
-  const float a = clampf(film.density / P.threshold, 0.f, 1.f);
-  h.albedo = lerp(P.paper_rgb, ryb_to_rgb(film.ryb), a);
-  h.dryness = a > 0.f ? film.dryness : 1.f;
+  h.albedo = P.paper_rgb;
   return h;
 }
 
@@ -332,7 +488,8 @@ WB_HD WB_INLINE Vec3 shade(const RenderParams& P, const RayHit& h, Vec3 dir, flo
     const Vec3 H = normalize(L - dir);
     const float ndh = maxf(dot(h.normal, H), 0.f);
     const float wet = 1.f - clampf(h.dryness, 0.f, 1.f);
-    c += Vec3(1.f, 1.f, 1.f) * (P.specular * wet * powf(ndh, P.shininess) * (ndl > 0.f ? 1.f : 0.f));
+    // The thinnest films shine only as much as they cover, so they fade into the bare canvas.
+    c += Vec3(1.f, 1.f, 1.f) * (P.specular * wet * h.cover * powf(ndh, P.shininess) * (ndl > 0.f ? 1.f : 0.f));
   }
   return Vec3(clampf(c.x, 0.f, 1.f), clampf(c.y, 0.f, 1.f), clampf(c.z, 0.f, 1.f));
 }

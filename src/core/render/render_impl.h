@@ -10,33 +10,78 @@
 
 namespace wb::WB_BACKEND_NS {
 
-void render_top_map(RenderVolume v, int x0, int y0, int w, int h, uint16_t* top) {
+void render_top_map(RenderVolume v, RenderParams P, int x0, int y0, int w, int h, uint16_t* top, FilmColumn* film) {
   parallel_for(int64_t(w) * h, [=] WB_HD(int64_t i) {
     const int x = x0 + int(i % w), y = y0 + int(i / w);
+    // Down the whole column: its top, the integral of density and its densest cell; then, for a
+    // column thin enough to be a film, its density-weighted mean paint (thick columns' paint is
+    // never read as a film's).
     int t = 0;
-    if (!v.has_win && !v.has_splat) {
-      // Tiles only: one slot lookup, then a strided scan down the column.
+    float sum = 0.f, dmax = 0.f;
+    const bool tiles_only = !v.has_win && !v.has_splat;
+    int64_t a0 = -1;  // tiles only: address of the column's bottom cell, -1 for an empty tile
+    if (tiles_only) {
       const int32_t slot = v.tiles.slot_of_tile[(y / kTileSize) * v.tiles.tiles_x + x / kTileSize];
-      if (slot >= 0) {
-        const float* col = v.tiles.density + int64_t(slot) * v.tiles.tile_cells() + v.tiles.cell_offset(x % kTileSize, y % kTileSize, 0);
-        for (int z = v.tiles.depth - 1; z >= 0; --z)
-          if (col[int64_t(z) * kTileSize * kTileSize] > 0.f) {
-            t = z + 1;
-            break;
-          }
-      }
-    } else {
-      for (int z = v.tiles.depth - 1; z >= 0; --z)
-        if (cell_density_raw(v, x, y, z) > 0.f) {
-          t = z + 1;
-          break;
-        }
+      if (slot >= 0) a0 = int64_t(slot) * v.tiles.tile_cells() + v.tiles.cell_offset(x % kTileSize, y % kTileSize, 0);
     }
-    top[i] = uint16_t(t);
+    const int64_t dz = int64_t(kTileSize) * kTileSize;
+    if (tiles_only) {
+      if (a0 >= 0)
+        for (int z = 0; z < v.tiles.depth; ++z) {
+          const float d = v.tiles.density[a0 + z * dz];
+          if (!(d > 0.f)) continue;
+          t = z + 1;
+          sum += d;
+          dmax = d > dmax ? d : dmax;
+        }
+    } else {
+      for (int z = 0; z < v.tiles.depth; ++z) {
+        const float d = cell_density_raw(v, x, y, z);
+        if (!(d > 0.f)) continue;
+        t = z + 1;
+        sum += d;
+        dmax = d > dmax ? d : dmax;
+      }
+    }
+    FilmColumn f{sum, 0, 0, 0, 0, 0, 0};
+    const float thin = column_thinness(P, dmax);
+    if (sum > 0.f && thin > 0.f) {
+      float r = 0.f, yy = 0.f, b = 0.f, oil = 0.f, dry = 0.f;
+      for (int z = 0; z < t; ++z) {
+        RenderCell c;
+        if (tiles_only) {
+          const int64_t a = a0 + z * dz;
+          c.density = v.tiles.density[a];
+          if (!(c.density > 0.f)) continue;
+          c.r = decode_unorm16(v.tiles.pigment_r[a]);
+          c.y = decode_unorm16(v.tiles.pigment_y[a]);
+          c.b = decode_unorm16(v.tiles.pigment_b[a]);
+          c.oil = decode_unorm16(v.tiles.oil[a]);
+          c.dryness = decode_unorm16(v.tiles.dryness[a]);
+        } else {
+          c = cell_full_raw(v, x, y, z);
+          if (!(c.density > 0.f)) continue;
+        }
+        r += c.density * c.r;
+        yy += c.density * c.y;
+        b += c.density * c.b;
+        oil += c.density * c.oil;
+        dry += c.density * c.dryness;
+      }
+      const float s = 1.f / sum;
+      f = FilmColumn{sum, encode_unorm16(r * s), encode_unorm16(yy * s), encode_unorm16(b * s),
+                     encode_unorm16(oil * s), encode_unorm16(dry * s), encode_unorm16(thin)};
+    }
+    // Densities above 1 pack more paint than the cells hold: rays must start above that film.
+    const int tf = int(ceilf(sum));
+    t = tf > t ? tf : t;
+    top[i] = uint16_t(t < 65535 ? t : 65535);
+    film[i] = f;
   });
 }
 
-void render_block_top(const uint16_t* top, int w, int h, uint16_t* blocks, int bw, int bh) {
+void render_block_top(const uint16_t* top, const FilmColumn* film, int w, int h, uint16_t* blocks,
+                      uint8_t* block_film, int bw, int bh) {
   parallel_for(int64_t(bw) * bh, [=] WB_HD(int64_t i) {
     const int bx = int(i % bw), by = int(i / bw);
     uint16_t m = 0;
@@ -46,6 +91,19 @@ void render_block_top(const uint16_t* top, int w, int h, uint16_t* blocks, int b
         m = t > m ? t : m;
       }
     blocks[i] = m;
+    // A film sample at a point reads the columns up to one past the block of its lower corner:
+    // the flag looks one column beyond the block on every side.
+    uint8_t any = 0;
+    for (int y = by * kTopBlock - 1; y <= (by + 1) * kTopBlock && !any; ++y)
+      for (int x = bx * kTopBlock - 1; x <= (bx + 1) * kTopBlock; ++x) {
+        if (x < 0 || y < 0 || x >= w || y >= h) continue;
+        const FilmColumn& f = film[int64_t(y) * w + x];
+        if (f.thin != 0 && f.height > 0.f) {
+          any = 1;
+          break;
+        }
+      }
+    block_film[i] = any;
   });
 }
 

@@ -14,6 +14,9 @@ struct RenderParams {
   // Transparency: oil density sets how far below the surface pigment is still gathered.
   float penetration_per_oil = 6.f;  ///< penetration distance L = oil * this, cells
   float penetration_step = 0.75f;   ///< spacing of the pigment samples below the surface, cells
+  // Films: paint whose column never reaches the threshold lies at the column's paint volume.
+  float film_fade = 0.25f;   ///< densest cell from threshold to threshold + this: film gives way to the threshold surface
+  float film_hiding = 0.2f;  ///< film thickness hiding all but 2 % of the ground (Beer–Lambert), cells (0.04 mm)
   // Ambient occlusion (§6: 64 rays, maximum density reached within a short distance).
   int ao_rays = 64;
   float ao_length = 4.f;    ///< how far each AO ray looks, cells

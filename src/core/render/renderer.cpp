@@ -14,11 +14,13 @@
 namespace wb {
 
 namespace {
-void top_map_dispatch(const Device& d, RenderVolume v, int x0, int y0, int w, int h, uint16_t* top) {
-  WB_DISPATCH(d, render_top_map(v, x0, y0, w, h, top));
+void top_map_dispatch(const Device& d, RenderVolume v, const RenderParams& P, int x0, int y0, int w, int h,
+                      uint16_t* top, FilmColumn* film) {
+  WB_DISPATCH(d, render_top_map(v, P, x0, y0, w, h, top, film));
 }
-void block_dispatch(const Device& d, const uint16_t* top, int w, int h, uint16_t* b, int bw, int bh) {
-  WB_DISPATCH(d, render_block_top(top, w, h, b, bw, bh));
+void block_dispatch(const Device& d, const uint16_t* top, const FilmColumn* film, int w, int h, uint16_t* b,
+                    uint8_t* bf, int bw, int bh) {
+  WB_DISPATCH(d, render_block_top(top, film, w, h, b, bf, bw, bh));
 }
 void splat_dispatch(const Device& d, SplatView s, ParticleOverlay p) { WB_DISPATCH(d, render_splat(s, p)); }
 void pixels_dispatch(const Device& d, RenderVolume v, RenderParams P, CameraBasis cam, const Vec3* dirs,
@@ -42,11 +44,15 @@ void check_params(const RenderParams& p) {
   WB_REQUIRE(p.ao_step > 0.f && p.ao_length >= 0.f, "render: AO step must be positive, length non-negative");
   WB_REQUIRE(length(p.light_dir) > 0.f && isfinite3(p.light_dir), "render: light direction must be non-zero");
   WB_REQUIRE(p.weave_period > 0.f, "render: weave period must be positive");
+  WB_REQUIRE(p.film_hiding > 0.f, "render: film hiding thickness must be positive");
+  WB_REQUIRE(p.film_fade > 0.f, "render: film fade must be positive");
 }
 }  // namespace
 
 Renderer::Renderer(const Device& device) : device_(device) {
   for (auto* b : {&top_, &block_top_}) b->set_device(device);
+  film_.set_device(device);
+  block_film_.set_device(device);
   for (auto* b : {&splat_d_, &splat_r_, &splat_y_, &splat_b_, &splat_oil_, &fout_}) b->set_device(device);
   ao_dirs_.set_device(device);
   tile_list_.set_device(device);
@@ -96,8 +102,8 @@ void Renderer::prepare(TileStore& canvas, const Camera& camera, const std::vecto
   }
 
   // Footprint of the listed image tiles on the canvas: every column a ray, its normal stencil
-  // or its AO rays can touch. Columns outside it read as full depth (no skipping), so the map
-  // only has to be right where it exists.
+  // or its AO rays can touch. Columns outside it read as full depth (no skipping) and hold no
+  // film, so the maps only have to be right where they exist.
   const CanvasDims dims = canvas.dims();
   const CameraBasis cam = camera_basis(camera);
   const int tiles_x = (img_w_ + tile_px - 1) / tile_px;
@@ -131,15 +137,19 @@ void Renderer::prepare(TileStore& canvas, const Camera& camera, const std::vecto
   if (w > 0 && h > 0) {
     WB_PROFILE_SCOPE("render.top_map");
     top_.resize(size_t(w) * h);
+    film_.resize(size_t(w) * h);
     block_top_.resize(size_t(bw) * bh);
-    top_map_dispatch(device_, vol_, x0, y0, w, h, top_.data());
-    block_dispatch(device_, top_.data(), w, h, block_top_.data(), bw, bh);
+    block_film_.resize(size_t(bw) * bh);
+    top_map_dispatch(device_, vol_, kparams_, x0, y0, w, h, top_.data(), film_.data());
+    block_dispatch(device_, top_.data(), film_.data(), w, h, block_top_.data(), block_film_.data(), bw, bh);
     host_blocks_.resize(size_t(bw) * bh);
     block_top_.copy_to_host(host_blocks_.data(), host_blocks_.size());
     for (uint16_t b : host_blocks_) vol_.z_top_max = std::max<int>(vol_.z_top_max, b);
   }
   vol_.top = top_.data();
   vol_.block_top = block_top_.data();
+  vol_.film = film_.data();
+  vol_.block_film = block_film_.data();
   if (vol_.has_splat) {
     // Splatted paint may stick out of the map (off-canvas): let oblique rays start above it.
     vol_.z_top_max = std::max(vol_.z_top_max, std::min(dims.depth, vol_.splat.oz + vol_.splat.nz));

@@ -88,6 +88,8 @@ class Renderer {
   RenderVolume vol_{};
   RenderParams kparams_{};
   DeviceBuffer<uint16_t> top_, block_top_;
+  DeviceBuffer<FilmColumn> film_;
+  DeviceBuffer<uint8_t> block_film_;
   DeviceBuffer<float> splat_d_, splat_r_, splat_y_, splat_b_, splat_oil_;
   DeviceBuffer<Vec3> ao_dirs_;
   DeviceBuffer<int32_t> tile_list_;
@@ -132,15 +134,19 @@ class CanvasImageCache {
 };
 
 namespace cpu {
-void render_top_map(RenderVolume v, int x0, int y0, int w, int h, uint16_t* top);
-void render_block_top(const uint16_t* top, int w, int h, uint16_t* blocks, int bw, int bh);
+void render_top_map(RenderVolume v, RenderParams P, int x0, int y0, int w, int h, uint16_t* top,
+                    FilmColumn* film);
+void render_block_top(const uint16_t* top, const FilmColumn* film, int w, int h, uint16_t* blocks,
+                      uint8_t* block_film, int bw, int bh);
 void render_splat(SplatView s, ParticleOverlay p);
 void render_pixels(RenderVolume v, RenderParams P, CameraBasis cam, const Vec3* ao_dirs, const int32_t* tiles,
                    int ntiles, int tile_px, int img_w, int img_h, int mode, uint32_t* rgba, float* fout);
 }  // namespace cpu
 namespace cuda {
-void render_top_map(RenderVolume v, int x0, int y0, int w, int h, uint16_t* top);
-void render_block_top(const uint16_t* top, int w, int h, uint16_t* blocks, int bw, int bh);
+void render_top_map(RenderVolume v, RenderParams P, int x0, int y0, int w, int h, uint16_t* top,
+                    FilmColumn* film);
+void render_block_top(const uint16_t* top, const FilmColumn* film, int w, int h, uint16_t* blocks,
+                      uint8_t* block_film, int bw, int bh);
 void render_splat(SplatView s, ParticleOverlay p);
 void render_pixels(RenderVolume v, RenderParams P, CameraBasis cam, const Vec3* ao_dirs, const int32_t* tiles,
                    int ntiles, int tile_px, int img_w, int img_h, int mode, uint32_t* rgba, float* fout);

@@ -69,7 +69,7 @@ float layer_density(float h, int z) { return sdf_density(h - (float(z) + 0.5f));
 }  // namespace
 
 std::vector<std::string> test_volume_names() {
-  return {"flat", "hemisphere", "ridges", "glaze", "swatches", "impasto-1024"};
+  return {"flat", "hemisphere", "ridges", "glaze", "swatches", "films", "impasto-1024"};
 }
 
 CanvasDims test_volume_dims(const std::string& name) {
@@ -78,8 +78,9 @@ CanvasDims test_volume_dims(const std::string& name) {
   if (name == "ridges") return {96, 96, 16};
   if (name == "glaze") return {128, 64, 16};
   if (name == "swatches") return {256, 128, 16};
+  if (name == "films") return {192, 96, 16};
   if (name == "impasto-1024") return {1024, 1024, 32};
-  WB_THROW("unknown test volume '" + name + "' (known: flat, hemisphere, ridges, glaze, swatches, impasto-1024)");
+  WB_THROW("unknown test volume '" + name + "' (known: flat, hemisphere, ridges, glaze, swatches, films, impasto-1024)");
 }
 
 void make_test_volume(TileStore& canvas, const std::string& name) {
@@ -128,6 +129,21 @@ void make_test_volume(TileStore& canvas, const std::string& name) {
       if (y < 72 || y >= 120) return PaintCell{};
       if (z < 2) return paint(dens, 0.f, 1.f, 0.f, 0.3f);
       return paint(dens, 1.f, 0.1f, 0.f, float(k) / 7.f);
+    });
+  } else if (name == "films") {
+    // Top: squares of paint 0.01, 0.05, 0.1, 0.3, 0.6 and 2 cells thick (2 um to 0.4 mm).
+    // Bottom: paint rising along x from none to a 3-cell layer (upper rows), and to two full
+    // cells spread evenly over both, density 0 to 1 (lower rows).
+    const float thick[6] = {0.01f, 0.05f, 0.1f, 0.3f, 0.6f, 2.f};
+    fill_volume(canvas, 0, 0, d.width, d.height, [&](int x, int y, int z) {
+      const float f = (float(x) - 8.f + 0.5f) / 176.f;
+      float dens = 0.f;
+      if (y >= 8 && y < 40 && (x - 8) % 30 < 24 && x >= 8 && x < 8 + 6 * 30) {
+        dens = layer_density(thick[(x - 8) / 30], z);
+      } else if (y >= 52 && y < 88 && x >= 8 && x < 184) {
+        dens = y < 70 ? layer_density(3.f * f, z) : (z < 2 ? f : 0.f);
+      }
+      return paint(dens, 0.9f, 0.3f, 0.05f, 0.1f);
     });
   } else if (name == "impasto-1024") {
     // Thick strokes everywhere: a wavy height field 1..9 cells, a colour that changes by

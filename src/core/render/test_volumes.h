@@ -25,6 +25,7 @@ CanvasDims test_volume_dims(const std::string& name);
 /// Fills `canvas` (of test_volume_dims(name)) with the named volume; throws on unknown names.
 /// flat: 4-cell red layer; hemisphere: radius 24 dome; ridges: two parallel ridges with a
 /// crease; glaze: thin oily and thick opaque blue over red; swatches: colour and oil swatches;
+/// films: thin films 0.01 to 2 cells thick and paint rising from none to thick;
 /// impasto-1024: a 1024^2 canvas covered with thick strokes (the timing volume).
 void make_test_volume(TileStore& canvas, const std::string& name);
 
