@@ -79,13 +79,32 @@ TEST(TransferSweep, ParticlesLayTheTrailAlongThePath) {
   const float dt = 1.f / 60.f;
   float lo = 1e9f, hi = -1e9f;
   for (int i = 0; i < 10; ++i) {
-    const Vec3 q = swept_position(x, vt, dt, 0.5f, 1.5f, i, 10, emission_pattern_point(i, 16), 0.f, Vec3(0, 0, 0),
+    const Vec3 q = swept_position(x, vt, dt, 0.5f, 1.5f, i, 10, 0.5f, emission_pattern_point(i, 16), 0.f, Vec3(0, 0, 0),
                                   Vec3(256, 256, 0));
     lo = std::min(lo, q.x), hi = std::max(hi, q.x);
     EXPECT_NEAR(q.z, 2.f - 1.5f + 0.25f, 1e-5f);
   }
   EXPECT_LT(lo, x.x - 0.8f * 10.f);
   EXPECT_GT(hi, x.x - 0.2f * 10.f);
+}
+
+TEST(TransferSweep, OneParticleAStepLandsAnywhereAlongItsPath) {
+  // A sample that leaves one particle a step puts it at a different point of each step's path,
+  // uniformly over the path (a fixed point would print a bead every step).
+  const Vec3 x(100.f, 50.f, 2.f), vt(300.f, 0.f, 0.f);
+  const float dt = 1.f / 60.f;
+  for (int64_t j : {0, 7, 4093}) {
+    int bins[10] = {};
+    for (int64_t step = 0; step < 2000; ++step) {
+      const Vec3 q = swept_position(x, vt, dt, 0.f, 1.5f, 0, 1, sample_step_jitter(j, step), Vec3(), 0.f,
+                                    Vec3(0, 0, 0), Vec3(256, 256, 0));
+      const float u = (q.x - (x.x - vt.x * dt)) / (vt.x * dt);
+      ASSERT_GE(u, 0.f);
+      ASSERT_LT(u, 1.f);
+      ++bins[int(u * 10.f)];
+    }
+    for (int b = 0; b < 10; ++b) EXPECT_NEAR(bins[b], 200, 50) << "sample " << j << ", tenth " << b << " of the path";
+  }
 }
 
 TEST(TransferCapacity, CapFormulaMatchesNumericIntegration) {

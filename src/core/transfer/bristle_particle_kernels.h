@@ -177,19 +177,28 @@ WB_HD WB_INLINE int swept_count(float deposit, float travel, float emit_mass, fl
 }
 
 /// Position of the i-th of n particles of a swept deposit: spread along the sample's path over
-/// the step, from x_j - v_t dt to x_j (v_t: the velocity along the surface), across the cap's
+/// the step, from x_j - v_t dt to x_j (v_t: the velocity along the surface), stratified with a
+/// per-sample, per-step `jitter` in [0, 1) (at u = (i + jitter) / n: with a fixed offset a sample
+/// that leaves one particle a step leaves it at the same point of every step's path, and the
+/// stroke is a chain of beads at the step period), across the cap's
 /// footprint (half-width a = sqrt(R_m^2 - r^2)) by pattern point `slot`, a quarter cell above
 /// the surface r_j below the sample (never below the canvas), and inside the columns [lo, hi)
 /// of the active window: particles live only there (a path that began outside the window, which
 /// moved with the brush, ends its trail at the window's wall).
-WB_HD WB_INLINE Vec3 swept_position(Vec3 x_j, Vec3 v_t, float dt, float a, float r, int i, int n, Vec3 pattern,
-                                    float floor_z, Vec3 lo, Vec3 hi) {
-  const float u = (float(i) + 0.5f) / float(n);
+WB_HD WB_INLINE Vec3 swept_position(Vec3 x_j, Vec3 v_t, float dt, float a, float r, int i, int n, float jitter,
+                                    Vec3 pattern, float floor_z, Vec3 lo, Vec3 hi) {
+  const float u = (float(i) + jitter) / float(n);
   Vec3 p = x_j - v_t * (dt * (1.f - u));
   p.x = clampf(p.x + pattern.x * a, lo.x + 0.5f, hi.x - 0.5f);
   p.y = clampf(p.y + pattern.y * a, lo.y + 0.5f, hi.y - 0.5f);
   p.z = maxf(x_j.z - r, floor_z) + 0.25f;
   return p;
+}
+
+/// Deterministic value in [0, 1) for sample j at step `step` (stratification jitter).
+WB_HD WB_INLINE float sample_step_jitter(int64_t j, int64_t step) {
+  const uint32_t h = transfer_hash(uint32_t(j) * 2654435761u ^ uint32_t(step) * 40503u ^ 0x9e3779b9u);
+  return float(h >> 8) * (1.f / 16777216.f);
 }
 
 /// Point s of the fixed emission pattern of P points, uniform in the lower half of the unit

@@ -361,7 +361,8 @@ void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, cons
         // Left on the surface along the path slid this step, at rest with it.
         const int q = i - n_static;
         const int64_t slot = (j + step_index * int64_t(n_swept) + int64_t(q)) % int64_t(P);
-        p.x[k] = swept_position(xj, vt, dt, a, r, q, n_swept, emission_pattern_point(int(slot), P), floor_z, lo, hi);
+        p.x[k] = swept_position(xj, vt, dt, a, r, q, n_swept, sample_step_jitter(j, step_index),
+                                emission_pattern_point(int(slot), P), floor_z, lo, hi);
         p.v[k] = Vec3();
         p.m[k] = swept_each[j];
       }
