@@ -107,6 +107,32 @@ TEST(TransferSweep, OneParticleAStepLandsAnywhereAlongItsPath) {
   }
 }
 
+TEST(TransferSweep, SamplesSweepingOneColumnShareTheirPassesDeposit) {
+  // k passes in sequence, each closing `split` of the gap to the balance film: 1 - (1 - split)^k
+  // of the gap in all, shared by the k samples of one step.
+  for (float split : {0.25f, 0.5f, 0.9f}) {
+    EXPECT_FLOAT_EQ(pass_share(1.f, split), 1.f) << "one pass keeps its deposit";
+    for (int k : {2, 5, 40}) {
+      double gap = 1.0;
+      for (int i = 0; i < k; ++i) gap -= split * gap;
+      EXPECT_NEAR(k * split * pass_share(float(k), split), 1.0 - gap, 1e-5) << k << " passes, split " << split;
+      EXPECT_LT(pass_share(float(k), split), pass_share(float(k - 1), split));
+    }
+  }
+  EXPECT_FLOAT_EQ(pass_share(4.f, 1.f), 0.25f) << "split 1: the first pass lays it all";
+  EXPECT_FLOAT_EQ(pass_share(4.f, 0.f), 1.f);
+  // The columns of a path: those of a point per cell slid, each once (5 cells: 5 or 6 columns).
+  int n = 0;
+  for_path_columns(Vec3(20.5f, 10.5f, 1.f), Vec3(300.f, 0.f, 0.f), 1.f / 60.f, 0, 0, 64, 64, [&](int ix, int iy) {
+    EXPECT_EQ(iy, 10);
+    EXPECT_GE(ix, 15);
+    EXPECT_LE(ix, 20);
+    ++n;
+  });
+  EXPECT_GE(n, 5);
+  EXPECT_LE(n, 6);
+}
+
 TEST(TransferCapacity, CapFormulaMatchesNumericIntegration) {
   // The cap beyond a plane at distance r from the centre: integral_r^R pi (R^2 - z^2) dz.
   for (float R : {0.3f, 0.75f, 2.f}) {

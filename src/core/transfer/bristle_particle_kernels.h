@@ -150,6 +150,37 @@ WB_HD WB_INLINE float swept_deposit(float m, float r, float film, float travel, 
   return maxf(net, 0.f) * cell_mass * travel;
 }
 
+/// Share of its single-pass deposit a sample leaves when k samples sweep the same canvas column
+/// in one step (docs/TRANSFER.md "Swept contact"). Each pass moves the film f towards the
+/// balance thickness f* by split of the difference (swept_deposit per unit track area:
+/// f <- (1 - split) f + split f*), so k passes in sequence leave 1 - (1 - split)^k of the gap
+/// to f*, where k independent passes would each add split of it: the k samples share the
+/// sequence's deposit, (1 - (1 - split)^k) / (k split) each. Within a step the samples cannot
+/// see each other's paint (it reaches the fields the next step); across steps the film does.
+WB_HD WB_INLINE float pass_share(float k, float split) {
+  if (!(k > 1.f) || !(split > 0.f)) return 1.f;
+  if (!(split < 1.f)) return 1.f / k;
+  return (1.f - powf(1.f - split, k)) / (k * split);
+}
+
+/// The canvas columns a sample's path over the step crosses (from x - v_t dt to x), a point per
+/// cell slid; calls f(ix, iy) for each column of the window [0, nx) x [0, ny) it enters, once
+/// per run of points in the same column.
+template <class F>
+WB_HD WB_INLINE void for_path_columns(Vec3 x, Vec3 v, float dt, int ox, int oy, int nx, int ny, F&& f) {
+  const Vec3 vt(v.x, v.y, 0.f);
+  const float travel = sqrtf(v.x * v.x + v.y * v.y) * dt;
+  const int n = travel > 1.f ? int(ceilf(travel)) : 1;
+  int px = -1, py = -1;
+  for (int i = 0; i < n; ++i) {
+    const Vec3 p = x - vt * (dt * (1.f - (float(i) + 0.5f) / float(n)));
+    const int ix = int(floorf(p.x)) - ox, iy = int(floorf(p.y)) - oy;
+    if (ix == px && iy == py) continue;
+    px = ix, py = iy;
+    if (ix >= 0 && iy >= 0 && ix < nx && iy < ny) f(ix, iy);
+  }
+}
+
 /// Wet paint under a sample at x: the column integral of `density` (grid plus particles, cell
 /// fractions) from the solid `gap` cells below it up to it, in steps of `step` cells (midpoint
 /// rule): the film thickness the sample meets, thin films of any density included.

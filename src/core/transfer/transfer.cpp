@@ -22,6 +22,14 @@ void d_wick(const Device& d, SampleView s, BristleLoadView l, int bristles, int 
             float dt, float* a, float* b) {
   WB_DISPATCH(d, transfer_wick(s, l, bristles, per, k_dt, k_slide, dt, a, b));
 }
+void d_contact_paths(const Device& d, SampleView s, BristleLoadView l, float dt, int ox, int oy, int nx, int ny,
+                     uint32_t* passes) {
+  WB_DISPATCH(d, transfer_contact_paths(s, l, dt, ox, oy, nx, ny, passes));
+}
+void d_contact_share(const Device& d, SampleView s, BristleLoadView l, float dt, int ox, int oy, int nx, int ny,
+                     const uint32_t* passes, float split) {
+  WB_DISPATCH(d, transfer_contact_share(s, l, dt, ox, oy, nx, ny, passes, split));
+}
 void d_absorb_apply(const Device& d, BristleLoadView l, AbsorbScratch a) { WB_DISPATCH(d, transfer_absorb_apply(l, a)); }
 void d_occupancy(const Device& d, SampleView s, DistanceBlocks db, int32_t* occ, int ox, int oy, int oz) {
   WB_DISPATCH(d, transfer_distance_occupancy(s, db, occ, ox, oy, oz));
@@ -139,6 +147,7 @@ Transfer::Transfer(const Device& device, const TransferParams& params)
   for (auto& b : c_f32_) b.set_device(device);
   for (auto& b : c_i64_) b.set_device(device);
   p_moved_.set_device(device);
+  passes_.set_device(device);
   occ_.set_device(device);
   d2_.set_device(device);
   d2_tmp_.set_device(device);
@@ -166,6 +175,10 @@ TransferRecord Transfer::step(const SampleView& samples, BristleLoad& load, Part
   {
     WB_PROFILE_SCOPE("transfer.capacity");
     update_capacity(samples, load, env);
+  }
+  if (env.dt > 0.f) {
+    WB_PROFILE_SCOPE("transfer.share");
+    share_contact(samples, load, env);
   }
   if (env.dt > 0.f) {  // also with wick_rate 0: the swept contact's sink is solved there
     WB_PROFILE_SCOPE("transfer.wick");
@@ -209,6 +222,16 @@ void Transfer::update_capacity(const SampleView& samples, BristleLoad& load, con
   const CellField particles{env.particle_density, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
   transfer_capacity(device_, samples, load.view(), psi, density, dryness, particles, params_, env.floor_z,
                     env.dry_threshold, env.dt);
+}
+
+void Transfer::share_contact(const SampleView& samples, BristleLoad& load, const TransferEnv& env) {
+  const PaintWindowView& pw = env.paint;
+  if (samples.count() == 0 || params_.split <= 0.f) return;
+  passes_.resize(size_t(pw.nx) * size_t(pw.ny));
+  passes_.fill_zero();
+  const BristleLoadView lv = load.view();
+  d_contact_paths(device_, samples, lv, env.dt, pw.ox, pw.oy, pw.nx, pw.ny, passes_.data());
+  d_contact_share(device_, samples, lv, env.dt, pw.ox, pw.oy, pw.nx, pw.ny, passes_.data(), params_.split);
 }
 
 void Transfer::wick(const SampleView& samples, BristleLoad& load, float dt) {

@@ -124,6 +124,10 @@ class Transfer {
   /// Wicking (docs/TRANSFER.md): the load flows along each bristle from fuller to emptier
   /// samples (saturation m / M'), implicitly over dt; colour and oil go with it.
   void wick(const SampleView& samples, BristleLoad& load, float dt);
+  /// Swept contact: samples that sweep the same canvas column in one step share the deposit
+  /// of their sequence of passes (pass_share), so that a layer is laid once, not once per row
+  /// of bristles.
+  void share_contact(const SampleView& samples, BristleLoad& load, const TransferEnv& env);
   /// Eq. 14: particles within R_j of their nearest sample j join it while m_j < M_j (at most
   /// absorb_limit per sample), else bleed colour. Absorbed particles are flagged dead.
   void absorb(const SampleView& samples, BristleLoad& load, ParticleStore& particles, TransferRecord& rec);
@@ -171,6 +175,8 @@ class Transfer {
   DeviceBuffer<float> d2_, d2_tmp_, edt_z_;
   DeviceBuffer<int32_t> edt_v_;
   DistanceBlocks blocks_{};
+  // Swept-contact passes per window column.
+  DeviceBuffer<uint32_t> passes_;
   // Counters.
   DeviceBuffer<int32_t> counters_;
 };
@@ -183,6 +189,10 @@ void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadVi
 #define WB_TRANSFER_BACKEND_DECLS                                                                                  \
   void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellField density, CellField dryness,  \
                          CellField particles, TransferParams prm, float floor_z, float dry_threshold, float dt);   \
+  void transfer_contact_paths(SampleView s, BristleLoadView load, float dt, int ox, int oy, int nx, int ny,       \
+                              uint32_t* passes);                                                                  \
+  void transfer_contact_share(SampleView s, BristleLoadView load, float dt, int ox, int oy, int nx, int ny,       \
+                              const uint32_t* passes, float split);                                               \
   void transfer_absorb(ParticleView p, SampleView s, BristleLoadView load, AbsorbScratch a, TransferParams prm);    \
   void transfer_absorb_apply(BristleLoadView load, AbsorbScratch a);                                               \
   void transfer_wick(SampleView s, BristleLoadView load, int bristles, int per, float k_dt, float k_slide, float dt, \

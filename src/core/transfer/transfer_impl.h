@@ -40,6 +40,31 @@ void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellFi
   });
 }
 
+// --- swept contact: samples sweeping the same columns in one step share their deposit ----
+
+void transfer_contact_paths(SampleView s, BristleLoadView load, float dt, int ox, int oy, int nx, int ny,
+                            uint32_t* passes) {
+  parallel_for(load.count, [=] WB_HD(int64_t j) {
+    if (!(load.sweep[j] > 0.f)) return;
+    for_path_columns(s.x[j], s.v[j], dt, ox, oy, nx, ny,
+                     [&](int ix, int iy) { atomic_add(&passes[int64_t(iy) * nx + ix], 1u); });
+  });
+}
+
+void transfer_contact_share(SampleView s, BristleLoadView load, float dt, int ox, int oy, int nx, int ny,
+                            const uint32_t* passes, float split) {
+  parallel_for(load.count, [=] WB_HD(int64_t j) {
+    if (!(load.sweep[j] > 0.f)) return;
+    float sum = 0.f;
+    int n = 0;
+    for_path_columns(s.x[j], s.v[j], dt, ox, oy, nx, ny, [&](int ix, int iy) {
+      sum += float(passes[int64_t(iy) * nx + ix]);
+      ++n;
+    });
+    if (n > 0) load.sweep[j] *= pass_share(sum / float(n), split);
+  });
+}
+
 // --- wicking along each bristle (docs/TRANSFER.md "Wicking") -------------------------------
 
 // One thread per bristle: backward Euler for M'_i s_i - sum_e g_e (s_nb - s_i) = m_i (Thomas
