@@ -126,7 +126,7 @@ TEST_F(AdhesionTest, BetaZeroCarriesARotatingFrameRigidly) {
   EXPECT_GT(length(pn - p), 10.f * length(rest - p));
 }
 
-TEST_F(AdhesionTest, SpinAboutTheTangentDoesNotSwingParticlesAndTurnsAreCapped) {
+TEST_F(AdhesionTest, SpinAboutTheTangentDoesNotSwingParticles) {
   // A round bristle spinning about its own tangent carries no paint around with it: a particle
   // at rest beside it stays where it is (beta_L = 0, no acceleration).
   SampleFrame s;
@@ -135,12 +135,11 @@ TEST_F(AdhesionTest, SpinAboutTheTangentDoesNotSwingParticlesAndTurnsAreCapped) 
   s.omega = s.t * 300.f;  // 5 rad per step: a parallel-transport artefact
   const Vec3 p = s.x + Vec3(0.f, 4.f, 0.f);
   EXPECT_NEAR(length(local_frame_step(p, Vec3(), Vec3(), s, 0.f, kDt) - p), 0.f, 1e-4f);
-  // A turn across the tangent faster than kMaxFrameTurn per step is capped to it, keeping its axis.
+  // A turn across the tangent is kept whole, whatever its rate; only the spin goes.
   s.omega = Vec3(0.f, 0.f, 600.f) + s.t * 200.f;  // 10 rad per step across t, plus spin
-  const SampleFrame c = physical_rotation(s, kDt);
+  const SampleFrame c = physical_rotation(s);
   EXPECT_NEAR(dot(c.omega, s.t), 0.f, 1e-4f);
-  EXPECT_NEAR(length(c.omega) * kDt, kMaxFrameTurn, 1e-5f);
-  EXPECT_NEAR(length(cross(normalize(c.omega), Vec3(0, 0, 1))), 0.f, 1e-5f);
+  EXPECT_NEAR(length(c.omega - Vec3(0.f, 0.f, 600.f)), 0.f, 1e-3f);
 }
 
 TEST_F(AdhesionTest, CanvasHoldsPaintThatTouchesItAgainstBristleJolts) {

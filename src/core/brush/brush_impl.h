@@ -39,9 +39,7 @@ void brush_integrate(BristleState s, BristleRest r, BrushFrame f, BrushForces e,
     Vec3 dv_canvas = e.gravity * dt;
     if (e.has_drag) dv_canvas += brush::drag_velocity_change(e.drag, s.x[g], s.v[g], dt);
     const Vec3 a = brush::eq2_acceleration(f.R_B * (dv_canvas / dt), f, s.xb[g], s.vb[g], beta_B);
-    const float length = r.seg_length[k * V + 1] * float(V - 1);
-    Vec3 vb = (s.vb[g] * (1.f - damping) + a * dt);
-    vb = brush::clamp_length(vb, length / dt);
+    const Vec3 vb = (s.vb[g] * (1.f - damping) + a * dt);
     s.vb[g] = vb;
     s.xb[g] = s.xb[g] + vb * dt;
   });

@@ -72,23 +72,14 @@ WB_HD WB_INLINE Vec3 to_canvas(Vec3 t, Vec3 n, Vec3 b, Vec3 v) { return t * v.x 
 /// The canvas-frame update without adhesion (symplectic Euler): p'' = p + dt (v + dt a_k).
 WB_HD WB_INLINE Vec3 canvas_frame_step(Vec3 p, Vec3 v, Vec3 a_k, float dt) { return p + (v + a_k * dt) * dt; }
 
-/// Largest turn of a sample frame that carries particles in one step, radians.
-inline constexpr float kMaxFrameTurn = 0.5f;
-
 /// The part of a sample frame's rotation that paint around the bristle feels. A bristle is
 /// round: its Bishop frame's spin about the tangent t is a by-product of parallel transport
 /// along the moving curve, not a motion of the fibre, and at sharp bends it reached 2500 rad/s
 /// on a 16-cell brush, flinging particles up to D1 away around the bristle. Only the rotation
-/// that turns t is kept (omega - (omega . t) t, likewise alpha), capped at kMaxFrameTurn per step.
-WB_HD WB_INLINE SampleFrame physical_rotation(SampleFrame s, float dt) {
+/// that turns t is kept (omega - (omega . t) t, likewise alpha).
+WB_HD WB_INLINE SampleFrame physical_rotation(SampleFrame s) {
   s.omega = s.omega - s.t * dot(s.omega, s.t);
   s.alpha = s.alpha - s.t * dot(s.alpha, s.t);
-  const float turn = length(s.omega) * dt;
-  if (turn > kMaxFrameTurn) {
-    const float k = kMaxFrameTurn / turn;
-    s.omega = s.omega * k;
-    s.alpha = s.alpha * k;
-  }
   return s;
 }
 
@@ -102,7 +93,7 @@ WB_HD WB_INLINE SampleFrame physical_rotation(SampleFrame s, float dt) {
 /// integrated by symplectic Euler, and p^l mapped back with the frame at t + dt.
 /// With beta_L = 0 and a_k = 0 a particle moving with the sample stays rigidly attached.
 WB_HD WB_INLINE Vec3 local_frame_step(Vec3 p, Vec3 v, Vec3 a_k, const SampleFrame& s_in, float beta_L, float dt) {
-  const SampleFrame s = physical_rotation(s_in, dt);
+  const SampleFrame s = physical_rotation(s_in);
   // The frame at the start of the step.
   const Vec3 x0 = s.x - s.v * dt;
   const Vec3 v0 = s.v - s.a * dt;

@@ -278,11 +278,7 @@ void Simulator::brush_stage(const BrushPose* poses, int substeps, float dt) {
 void Simulator::particle_stage(float dt) {
   if (particles_.size() == 0) return;
   WB_PROFILE_SCOPE("particles");
-  // D1 (Table 1: 0.3 cm) suits the paper's brushes of 1-2 cm; on a 3 mm brush it would tie
-  // paint to bristles across the whole brush, and lifting the brush flings it. Adhesion
-  // reaches at most a fifth of the bristle length (the default brushes keep D1).
-  ParticleParams prm = config_.params.particles;
-  prm.D1 = std::min(prm.D1, 0.2f * config_.brush.length);
+  const ParticleParams& prm = config_.params.particles;
   // Samples are at t + dt, particles at t: hash the samples rewound to t (hash_grid.h).
   hash_.build(brush_->samples(), prm.hash_cell, ws_, dt);
   hash_.query_nearest(particles_.view(), prm.D0);
