@@ -133,6 +133,29 @@ TEST(TransferSweep, SamplesSweepingOneColumnShareTheirPassesDeposit) {
   EXPECT_LE(n, 6);
 }
 
+TEST(TransferSweep, FilmIsTheWetPaintOnTheSolidNotTheDriedPaint) {
+  // Columns of 8 cells: a dried layer 3 cells thick (z 0..3), then 1 cell of wet paint (z 3..4).
+  // A sample at z 4.5 with the solid 1.5 below meets a film of the wet cell only.
+  const int n = 4, nz = 8;
+  std::vector<float> rho(size_t(n) * n * nz, 0.f), dry(rho.size(), 0.f);
+  for (int k = 0; k < 4; ++k)
+    for (int c = 0; c < n * n; ++c) {
+      rho[size_t(k) * n * n + c] = 1.f;
+      dry[size_t(k) * n * n + c] = k < 3 ? 1.f : 0.f;
+    }
+  const CellField density{rho.data(), n, n, nz, 0, 0, 0}, dryness{dry.data(), n, n, nz, 0, 0, 0};
+  const CellField none{nullptr, n, n, nz, 0, 0, 0};
+  const Vec3 x(2.f, 2.f, 4.5f);
+  // Trilinear reads blur the wet cell's edges over half a cell each way: about 0.9 of it.
+  const float wet = film_below(x, 1.5f, density, dryness, 0.9f, none, 0.05f);
+  EXPECT_NEAR(wet, 0.875f, 0.05f);
+  // Over the bare dried layer (the wet cell taken away) there is no film at all.
+  for (int c = 0; c < n * n; ++c) rho[size_t(3) * n * n + c] = 0.f;
+  EXPECT_NEAR(film_below(Vec3(2.f, 2.f, 3.5f), 0.5f, density, dryness, 0.9f, none, 0.05f), 0.f, 1e-6f);
+  // Read without the dryness, the dried layer's top would count as film.
+  EXPECT_GT(film_below(Vec3(2.f, 2.f, 3.5f), 0.5f, density, none, 0.9f, none, 0.05f), 0.1f);
+}
+
 TEST(TransferCapacity, CapFormulaMatchesNumericIntegration) {
   // The cap beyond a plane at distance r from the centre: integral_r^R pi (R^2 - z^2) dz.
   for (float R : {0.3f, 0.75f, 2.f}) {

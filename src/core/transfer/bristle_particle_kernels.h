@@ -181,15 +181,19 @@ WB_HD WB_INLINE void for_path_columns(Vec3 x, Vec3 v, float dt, int ox, int oy, 
   }
 }
 
-/// Wet paint under a sample at x: the column integral of `density` (grid plus particles, cell
-/// fractions) from the solid `gap` cells below it up to it, in steps of `step` cells (midpoint
-/// rule): the film thickness the sample meets, thin films of any density included.
-WB_HD WB_INLINE float film_below(Vec3 x, float gap, const CellField& density, const CellField& particles, float step) {
+/// Wet paint under a sample at x: the column integral of the wet density (grid plus particles,
+/// cell fractions; dried cells count as empty) from the solid `gap` cells below it up to it, in
+/// steps of `step` cells (midpoint rule): the film thickness the sample meets, thin films of
+/// any density included. Dried paint is the solid the film lies on, not film: counted as film,
+/// the top of a dried ridge read as a wet layer the bristle had already laid, and a brush
+/// skimming dried ridges left nothing on their tops.
+WB_HD WB_INLINE float film_below(Vec3 x, float gap, const CellField& density, const CellField& dryness,
+                                 float dry_threshold, const CellField& particles, float step) {
   float film = 0.f;
   for (float s = 0.f; s < gap; s += step) {
     const float h = minf(step, gap - s);
     const Vec3 p(x.x, x.y, x.z - s - 0.5f * h);
-    film += (cell_field_at(density, p) + cell_field_at(particles, p)) * h;
+    film += (wet_density_at(density, dryness, dry_threshold, p) + cell_field_at(particles, p)) * h;
   }
   return film;
 }

@@ -56,6 +56,29 @@ WB_HD WB_INLINE float cell_field_at(const CellField& g, Vec3 p) {
   return acc;
 }
 
+/// Trilinear value of the wet part of a cell-centred density field at canvas position p: cells
+/// that are solid (dried, `cell_is_solid`) count as empty; nodes outside the field read 0.
+WB_HD WB_INLINE float wet_density_at(const CellField& density, const CellField& dryness, float dry_threshold, Vec3 p) {
+  if (density.f == nullptr) return 0.f;
+  const float sx = p.x - float(density.ox) - 0.5f, sy = p.y - float(density.oy) - 0.5f,
+              sz = p.z - float(density.oz) - 0.5f;
+  const float fx = floorf(sx), fy = floorf(sy), fz = floorf(sz);
+  const int i0 = int(fx), j0 = int(fy), k0 = int(fz);
+  const float tx = sx - fx, ty = sy - fy, tz = sz - fz;
+  float acc = 0.f;
+  for (int c = 0; c < 2; ++c)
+    for (int b = 0; b < 2; ++b)
+      for (int a = 0; a < 2; ++a) {
+        const int i = i0 + a, j = j0 + b, k = k0 + c;
+        if (i < 0 || j < 0 || k < 0 || i >= density.nx || j >= density.ny || k >= density.nz) continue;
+        const int64_t id = (int64_t(k) * density.ny + j) * density.nx + i;
+        const float rho = density.f[id];
+        if (dryness.f && cell_is_solid(rho, dryness.f[id], dry_threshold)) continue;
+        acc += (a ? tx : 1.f - tx) * (b ? ty : 1.f - ty) * (c ? tz : 1.f - tz) * rho;
+      }
+  return acc;
+}
+
 /// Trilinear density of the liquid (non-solid) paint at window position q, constant
 /// extension at the window's edges; solid cells count as empty. Used to keep candidates.
 WB_HD WB_INLINE float liquid_density_at(const PaintWindowView& pw, Vec3 q, float dry_threshold) {

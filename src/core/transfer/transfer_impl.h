@@ -29,7 +29,7 @@ void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellFi
     // thicker than the load sphere carries the sample above it (it ploughs, Eq. 13 emits).
     const float gap = surface_distance(x, R, floor_z, density, thr, step, dryness, dry_threshold);
     load.gap[j] = gap;
-    const float film = film_below(x, gap, density, particles, step);
+    const float film = film_below(x, gap, density, dryness, dry_threshold, particles, step);
     load.film[j] = film;
     // Swept contact: the share of its load the sample would leave sliding this step (sigma_j of
     // the wick's sink).
