@@ -53,7 +53,10 @@ BENCHMARK(BM_GridForces)->Unit(benchmark::kMillisecond);
 void BM_GridViscosity(benchmark::State& state) {
   wb::Grid& g = scene().grid();
   g.classify();
+  g.rheology();
   for (auto _ : state) g.apply_viscosity(g.params().dt);
+  state.counters["cg_iterations"] = g.stats().viscosity_iterations;
+  state.counters["residual"] = g.stats().viscosity_residual;
 }
 BENCHMARK(BM_GridViscosity)->Unit(benchmark::kMillisecond);
 

@@ -91,8 +91,13 @@ void apply_overrides(const ReplayArgs& a, Stroke& stroke) {
 
 /// `wetbrush bench`: every profiler scope's median, 90th percentile and share of the step
 /// (the paper's Figure 12), the step rate against the stroke's own clock, and memory.
+/// Per step of a bench run: the viscous solve's CG iterations and the residual it reached.
+struct SolveLog {
+  std::vector<double> iterations, residual;
+};
+
 void report_bench(const ReplayArgs& a, const Simulator& sim, const Stroke& stroke, const Device& device,
-                  int64_t steps) {
+                  int64_t steps, const SolveLog& solve) {
   const Profiler& prof = sim.profiler();
   const double step_ms = prof.median_ms("sim.step");
   auto pct = [](std::vector<double> v, double q) {
@@ -116,6 +121,10 @@ void report_bench(const ReplayArgs& a, const Simulator& sim, const Stroke& strok
   std::printf("step rate %.1f steps/s, %.2f x real time (dt %.4g s); %s memory %.1f MiB peak, %.1f MiB held\n",
               rate, rate * stroke.dt, stroke.dt, device.is_cpu() ? "host" : "device",
               double(use.peak) / 1048576.0, double(use.in_use) / 1048576.0);
+  const double it_med = pct(solve.iterations, 0.5), it_max = pct(solve.iterations, 1.0);
+  const double res_med = pct(solve.residual, 0.5), res_max = pct(solve.residual, 1.0);
+  std::printf("viscous solve: %.0f CG iterations median, %.0f most; residual %.2e median, %.2e worst (tolerance %.0e)\n",
+              it_med, it_max, res_med, res_max, double(sim.config().params.grid.viscosity_tolerance));
   if (!a.bench_json.empty()) {
     nlohmann::json j{{"stroke", a.strokes},
                      {"device", device.to_string()},
@@ -124,6 +133,11 @@ void report_bench(const ReplayArgs& a, const Simulator& sim, const Stroke& strok
                      {"step_rate", rate},
                      {"real_time_factor", rate * stroke.dt},
                      {"memory_peak_bytes", use.peak},
+                     {"viscous_solve",
+                      {{"iterations_median", it_med},
+                       {"iterations_max", it_max},
+                       {"residual_median", res_med},
+                       {"residual_max", res_max}}},
                      {"stages", stages}};
     write_text_file(a.bench_json, j.dump(2) + "\n");
   }
@@ -181,8 +195,13 @@ int run_replay(const ReplayArgs& a) {
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   double last_print = -1.0;
   mem::reset_peak();
+  SolveLog solve;
   while (replay.advance()) {
     const int64_t done = replay.steps_done();
+    if (a.bench) {
+      solve.iterations.push_back(sim.grid().stats().viscosity_iterations);
+      solve.residual.push_back(sim.grid().stats().viscosity_residual);
+    }
     if (!a.frames_dir.empty() && done % a.every == 0) {
       char name[64];
       std::snprintf(name, sizeof name, "/frame_%06lld.png", static_cast<long long>(done));
@@ -202,7 +221,7 @@ int run_replay(const ReplayArgs& a) {
   if (progress) std::fprintf(stderr, "\n");
   const double wall_ms = elapsed() * 1e3;
   if (a.bench) {
-    report_bench(a, sim, stroke, device, replay.steps_done());
+    report_bench(a, sim, stroke, device, replay.steps_done(), solve);
     return sim.counters().nonfinite_events ? 3 : 0;
   }
   const int64_t particles_final = sim.particles().size();

@@ -1,6 +1,6 @@
 // Grid step (paper §4.2): resting paint stays still, a moving plate pushes paint and piles
-// it up, dried cells never move, drying makes cells solid, viscosity is stable for the
-// thickest paint, and advection's mass drift is corrected.
+// it up, dried cells never move, drying makes cells solid, the viscous solve converges for the
+// stiffest paint, and advection's mass drift is corrected.
 #include <cmath>
 #include <random>
 
@@ -21,13 +21,20 @@ TEST_F(GridStepTest, StillPaintLayerStaysStill) {
   });
   const auto rho0 = host_density(g);
   const float dt = g.params().dt;
-  for (int s = 0; s < 100; ++s) g.step(dt);
+  int iterations = 0;
+  for (int s = 0; s < 100; ++s) {
+    g.step(dt);
+    iterations = std::max(iterations, g.stats().viscosity_iterations);
+  }
+  std::printf("[ still ] most CG iterations in a step: %d\n", iterations);
   const float speed = g.max_fluid_speed();
   EXPECT_LT(speed * dt, 1e-4f) << "spurious current " << speed << " cells/s";
   const auto rho1 = host_density(g);
   double change = 0;
   for (size_t i = 0; i < rho0.size(); ++i) change = std::max(change, double(std::fabs(rho1[i] - rho0[i])));
-  EXPECT_LT(change, 1e-4);
+  // The 3-cell step (5.9 Pa at its foot) is below the yield stress of oil-0.2 paint (60 Pa): it
+  // creeps only at the regularised viscosity tau_y m = 6e5 Pa s, about 1e-4 cells in 1.7 s.
+  EXPECT_LT(change, 1e-3);
 }
 
 TEST_F(GridStepTest, PlatePushesPaintAndPilesItUp) {
@@ -148,11 +155,11 @@ TEST_F(GridStepTest, LetItDryMakesTheWholeCanvasSolid) {
   EXPECT_EQ(cls[size_t(d.cell(5, 7, 4))], kCellAir);
 }
 
-TEST_F(GridStepTest, ViscosityIsStableForTheThickestPaint) {
+TEST_F(GridStepTest, ViscousSolveConvergesForTheStiffestPaint) {
   TileStore canvas(device_, CanvasDims{128, 128, 64});
   GridParams p;
-  p.nu_thick = 1e6f;  // nu dt ~ 1.7e4
-  p.viscosity_iterations = 8;
+  p.yield_stress_stiff = 1e4f;  // the table's top: unyielded mu = tau_y m = 1e6 Pa s, nu dt ~ 4e8 cells^2
+  p.consistency_stiff = 1e5f;
   Grid g(canvas, p, Int3{32, 32, 16}, Int3{0, 0, 0});
   paint_cells(g, [](int, int, int k) { return k < 10 ? 1.f : 0.f; }, /*oil=*/0.f);
   g.classify();
@@ -164,11 +171,16 @@ TEST_F(GridStepTest, ViscosityIsStableForTheThickestPaint) {
     g.window().velocity(c).copy_from_host(v);
   }
   const float before = g.max_fluid_speed();
-  for (int s = 0; s < 20; ++s) g.apply_viscosity(p.dt);
+  g.rheology();
+  g.apply_viscosity(p.dt);
   const float after = g.max_fluid_speed();
   EXPECT_TRUE(std::isfinite(after));
-  EXPECT_LE(after, before);  // maximum principle of the backward-Euler sweeps
-  EXPECT_LT(after, 0.5f * before);
+  EXPECT_LE(g.stats().viscosity_residual, p.viscosity_tolerance);
+  EXPECT_LT(g.stats().viscosity_iterations, p.viscosity_max_iterations);
+  EXPECT_GT(g.stats().viscosity_faces, 3 * 30 * 30 * 9);
+  EXPECT_LT(after, 0.5f * before);  // a no-slip floor and a random field: diffusion damps it
+  std::printf("[ viscosity ] stiffest paint: %d faces, %d CG iterations, residual %.2e\n",
+              g.stats().viscosity_faces, g.stats().viscosity_iterations, g.stats().viscosity_residual);
 }
 
 TEST_F(GridStepTest, AdvectionMassDriftIsCorrected) {

@@ -32,13 +32,35 @@ void scale_touched_d(const Device& d, float* a, const float* b, const uint8_t* c
 void advect_vel_d(const Device& d, GridView g, const float* u, const float* v, const float* w, float dt) {
   WB_DISPATCH(d, grid_advect_velocity(g, u, v, w, dt));
 }
-void gravity_d(const Device& d, GridView g, const float* oil, float* ph, float g_dt, float yield) {
-  WB_DISPATCH(d, grid_gravity(g, oil, ph, g_dt, yield));
+void gravity_d(const Device& d, GridView g, float* ph, float g_dt) { WB_DISPATCH(d, grid_gravity(g, ph, g_dt)); }
+void mu_d(const Device& d, GridView g, const float* oil, HerschelBulkley s, HerschelBulkley o, float m, float* mu) {
+  WB_DISPATCH(d, grid_effective_viscosity(g, oil, s, o, m, mu));
 }
-void visc_d(const Device& d, GridView g, const float* oil, float* const cur[3], float* const old[3], float* const out[3],
-            float nt, float nn, float dt) {
-  WB_DISPATCH(d, grid_viscosity_sweep(g, oil, cur[0], cur[1], cur[2], old[0], old[1], old[2], out[0], out[1], out[2],
-                                      nt, nn, dt));
+void visc_flags_d(const Device& d, GridView g, uint32_t* flag) { WB_DISPATCH(d, grid_viscous_flags(g, flag)); }
+void visc_list_d(const Device& d, GridView g, const uint32_t* idx, uint32_t* list) {
+  WB_DISPATCH(d, grid_viscous_list(g, idx, list));
+}
+void visc_setup_d(const Device& d, GridView g, const uint32_t* list, int64_t n, const uint32_t* idx, const float* mu,
+                  float scale, float* nu, int32_t* nb, float* diag, float* b, float* x) {
+  WB_DISPATCH(d, grid_viscous_setup(g, list, n, idx, mu, scale, nu, nb, diag, b, x));
+}
+void visc_apply_d(const Device& d, int64_t n, const float* nu, const int32_t* nb, const float* diag, const float* p,
+                  float* q, float* pq) {
+  WB_DISPATCH(d, grid_viscous_apply(n, nu, nb, diag, p, q, pq));
+}
+void pcg_start_d(const Device& d, int64_t n, const float* b, const float* ax, const float* diag, float* r, float* z,
+                 float* p, float* rz, float* bz) {
+  WB_DISPATCH(d, grid_pcg_start(n, b, ax, diag, r, z, p, rz, bz));
+}
+void pcg_update_d(const Device& d, int64_t n, float alpha, const float* p, const float* q, const float* diag, float* x,
+                  float* r, float* z, float* rz) {
+  WB_DISPATCH(d, grid_pcg_update(n, alpha, p, q, diag, x, r, z, rz));
+}
+void pcg_direction_d(const Device& d, int64_t n, float beta, const float* z, float* p) {
+  WB_DISPATCH(d, grid_pcg_direction(n, beta, z, p));
+}
+void visc_write_d(const Device& d, GridView g, const uint32_t* list, int64_t n, const float* x) {
+  WB_DISPATCH(d, grid_viscous_write(g, list, n, x));
 }
 void rhs_d(const Device& d, GridView g, float* b) { WB_DISPATCH(d, grid_rhs(g, b)); }
 void jacobi_d(const Device& d, PoissonView s, const float* b, const float* x, float* out, float omega) {
@@ -78,12 +100,22 @@ void check_params(const GridParams& p) {
   WB_REQUIRE(p.chebyshev_rho >= 0.f && p.chebyshev_rho < 1.f, "grid: chebyshev_rho must be in [0, 1)");
   WB_REQUIRE(p.chebyshev_power_iterations >= 1 && p.chebyshev_power_iterations <= 1000,
              "grid: chebyshev_power_iterations must be in [1, 1000]");
-  WB_REQUIRE(p.nu_thick >= 0.f && p.nu_thin >= 0.f && p.nu_thick <= 1e7f && p.nu_thin <= 1e7f,
-             "grid: viscosities must be in [0, 1e7] cells^2/s");
-  WB_REQUIRE(p.viscosity_iterations >= 0 && p.viscosity_iterations <= 100,
-             "grid: viscosity_iterations must be in [0, 100]");
+  WB_REQUIRE(p.yield_stress_stiff >= 0.f && p.yield_stress_oily >= 0.f && p.yield_stress_stiff <= 1e4f &&
+                 p.yield_stress_oily <= 1e4f,
+             "grid: yield stresses must be in [0, 1e4] Pa");
+  WB_REQUIRE(p.consistency_stiff > 0.f && p.consistency_oily > 0.f && p.consistency_stiff <= 1e5f &&
+                 p.consistency_oily <= 1e5f,
+             "grid: consistencies must be in (0, 1e5] Pa s^n");
+  WB_REQUIRE(p.flow_index_stiff > 0.f && p.flow_index_oily > 0.f && p.flow_index_stiff <= 1.f &&
+                 p.flow_index_oily <= 1.f,
+             "grid: flow indices must be in (0, 1]");
+  WB_REQUIRE(p.regularisation >= 1.f && p.regularisation <= 1e5f, "grid: regularisation must be in [1, 1e5] s");
+  WB_REQUIRE(p.rho0 > 0.f && p.cell_size > 0.f, "grid: rho0 and cell_size must be positive");
+  WB_REQUIRE(p.viscosity_tolerance >= 1e-7f && p.viscosity_tolerance <= 1.f,
+             "grid: viscosity_tolerance must be in [1e-7, 1]");
+  WB_REQUIRE(p.viscosity_max_iterations >= 0 && p.viscosity_max_iterations <= 10000,
+             "grid: viscosity_max_iterations must be in [0, 10000]");
   WB_REQUIRE(p.gravity >= 0.f && p.gravity <= 1e6f, "grid: gravity must be in [0, 1e6] cells/s^2");
-  WB_REQUIRE(p.yield_height >= 0.f && p.yield_height <= 1e4f, "grid: yield_height must be in [0, 1e4] cells");
   WB_REQUIRE(p.liquid_threshold > 0.f && p.liquid_threshold <= 1.f, "grid: liquid_threshold must be in (0, 1]");
   WB_REQUIRE(p.dry_rate >= 0.f && p.dry_rate <= 1000.f, "grid: dry_rate must be in [0, 1000] /s");
   WB_REQUIRE(p.dry_threshold > 0.f && p.dry_threshold <= 1.f, "grid: dry_threshold must be in (0, 1]");
@@ -203,13 +235,21 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
     fluid_[c].resize(size_t(g.faces(c)));
     fluid_[c].fill_zero();
   }
-  for (auto* b : {&pressure_, &rhs_, &cell_tmp_}) {
+  for (auto* b : {&pressure_, &rhs_, &cell_tmp_, &mu_}) {
     b->set_device(d);
     b->resize(size_t(g.cells()));
     b->fill_zero();
   }
+  const size_t all_faces = size_t(g.nu() + g.nv() + g.nw());
   face_tmp_.set_device(d);
-  face_tmp_.resize(size_t(g.nu() + g.nv() + g.nw()));
+  face_tmp_.resize(all_faces);
+  for (auto* b : {&visc_idx_, &visc_list_}) {
+    b->set_device(d);
+    b->resize(all_faces);
+  }
+  cg_nb_.set_device(d);
+  for (auto* b : {&cg_nu_, &cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_, &cg_dot_a_, &cg_dot_b_})
+    b->set_device(d);
   paint_tmp_ = PaintWindow(d, dims);
   scratch_.reserve(d, g.cells());
   classify();
@@ -297,38 +337,74 @@ void Grid::advect(float dt) {
   advect_vel_d(d, v, vel_tmp_[0].data(), vel_tmp_[1].data(), vel_tmp_[2].data(), dt);
 }
 
+void Grid::rheology() {
+  WB_PROFILE_SCOPE("grid.rheology");
+  const HerschelBulkley stiff{params_.yield_stress_stiff, params_.consistency_stiff, params_.flow_index_stiff};
+  const HerschelBulkley oily{params_.yield_stress_oily, params_.consistency_oily, params_.flow_index_oily};
+  mu_d(device(), view(), window_.paint().oil.data(), stiff, oily, params_.regularisation, mu_.data());
+}
+
 void Grid::add_external_forces(float dt) {
   WB_PROFILE_SCOPE("grid.forces");
   if (params_.gravity <= 0.f) return;
-  gravity_d(device(), view(), window_.paint().oil.data(), cell_tmp_.data(), params_.gravity * dt,
-            params_.yield_height);
+  gravity_d(device(), view(), cell_tmp_.data(), params_.gravity * dt);
 }
 
 void Grid::apply_viscosity(float dt) {
   WB_PROFILE_SCOPE("grid.viscosity");
-  if (params_.viscosity_iterations <= 0 || (params_.nu_thick <= 0.f && params_.nu_thin <= 0.f)) return;
   const Device& d = device();
   const GridDims g = dims();
   GridView v = view();
-  // old = u before diffusion (kept in vel_pre_, overwritten again by project()); iterate
-  // between the window's velocity and vel_tmp_.
-  float* old[3];
-  float* a[3];
-  float* b[3];
-  for (int c = 0; c < 3; ++c) {
+  // Eq. 11's old grid velocity: after advection, the particles' momentum and the forces.
+  for (int c = 0; c < 3; ++c)
     mem::copy_on_device(d, vel_pre_[c].data(), v.vel[c], size_t(g.faces(c)) * sizeof(float));
-    old[c] = vel_pre_[c].data();
-    a[c] = v.vel[c];
-    b[c] = vel_tmp_[c].data();
+  stats_.viscosity_faces = 0;
+  stats_.viscosity_iterations = 0;
+  stats_.viscosity_residual = 0;
+  if (params_.viscosity_max_iterations <= 0) return;
+  // The fluid faces, compacted: the solve costs in proportion to the paint, not to the window.
+  const int64_t all = int64_t(visc_idx_.size());
+  visc_flags_d(d, v, visc_idx_.data());
+  const int64_t n = exclusive_scan(d, visc_idx_.data(), visc_idx_.data(), all, ws_);
+  stats_.viscosity_faces = int(n);
+  if (n == 0) return;
+  visc_list_d(d, v, visc_idx_.data(), visc_list_.data());
+  if (cg_x_.size() < size_t(n)) {
+    const size_t cap = std::min(size_t(all), size_t(n) + size_t(n) / 2);
+    cg_nb_.resize(6 * cap);
+    for (auto* b : {&cg_nu_, &cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_, &cg_dot_a_, &cg_dot_b_})
+      b->resize(cap);
   }
-  for (int it = 0; it < params_.viscosity_iterations; ++it) {
-    visc_d(d, v, window_.paint().oil.data(), a, old, b, params_.nu_thick, params_.nu_thin, dt);
-    std::swap(a[0], b[0]);
-    std::swap(a[1], b[1]);
-    std::swap(a[2], b[2]);
+  // (1 - dt div(nu grad)) u = u_old, nu = mu / rho0 in cells^2/s.
+  const double h = params_.cell_size;
+  const float nu_scale = float(double(dt) / (double(params_.rho0) * h * h));
+  const uint32_t* list = visc_list_.data();
+  const uint32_t* idx = visc_idx_.data();
+  visc_setup_d(d, v, list, n, idx, mu_.data(), nu_scale, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_b_.data(),
+               cg_x_.data());
+  // Jacobi-preconditioned conjugate gradients (Saad 2003, Alg. 9.1) from the current velocity.
+  visc_apply_d(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_x_.data(), cg_q_.data(), cg_dot_a_.data());
+  pcg_start_d(d, n, cg_b_.data(), cg_q_.data(), cg_diag_.data(), cg_r_.data(), cg_z_.data(), cg_p_.data(),
+              cg_dot_a_.data(), cg_dot_b_.data());
+  double rz = reduce_sum(d, cg_dot_a_.data(), n, ws_);
+  const double bnorm = reduce_sum(d, cg_dot_b_.data(), n, ws_);
+  const double target = double(params_.viscosity_tolerance) * double(params_.viscosity_tolerance) * bnorm;
+  int it = 0;
+  while (it < params_.viscosity_max_iterations && rz > target && rz > 0.0) {
+    visc_apply_d(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_p_.data(), cg_q_.data(), cg_dot_a_.data());
+    const double pq = reduce_sum(d, cg_dot_a_.data(), n, ws_);
+    if (!(pq > 0.0)) break;  // SPD: only round-off at convergence gets here
+    const float alpha = float(rz / pq);
+    pcg_update_d(d, n, alpha, cg_p_.data(), cg_q_.data(), cg_diag_.data(), cg_x_.data(), cg_r_.data(), cg_z_.data(),
+                 cg_dot_a_.data());
+    const double rz_new = reduce_sum(d, cg_dot_a_.data(), n, ws_);
+    pcg_direction_d(d, n, float(rz_new / rz), cg_z_.data(), cg_p_.data());
+    rz = rz_new;
+    ++it;
   }
-  if (a[0] != v.vel[0])
-    for (int c = 0; c < 3; ++c) mem::copy_on_device(d, v.vel[c], a[c], size_t(g.faces(c)) * sizeof(float));
+  stats_.viscosity_iterations = it;
+  stats_.viscosity_residual = bnorm > 0.0 ? std::sqrt(std::max(rz, 0.0) / bnorm) : 0.0;
+  visc_write_d(d, v, list, n, cg_x_.data());
 }
 
 void Grid::compute_rhs() { rhs_d(device(), view(), rhs_.data()); }
@@ -338,8 +414,6 @@ void Grid::project() {
   const Device& d = device();
   const GridDims g = dims();
   GridView v = view();
-  for (int c = 0; c < 3; ++c)
-    mem::copy_on_device(d, vel_pre_[c].data(), v.vel[c], size_t(g.faces(c)) * sizeof(float));
   compute_rhs();
   SolverConfig cfg;
   cfg.kind = params_.solver;
@@ -376,6 +450,7 @@ void Grid::step(float dt) {
   classify();  // solids for the backtrace (dried paint is never moved)
   advect(dt);
   classify();  // liquid where the paint now is
+  rheology();
   add_external_forces(dt);
   apply_viscosity(dt);
   project();

@@ -11,6 +11,7 @@
 #include "core/grid/active_window.h"
 #include "core/grid/grid_fields.h"
 #include "core/grid/grid_params.h"
+#include "core/grid/rheology.h"
 
 namespace wb {
 
@@ -24,6 +25,9 @@ struct GridStats {
   double rhs_norm = 0;          ///< ||div||_2 over liquid cells before the projection
   double residual_norm = 0;     ///< ||div||_2 over liquid cells after it
   float chebyshev_rho = 0;      ///< rho used by the Chebyshev solver (estimated or given)
+  int viscosity_faces = 0;      ///< fluid faces of the last viscous solve
+  int viscosity_iterations = 0; ///< CG iterations it took
+  double viscosity_residual = 0;///< relative residual it reached (sqrt(r D^-1 r / b D^-1 b))
   bool window_moved = false;
 };
 
@@ -84,20 +88,28 @@ class Grid {
   void classify();
   /// Semi-Lagrangian advection (RK2 backtrace, trilinear) of the paint fields and the velocity.
   void advect(float dt);
+  /// Apparent viscosity of each liquid cell (rheology.h) at the strain rate of the flow, before
+  /// this step's forces: a force the paint resists below its yield stress must not yield it. One
+  /// evaluation per step: the yield surface follows the flow with a lag of one step.
+  void rheology();
   /// Gravity on faces touching liquid, hydrostatic part split off (docs/GRID.md).
   void add_external_forces(float dt);
-  /// Implicit viscosity, nu from oil.
+  /// Keeps the velocity (Eq. 11's old grid velocity), then implicit viscosity with the apparent
+  /// viscosity of each liquid cell at its strain rate, solved by PCG to viscosity_tolerance.
   void apply_viscosity(float dt);
-  /// Keeps the pre-projection velocity, then projects with params().solver.
+  /// Projects with params().solver.
   void project();
   /// Dryness += dry_rate * dt in every cell holding paint.
   void dry(float dt);
-  /// classify, advect, classify, add_external_forces, apply_viscosity, project, dry.
+  /// classify, advect, classify, rheology, add_external_forces, apply_viscosity, project, dry.
   void step(float dt);
 
   // --- for the particles (FLIP/PIC, Eq. 11) ---
-  /// MAC velocity before the last projection (component c = 0,1,2).
-  const DeviceBuffer<float>& velocity_before_projection(int c) const { return vel_pre_[c]; }
+  /// MAC velocity after the forces, before the viscous and pressure steps (component c = 0,1,2):
+  /// the grid velocity Eq. 11's FLIP difference is taken against.
+  const DeviceBuffer<float>& velocity_before_solve(int c) const { return vel_pre_[c]; }
+  /// Apparent viscosity of each liquid cell at the last viscous step, Pa s (0 elsewhere).
+  const DeviceBuffer<float>& apparent_viscosity() const { return mu_; }
   const DeviceBuffer<float>& pressure() const { return pressure_; }
   /// Right-hand side b = -div of the last projection (liquid cells).
   const DeviceBuffer<float>& rhs() const { return rhs_; }
@@ -120,7 +132,14 @@ class Grid {
   const float* particle_density_ = nullptr;
   DeviceBuffer<float> theta_[3], solid_vel_[3], vel_pre_[3], vel_tmp_[3];
   DeviceBuffer<uint8_t> cls_, fluid_[3];
-  DeviceBuffer<float> pressure_, rhs_, cell_tmp_, face_tmp_;
+  DeviceBuffer<float> pressure_, rhs_, cell_tmp_, face_tmp_, mu_;
+  // Viscous solve: fluid faces as a compact list (idx maps a global face to its entry), and
+  // the conjugate-gradient vectors over the list. Sized to every face once.
+  // Per entry: nu dt, the six neighbour entries, and the CG vectors; they grow with the paint
+  // (never per step in a steady stroke) and keep their capacity.
+  DeviceBuffer<uint32_t> visc_idx_, visc_list_;
+  DeviceBuffer<int32_t> cg_nb_;
+  DeviceBuffer<float> cg_nu_, cg_x_, cg_b_, cg_r_, cg_z_, cg_p_, cg_q_, cg_diag_, cg_dot_a_, cg_dot_b_;
   PaintWindow paint_tmp_;
   SolverScratch scratch_;
   Workspace ws_;
@@ -135,10 +154,21 @@ class Grid {
   void grid_touched_density(const float* rho_new, const float* rho_old, const uint8_t* cls, float* out, int64_t n); \
   void grid_scale_touched(float* rho_new, const float* rho_old, const uint8_t* cls, float scale, int64_t n);         \
   void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt);                  \
-  void grid_gravity(GridView g, const float* oil, float* ph, float g_dt, float yield_height);                       \
-  void grid_viscosity_sweep(GridView g, const float* oil, const float* cur_u, const float* cur_v,                    \
-                            const float* cur_w, const float* old_u, const float* old_v, const float* old_w,         \
-                            float* out_u, float* out_v, float* out_w, float nu_thick, float nu_thin, float dt);     \
+  void grid_gravity(GridView g, float* ph, float g_dt);                                                              \
+  void grid_effective_viscosity(GridView g, const float* oil, HerschelBulkley stiff, HerschelBulkley oily, float m,  \
+                                float* mu);                                                                          \
+  void grid_viscous_flags(GridView g, uint32_t* flag);                                                               \
+  void grid_viscous_list(GridView g, const uint32_t* idx, uint32_t* list);                                           \
+  void grid_viscous_setup(GridView g, const uint32_t* list, int64_t n, const uint32_t* idx, const float* mu,       \
+                          float nu_scale, float* nu, int32_t* nb, float* diag, float* b, float* x);                  \
+  void grid_viscous_apply(int64_t n, const float* nu, const int32_t* nb, const float* diag, const float* p,         \
+                          float* q, float* pq);                                                                      \
+  void grid_pcg_start(int64_t n, const float* b, const float* ax, const float* diag, float* r, float* z, float* p,  \
+                      float* rz, float* bz);                                                                         \
+  void grid_pcg_update(int64_t n, float alpha, const float* p, const float* q, const float* diag, float* x,         \
+                       float* r, float* z, float* rz);                                                               \
+  void grid_pcg_direction(int64_t n, float beta, const float* z, float* p);                                         \
+  void grid_viscous_write(GridView g, const uint32_t* list, int64_t n, const float* x);                             \
   void grid_rhs(GridView g, float* b);                                                                               \
   void poisson_jacobi(PoissonView s, const float* b, const float* x, float* out, float omega);                      \
   void poisson_residual(PoissonView s, const float* b, const float* x, float* r);                                   \

@@ -6,6 +6,7 @@
 #include "core/grid/advect_kernels.h"
 #include "core/grid/grid.h"
 #include "core/grid/project_kernels.h"
+#include "core/grid/rheology.h"
 #include "core/grid/viscosity_kernels.h"
 
 namespace wb::WB_BACKEND_NS {
@@ -105,7 +106,7 @@ void grid_advect_velocity(GridView g, const float* u, const float* v, const floa
   });
 }
 
-void grid_gravity(GridView g, const float* oil, float* ph, float g_dt, float yield_height) {
+void grid_gravity(GridView g, float* ph, float g_dt) {
   const GridDims d = g.d;
   // Hydrostatic head of each liquid cell: contiguous liquid cells from it to the surface.
   parallel_for(int64_t(d.nx) * d.ny, [=] WB_HD(int64_t col) {
@@ -128,29 +129,111 @@ void grid_gravity(GridView g, const float* oil, float* ph, float g_dt, float yie
     face_cells(d, c, i, j, k, a, b, ha, hb);
     const bool la = ha && g.cls[a] == kCellLiquid, lb = hb && g.cls[b] == kCellLiquid;
     if (!la && !lb) return;
-    const float yield = g_dt * yield_height * (1.f - clampf(face_oil(d, oil, c, i, j, k), 0.f, 1.f));
-    g.vel[c][f] += gravity_face_impulse(c, la, lb, la ? ph[a] : 0.f, lb ? ph[b] : 0.f, g_dt, yield);
+    g.vel[c][f] += gravity_face_impulse(c, la, lb, la ? ph[a] : 0.f, lb ? ph[b] : 0.f, g_dt);
   });
 }
 
-void grid_viscosity_sweep(GridView g, const float* oil, const float* cur_u, const float* cur_v, const float* cur_w,
-                          const float* old_u, const float* old_v, const float* old_w, float* out_u, float* out_v,
-                          float* out_w, float nu_thick, float nu_thin, float dt) {
+void grid_effective_viscosity(GridView g, const float* oil, HerschelBulkley stiff, HerschelBulkley oily, float m,
+                              float* mu) {
   const GridDims d = g.d;
-  parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
-    int c, i, j, k;
-    int64_t f;
-    detail::split_face(d, t, c, f);
-    const float* cur = c == 0 ? cur_u : (c == 1 ? cur_v : cur_w);
-    const float* old = c == 0 ? old_u : (c == 1 ? old_v : old_w);
-    float* out = c == 0 ? out_u : (c == 1 ? out_v : out_w);
-    if (!g.fluid[c][f]) {
-      out[f] = cur[f];
+  parallel_for(d.cells(), [=] WB_HD(int64_t c) {
+    if (g.cls[c] != kCellLiquid) {
+      mu[c] = 0.f;
       return;
     }
-    d.decompose_face(c, f, i, j, k);
-    const float nu = viscosity_from_oil(face_oil(d, oil, c, i, j, k), nu_thick, nu_thin);
-    out[f] = viscosity_jacobi_face(g, cur, old, c, i, j, k, nu * dt);
+    int i, j, k;
+    d.decompose_cell(c, i, j, k);
+    mu[c] = apparent_viscosity(rheology_at_oil(oil[c], stiff, oily), cell_strain_rate(g, i, j, k), m);
+  });
+}
+
+void grid_viscous_flags(GridView g, uint32_t* flag) {
+  const GridDims d = g.d;
+  parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
+    int c;
+    int64_t f;
+    detail::split_face(d, t, c, f);
+    flag[t] = g.fluid[c][f] ? 1u : 0u;
+  });
+}
+
+void grid_viscous_list(GridView g, const uint32_t* idx, uint32_t* list) {
+  const GridDims d = g.d;
+  parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
+    int c;
+    int64_t f;
+    detail::split_face(d, t, c, f);
+    if (g.fluid[c][f]) list[idx[t]] = uint32_t(t);
+  });
+}
+
+namespace detail {
+/// Component, index and position of the face of list entry e.
+WB_HD WB_INLINE int64_t list_face(const GridDims& d, const uint32_t* list, int64_t e, int& c, int& i, int& j,
+                                  int& k) {
+  int64_t f;
+  split_face(d, int64_t(list[e]), c, f);
+  d.decompose_face(c, f, i, j, k);
+  return f;
+}
+}  // namespace detail
+
+void grid_viscous_setup(GridView g, const uint32_t* list, int64_t n, const uint32_t* idx, const float* mu,
+                        float nu_scale, float* nu, int32_t* nb, float* diag, float* b, float* x) {
+  const GridDims d = g.d;
+  parallel_for(n, [=] WB_HD(int64_t e) {
+    int c, i, j, k;
+    detail::list_face(d, list, e, c, i, j, k);
+    nu[e] = face_nu_dt(g, mu, c, i, j, k, nu_scale);
+  });
+  parallel_for(n, [=] WB_HD(int64_t e) {
+    int c, i, j, k;
+    const int64_t f = detail::list_face(d, list, e, c, i, j, k);
+    viscous_row(g, nu, idx, e, c, i, j, k, g.vel[c][f], nb + 6 * e, diag[e], b[e]);
+    x[e] = g.vel[c][f];  // the advected, forced velocity is the first guess
+  });
+}
+
+void grid_viscous_apply(int64_t n, const float* nu, const int32_t* nb, const float* diag, const float* p, float* q,
+                        float* pq) {
+  parallel_for(n, [=] WB_HD(int64_t e) {
+    q[e] = viscous_apply(nu, nb, p, diag[e], e);
+    pq[e] = p[e] * q[e];
+  });
+}
+
+void grid_pcg_start(int64_t n, const float* b, const float* ax, const float* diag, float* r, float* z, float* p,
+                    float* rz, float* bz) {
+  parallel_for(n, [=] WB_HD(int64_t e) {
+    r[e] = b[e] - ax[e];
+    z[e] = r[e] / diag[e];
+    p[e] = z[e];
+    rz[e] = r[e] * z[e];
+    bz[e] = b[e] * b[e] / diag[e];
+  });
+}
+
+void grid_pcg_update(int64_t n, float alpha, const float* p, const float* q, const float* diag, float* x, float* r,
+                     float* z, float* rz) {
+  parallel_for(n, [=] WB_HD(int64_t e) {
+    x[e] += alpha * p[e];
+    r[e] -= alpha * q[e];
+    z[e] = r[e] / diag[e];
+    rz[e] = r[e] * z[e];
+  });
+}
+
+void grid_pcg_direction(int64_t n, float beta, const float* z, float* p) {
+  parallel_for(n, [=] WB_HD(int64_t e) { p[e] = z[e] + beta * p[e]; });
+}
+
+void grid_viscous_write(GridView g, const uint32_t* list, int64_t n, const float* x) {
+  const GridDims d = g.d;
+  parallel_for(n, [=] WB_HD(int64_t e) {
+    int c;
+    int64_t f;
+    detail::split_face(d, int64_t(list[e]), c, f);
+    g.vel[c][f] = x[e];
   });
 }
 

@@ -34,25 +34,43 @@ struct GridParams {
   /// Power-iteration sweeps of the rho estimate. Default 30, range [1, 1000].
   int chebyshev_power_iterations = 30;
 
-  // --- viscosity from oil (§4.2 "viscosity", DESIGN step 6) ---
-  /// Kinematic viscosity of paint without oil (oil = 0), cells^2/s. Default 3000, range [0, 1e7].
-  float nu_thick = 3000.f;
-  /// Kinematic viscosity of pure oil (oil = 1), cells^2/s. Default 30, range [0, 1e7].
-  /// nu(oil) = nu_thick * (nu_thin / nu_thick)^oil: more oil, thinner paint.
-  float nu_thin = 30.f;
-  /// Jacobi sweeps of the implicit (backward Euler) viscosity solve. Default 4, range [0, 100].
-  /// Every sweep is a convex combination, so any count is stable at any nu*dt.
-  int viscosity_iterations = 4;
+  // --- rheology: regularised Herschel-Bulkley (docs/GRID.md "Rheology") ---
+  // tau = tau_y + K gamma_dot^n above the yield stress. The oil fraction moves each parameter
+  // between the stiff end member (oil 0: tube paint with little binder) and the oily one (oil 1:
+  // the binder itself): tau_y and K geometrically, n linearly (rheology.h).
+  /// Yield stress at oil 0, Pa. Default 300, range [0, 1e4]. Tube oil paints: tens to hundreds of Pa.
+  float yield_stress_stiff = 300.f;
+  /// Yield stress at oil 1, Pa. Default 0.1, range [0, 1e4]. Linseed oil has none; a trace keeps
+  /// the geometric interpolation defined.
+  float yield_stress_oily = 0.1f;
+  /// Consistency K at oil 0, Pa s^n. Default 30, range (0, 1e5].
+  float consistency_stiff = 30.f;
+  /// Consistency K at oil 1, Pa s^n. Default 0.05 (linseed oil, about 0.05 Pa s), range (0, 1e5].
+  float consistency_oily = 0.05f;
+  /// Flow index n at oil 0. Default 0.5 (strongly shear-thinning), range (0, 1].
+  float flow_index_stiff = 0.5f;
+  /// Flow index n at oil 1. Default 1 (the oil is Newtonian), range (0, 1].
+  float flow_index_oily = 1.f;
+  /// Papanastasiou regularisation m, s: below the critical strain rate 1/m the paint is a
+  /// liquid of viscosity tau_y m + K m^(1-n) (unyielded: it creeps at stress / that). Default 100,
+  /// range [1, 1e5].
+  float regularisation = 1e4f;
+  /// Paint density rho0, kg/m^3 (mu / rho0 is the kinematic viscosity). Default 1000 (§5.1).
+  float rho0 = 1000.f;
+  /// Cell edge, m. Default 2e-4 (0.2 mm, DESIGN "Units and scale").
+  float cell_size = 2e-4f;
+  /// Relative residual the viscous solve stops at: sqrt(r D^-1 r / b D^-1 b) (Jacobi-preconditioned
+  /// CG). Default 1e-3, range [1e-7, 1].
+  float viscosity_tolerance = 1e-3f;
+  /// Work bound of the viscous solve, CG iterations per step. Default 300, range [0, 10000]
+  /// (0 = no viscosity). GridStats reports the iterations used and the residual reached.
+  int viscosity_max_iterations = 300;
 
   // --- external forces ---
   /// Gravity magnitude along -z, cells/s^2. Default 49050 (9.81 m/s^2 at 0.2 mm cells), range [0, 1e6].
   /// Applied with its hydrostatic pressure split off per column (docs/GRID.md), so resting paint
-  /// feels no net force whatever the solver's accuracy.
+  /// feels no net force whatever the solver's accuracy; what is left is held by the yield stress.
   float gravity = 49050.f;
-  /// Yield head of paint without oil, cells: the unbalanced weight of a column of paint shorter
-  /// than yield_height * (1 - oil) does not move it (Bingham-like yield stress: tube paint holds
-  /// ridges and overhangs). Default 50 (about 100 Pa at rho0 = 1000 kg/m^3), range [0, 1e4].
-  float yield_height = 50.f;
 
   // --- cell classes ---
   /// Density (volume fraction) at and above which a cell is liquid in the projection.

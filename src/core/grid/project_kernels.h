@@ -172,21 +172,16 @@ WB_HD WB_INLINE float extrapolated_face_velocity(const GridView& g, int c, int i
   return n ? acc / float(n) : 0.f;
 }
 
-/// sign(f) max(|f| - y, 0).
-WB_HD WB_INLINE float soft_threshold(float f, float y) {
-  return f > y ? f - y : (f < -y ? f + y : 0.f);
-}
-
 /// Gravity impulse on one open face adjacent to liquid, with the hydrostatic gradient
 /// (p_h of a cell = g dt times the number of contiguous liquid cells from it up to the free
 /// surface, so its gradient cancels gravity exactly inside every resting liquid column)
 /// subtracted: -g dt e_z + (p_h(a) - p_h(b)) e_c. What is left (unsupported paint, columns of
-/// different heights) acts only beyond the paint's yield head (Bingham-like: tube paint
-/// holds ridges and overhangs), yield = g dt yield_height (1 - oil).
-WB_HD WB_INLINE float gravity_face_impulse(int c, bool la, bool lb, float ph_a, float ph_b, float g_dt, float yield) {
+/// different heights) is resisted by the paint's viscosity, which holds it below the yield
+/// stress (rheology.h).
+WB_HD WB_INLINE float gravity_face_impulse(int c, bool la, bool lb, float ph_a, float ph_b, float g_dt) {
   float f = (la ? ph_a : 0.f) - (lb ? ph_b : 0.f);
   if (c == 2) f -= g_dt;
-  return soft_threshold(f, yield);
+  return f;
 }
 
 }  // namespace wb

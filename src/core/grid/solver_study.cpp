@@ -96,6 +96,7 @@ void StudyScene::prepare_system(int warmup_steps) {
   grid_.classify();
   grid_.advect(dt);
   grid_.classify();
+  grid_.rheology();
   grid_.add_external_forces(dt);
   grid_.apply_viscosity(dt);
   grid_.compute_rhs();

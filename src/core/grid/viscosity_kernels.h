@@ -1,9 +1,11 @@
-// Grid stage, viscosity (paper §4.2; DESIGN step 6 "viscosity from oil density"):
-// backward-Euler diffusion of each MAC component, (1 - nu dt Laplacian) u = u_old,
-// solved by Jacobi sweeps. Each sweep is a convex combination of u_old and neighbours,
-// so it is stable for any nu dt (the thickest paint at dt = 1/60 s included).
+// Grid stage, viscosity (paper §4.2; docs/GRID.md "Viscosity"): backward Euler of the
+// variable-viscosity diffusion of each MAC component,
+//   u - dt div(nu grad u) = u_old,   nu = mu(gamma_dot) / rho0 (rheology.h),
+// on the faces that touch liquid, solved by Jacobi-preconditioned conjugate gradients to a
+// stated tolerance (grid.cpp). The matrix is symmetric positive definite: the link between two
+// fluid faces carries the mean of their viscosities, so each link is counted once from either side.
 #pragma once
-#include <cmath>
+#include <cstdint>
 
 #include "core/grid/grid_fields.h"
 #include "core/grid/project_kernels.h"
@@ -11,53 +13,91 @@
 
 namespace wb {
 
-/// nu(oil) = nu_thick (nu_thin / nu_thick)^oil, cells^2/s: more oil, thinner paint.
-WB_HD WB_INLINE float viscosity_from_oil(float oil, float nu_thick, float nu_thin) {
-  oil = clampf(oil, 0.f, 1.f);
-  if (nu_thick <= 0.f || nu_thin <= 0.f) return nu_thick + (nu_thin - nu_thick) * oil;
-  return nu_thick * powf(nu_thin / nu_thick, oil);
+/// Index of face (c, f) in the concatenated u | v | w list.
+WB_HD WB_INLINE int64_t global_face(const GridDims& d, int c, int64_t f) {
+  return f + (c >= 1 ? d.nu() : 0) + (c == 2 ? d.nv() : 0);
 }
 
-/// Mean oil of the cells a face separates (those in the window).
-WB_HD WB_INLINE float face_oil(const GridDims& d, const float* oil, int c, int i, int j, int k) {
-  int64_t a, b;
-  bool ha, hb;
-  face_cells(d, c, i, j, k, a, b, ha, hb);
-  if (ha && hb) return 0.5f * (oil[a] + oil[b]);
-  return ha ? oil[a] : (hb ? oil[b] : 0.f);
-}
-
-/// One Jacobi sweep of backward Euler for a fluid face f:
-/// u_f = (u_old_f + nu dt sum_n u_n) / (1 + nu dt N). Neighbours: fluid faces (current
-/// iterate), closed faces (their solid velocity: no-slip on bristles and dried paint), the
-/// canvas floor below the first layer (no-slip, 0). Faces open to air and the window's side
-/// walls are left out (free slip).
-WB_HD WB_INLINE float viscosity_jacobi_face(const GridView& g, const float* cur, const float* old, int c, int i, int j,
-                                            int k, float nu_dt) {
+/// Visits the viscous couplings of fluid face (c,i,j,k) with its six same-component neighbours:
+/// fluid(t) for a neighbouring fluid face (global index t), wall(u, s) for a no-slip neighbour of
+/// velocity u and weight s (the canvas floor below the first layer, 0; a closed face, its solid
+/// velocity: bristles and dried paint). Faces open to air and the window's side walls add nothing
+/// (free slip). A face partly covered by bristles (open fraction theta < 1) is also coupled to
+/// the bristles inside its own cell, with weight kPartialWall (1 - theta): the solid lies within
+/// half a cell, so a face half covered couples to it like a wall neighbour. Without this term a
+/// partly covered face moves independently of the bristles in it and a brush slides through stiff
+/// paint instead of pushing it (docs/GRID.md "Viscosity").
+constexpr float kPartialWall = 2.f;
+template <class Fluid, class Wall>
+WB_HD WB_INLINE void for_viscous_links(const GridView& g, int c, int i, int j, int k, Fluid&& fluid, Wall&& wall) {
   const GridDims& d = g.d;
+  const int64_t self = d.fidx(c, i, j, k);
+  const float theta = g.theta[c][self];
+  if (theta < 1.f) wall(g.solid_vel[c][self], kPartialWall * (1.f - theta));
   int ex, ey, ez;
   d.face_extent(c, ex, ey, ez);
   const int di[6] = {-1, 1, 0, 0, 0, 0}, dj[6] = {0, 0, -1, 1, 0, 0}, dk[6] = {0, 0, 0, 0, -1, 1};
-  float acc = 0.f;
-  int n = 0;
   for (int q = 0; q < 6; ++q) {
     const int ii = i + di[q], jj = j + dj[q], kk = k + dk[q];
-    if (kk < 0) {  // below the first layer: the canvas floor
-      ++n;
+    if (kk < 0) {
+      wall(0.f, 1.f);
       continue;
     }
     if (ii < 0 || jj < 0 || ii >= ex || jj >= ey || kk >= ez) continue;
     const int64_t nf = d.fidx(c, ii, jj, kk);
-    if (g.theta[c][nf] <= 0.f) {
-      acc += g.solid_vel[c][nf];
-      ++n;
-    } else if (g.fluid[c][nf]) {
-      acc += cur[nf];
-      ++n;
-    }
+    if (g.theta[c][nf] <= 0.f)
+      wall(g.solid_vel[c][nf], 1.f);
+    else if (g.fluid[c][nf])
+      fluid(global_face(d, c, nf));
   }
-  const int64_t f = d.fidx(c, i, j, k);
-  return (old[f] + nu_dt * acc) / (1.f + nu_dt * float(n));
+}
+
+/// nu dt of a face, cells^2: the mean apparent viscosity of the liquid cells it separates
+/// (mu, Pa s) times nu_scale = dt / (rho0 h^2).
+WB_HD WB_INLINE float face_nu_dt(const GridView& g, const float* mu, int c, int i, int j, int k, float nu_scale) {
+  int64_t a, b;
+  bool ha, hb;
+  face_cells(g.d, c, i, j, k, a, b, ha, hb);
+  const bool la = ha && g.cls[a] == kCellLiquid, lb = hb && g.cls[b] == kCellLiquid;
+  const float m = la && lb ? 0.5f * (mu[a] + mu[b]) : (la ? mu[a] : (lb ? mu[b] : 0.f));
+  return m * nu_scale;
+}
+
+/// Row of the system for list entry e (fluid face c,i,j,k): its fluid neighbours' entries
+/// (nb[0..6), -1 where none), the diagonal 1 + sum of link weights and the right-hand side
+/// u_old + sum over walls of weight * wall velocity. nu is compact (entry-indexed), idx maps a
+/// global face to its entry.
+WB_HD WB_INLINE void viscous_row(const GridView& g, const float* nu, const uint32_t* idx, int64_t e, int c, int i,
+                                 int j, int k, float u_old, int32_t* nb, float& diag, float& rhs) {
+  const float nf = nu[e];
+  float dsum = 1.f, r = u_old;
+  int q = 0;
+  for_viscous_links(
+      g, c, i, j, k,
+      [&](int64_t t) {
+        const uint32_t en = idx[t];
+        nb[q++] = int32_t(en);
+        dsum += 0.5f * (nf + nu[en]);
+      },
+      [&](float uw, float s) {
+        dsum += s * nf;
+        r += s * nf * uw;
+      });
+  for (; q < 6; ++q) nb[q] = -1;
+  diag = dsum;
+  rhs = r;
+}
+
+/// (A x) of list entry e: diag x_e - sum over its fluid links of weight x_nb.
+WB_HD WB_INLINE float viscous_apply(const float* nu, const int32_t* nb, const float* x, float diag, int64_t e) {
+  const float nf = nu[e];
+  float off = 0.f;
+  for (int q = 0; q < 6; ++q) {
+    const int32_t n = nb[6 * e + q];
+    if (n < 0) break;
+    off += 0.5f * (nf + nu[n]) * x[n];
+  }
+  return diag * x[e] - off;
 }
 
 }  // namespace wb

@@ -188,6 +188,7 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
     grid_->advect(dt);
     if (config_.particles && particles_.size() > 0) joint_fields_stage();
     grid_->classify();
+    grid_->rheology();
     grid_->add_external_forces(dt);
     grid_->apply_viscosity(dt);
     grid_->project();
@@ -198,9 +199,9 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
   if (config_.particles && particles_.size() > 0) {
     WB_PROFILE_SCOPE("particles.flip");
     ActiveWindow& win = grid_->window();
-    const MacView before = mac_view(grid_->velocity_before_projection(0).data(),
-                                    grid_->velocity_before_projection(1).data(),
-                                    grid_->velocity_before_projection(2).data(), win);
+    const MacView before = mac_view(grid_->velocity_before_solve(0).data(),
+                                    grid_->velocity_before_solve(1).data(),
+                                    grid_->velocity_before_solve(2).data(), win);
     const MacView after = mac_view(win.velocity(0).data(), win.velocity(1).data(), win.velocity(2).data(), win);
     particles_flip_pic(device(), particles_.view(), before, after, config_.params.particles.gamma);
   }

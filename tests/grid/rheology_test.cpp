@@ -1,0 +1,137 @@
+// Rheology of the grid paint (docs/GRID.md "Rheology"): the regularised Herschel–Bulkley law,
+// shear thinning measured by the grid's own strain rate, and paint at rest — a stiff ridge and
+// stiff grooves hold their shape for 2 s, an oily ridge levels.
+#include <cmath>
+#include <cstdio>
+
+#include "backend_fixture.h"
+#include "core/grid/rheology.h"
+#include "grid/grid_test_util.h"
+
+namespace wb::test {
+
+class RheologyTest : public BackendTest {};
+
+TEST(Rheology, ApparentViscosityIsHerschelBulkleyAboveTheCriticalRate) {
+  const HerschelBulkley hb{40.f, 5.f, 0.6f};
+  const float m = 1e4f;
+  for (float rate : {0.1f, 1.f, 10.f, 100.f, 1000.f, 1e4f}) {
+    const float tau = apparent_viscosity(hb, rate, m) * rate;
+    const float expect = hb.tau_y + hb.K * std::pow(rate, hb.n);
+    EXPECT_NEAR(tau, expect, 0.01f * expect) << "gamma_dot " << rate;
+  }
+  // At rest the regularised paint is a finite, very viscous liquid: tau_y m + K m^(1-n).
+  const float mu0 = apparent_viscosity(hb, 0.f, m);
+  EXPECT_NEAR(mu0, hb.tau_y * m + hb.K * std::pow(m, 1.f - hb.n), 1e-3f * mu0);
+  // Shear thinning: the apparent viscosity falls monotonically with the strain rate.
+  float last = mu0;
+  for (float rate = 1e-5f; rate < 1e5f; rate *= 3.f) {
+    const float mu = apparent_viscosity(hb, rate, m);
+    EXPECT_LE(mu, last * (1.f + 1e-5f)) << rate;
+    last = mu;
+  }
+  // The oil fraction moves between the end members: geometric in tau_y and K, linear in n.
+  const HerschelBulkley stiff{300.f, 30.f, 0.5f}, oily{0.1f, 0.05f, 1.f};
+  const HerschelBulkley mid = rheology_at_oil(0.5f, stiff, oily);
+  EXPECT_NEAR(mid.tau_y, std::sqrt(300.f * 0.1f), 1e-3f);
+  EXPECT_NEAR(mid.K, std::sqrt(30.f * 0.05f), 1e-4f);
+  EXPECT_NEAR(mid.n, 0.75f, 1e-6f);
+}
+
+namespace {
+/// Apparent viscosity the grid computes in the middle of a layer sheared at `rate` (u = rate z).
+float sheared_layer_viscosity(const Device& device, float rate, float oil) {
+  TileStore canvas(device, CanvasDims{64, 64, 32});
+  Grid g(canvas, GridParams{}, Int3{16, 16, 12}, Int3{0, 0, 0});
+  const int layer = 8;
+  paint_cells(g, [&](int, int, int k) { return k < layer ? 1.f : 0.f; }, oil);
+  g.classify();
+  const GridDims d = g.dims();
+  std::vector<float> u(size_t(d.nu()));
+  for (int k = 0; k < d.nz; ++k)
+    for (int j = 0; j < d.ny; ++j)
+      for (int i = 0; i <= d.nx; ++i) u[size_t(d.uidx(i, j, k))] = rate * (float(k) + 0.5f);
+  g.window().velocity(0).copy_from_host(u);
+  g.rheology();
+  const auto mu = g.apparent_viscosity().to_host();
+  double acc = 0;
+  int n = 0;
+  for (int k = 2; k < layer - 2; ++k)
+    for (int j = 4; j < d.ny - 4; ++j)
+      for (int i = 4; i < d.nx - 4; ++i) {
+        acc += mu[size_t(d.cell(i, j, k))];
+        ++n;
+      }
+  return float(acc / n);
+}
+
+/// Column volume (integral of density, cells) at window column (i, j).
+float column(const GridDims& d, const std::vector<float>& rho, int i, int j) {
+  float h = 0.f;
+  for (int k = 0; k < d.nz; ++k) h += rho[size_t(d.cell(i, j, k))];
+  return h;
+}
+}  // namespace
+
+TEST_F(RheologyTest, ShearedPaintThinsByTheModelsRatio) {
+  const GridParams p;
+  const float oil = 0.3f;
+  const HerschelBulkley hb = rheology_at_oil(oil, {p.yield_stress_stiff, p.consistency_stiff, p.flow_index_stiff},
+                                             {p.yield_stress_oily, p.consistency_oily, p.flow_index_oily});
+  const float slow = 10.f, fast = 1000.f;  // 1/s: a brush drags paint at 10^3 - 10^4 1/s
+  const float mu_slow = sheared_layer_viscosity(device_, slow, oil);
+  const float mu_fast = sheared_layer_viscosity(device_, fast, oil);
+  const float model = apparent_viscosity(hb, fast, p.regularisation) / apparent_viscosity(hb, slow, p.regularisation);
+  std::printf("[ shear ] oil %.1f: mu(%g/s) = %.3g Pa s, mu(%g/s) = %.3g Pa s, ratio %.4f (model %.4f)\n", oil, slow,
+              mu_slow, fast, mu_fast, mu_fast / mu_slow, model);
+  EXPECT_NEAR(mu_slow, apparent_viscosity(hb, slow, p.regularisation), 0.1f * mu_slow);
+  EXPECT_NEAR(mu_fast / mu_slow, model, 0.1f * model);
+  EXPECT_LT(mu_fast, 0.1f * mu_slow);  // strongly shear-thinning at oil 0.3
+}
+
+namespace {
+struct RestResult {
+  float ridge_before, ridge_after, groove_before, groove_after;
+};
+
+/// A ridge 15 cells (3 mm) high on a 4-cell layer and, beside it, grooves 2 cells (0.4 mm) apart,
+/// left alone for `seconds`. Uniform along y.
+RestResult paint_at_rest(const Device& device, float oil, float seconds) {
+  TileStore canvas(device, CanvasDims{128, 64, 64});
+  GridParams p;
+  Grid g(canvas, p, Int3{96, 6, 24}, Int3{0, 0, 0});
+  const GridDims d = g.dims();
+  auto height = [](int i) {
+    if (i >= 8 && i < 40) return 4.f + 15.f * std::max(0.f, 1.f - std::fabs(float(i) + 0.5f - 24.f) / 16.f);
+    if (i >= 56 && i < 88) return (i % 2) ? 6.f : 4.f;  // grooves: 2 cells deep, 0.4 mm apart
+    return 4.f;
+  };
+  paint_cells(g, [&](int i, int, int k) { return std::clamp(height(i) - float(k), 0.f, 1.f); }, oil);
+  auto measure = [&](float& ridge, float& groove) {
+    const auto rho = host_density(g);
+    ridge = 0.f;
+    for (int i = 8; i < 40; ++i) ridge = std::max(ridge, column(d, rho, i, 3) - 4.f);
+    double a = 0;
+    for (int i = 60; i < 84; i += 2) a += column(d, rho, i + 1, 3) - column(d, rho, i, 3);
+    groove = float(a / 12.0);
+  };
+  RestResult r{};
+  measure(r.ridge_before, r.groove_before);
+  const int steps = int(std::lround(seconds / p.dt));
+  for (int s = 0; s < steps; ++s) g.step(p.dt);
+  measure(r.ridge_after, r.groove_after);
+  std::printf("[ rest ] oil %.1f, %.0f s: ridge %.2f -> %.2f cells, grooves %.2f -> %.2f cells\n", oil, seconds,
+              r.ridge_before, r.ridge_after, r.groove_before, r.groove_after);
+  return r;
+}
+}  // namespace
+
+TEST_F(RheologyTest, StiffPaintHoldsRidgesAndGroovesOilyPaintLevels) {
+  const RestResult stiff = paint_at_rest(device_, 0.1f, 2.f);
+  EXPECT_GE(stiff.ridge_after, 0.95f * stiff.ridge_before);
+  EXPECT_GE(stiff.groove_after, 0.9f * stiff.groove_before);
+  const RestResult oily = paint_at_rest(device_, 0.8f, 2.f);
+  EXPECT_LE(oily.ridge_after, 0.8f * oily.ridge_before);
+}
+
+}  // namespace wb::test
