@@ -253,6 +253,32 @@ float figure8_max_distance(const Device& device, Workspace& ws, Method method, V
 }
 }  // namespace
 
+TEST_F(AdhesionTest, WetPaintCarriesItsOwnParticlesAndCatchesFallingOnes) {
+  // A wet layer whose surface is at z = 4 over the canvas floor at 0 (one column map, 1 x 1).
+  const float floor = 0.f, top = 4.f;
+  SolidView s;
+  s.floor_z = floor;
+  s.height = &floor;
+  s.wet_top = &top;
+  s.nx = s.ny = 1;
+  const Vec3 g(0.f, 0.f, -49050.f);
+  const float dt = 1.f / 60.f;
+  // Inside the paint: no weight of its own (the grid gives the paint its weight and support).
+  Vec3 p(0.5f, 0.5f, 2.f), v(0.f, 0.f, 0.f);
+  adhesion_update(p, v, nullptr, 100.f, s, g, 0.5f, 0.1f, 3.f, dt);
+  EXPECT_FLOAT_EQ(p.z, 2.f);
+  EXPECT_FLOAT_EQ(v.z, 0.f);
+  // Above it: it falls (13.6 cells in the first step at g) and lands on the surface, not the floor.
+  Vec3 q(0.5f, 0.5f, 9.f), u(0.f, 0.f, 0.f);
+  for (int k = 0; k < 5; ++k) adhesion_update(q, u, nullptr, 100.f, s, g, 0.5f, 0.1f, 3.f, dt);
+  EXPECT_FLOAT_EQ(q.z, top);
+  // Without wet paint it falls to the floor.
+  s.wet_top = nullptr;
+  Vec3 r(0.5f, 0.5f, 9.f), w(0.f, 0.f, 0.f);
+  for (int k = 0; k < 5; ++k) adhesion_update(r, w, nullptr, 100.f, s, g, 0.5f, 0.1f, 3.f, dt);
+  EXPECT_FLOAT_EQ(r.z, floor);
+}
+
 TEST_F(AdhesionTest, Figure8TwoStepKeepsParticlesWhereASpringCannot) {
   const float D1 = ParticleParams{}.D1;
   // A 135-degree turn and a reversal: dV dt = 18.5 and 20 cells, more than D1.

@@ -1,4 +1,5 @@
-// The solid the particles rest on (Eq. 8's d_k): canvas floor plus dried paint, per column.
+// The solid the particles rest on (Eq. 8's d_k): canvas floor plus dried paint, per column; and
+// the wet paint's surface, which free particles land on.
 #include "backend_fixture.h"
 #include "core/canvas/window.h"
 #include "core/particles/particles.h"
@@ -22,15 +23,21 @@ TEST_F(SolidHeightTest, DriedPaintRaisesTheFloorWetPaintDoesNot) {
     f[0][at(4, j, 4)] = 1.f, f[5][at(4, j, 4)] = 1.f;
   }
   w.from_host(f);
-  DeviceBuffer<float> h(device_, size_t(n.x) * n.y);
-  particles_solid_height(device_, w.view(), 0.95f, 0.25f, h.data());
-  const std::vector<float> hh = h.to_host();
+  DeviceBuffer<float> h(device_, size_t(n.x) * n.y), wet(device_, size_t(n.x) * n.y);
+  particles_solid_height(device_, w.view(), 0.95f, 0.5f, 0.25f, h.data(), wet.data());
+  const std::vector<float> hh = h.to_host(), ww = wet.to_host();
   for (int j = 0; j < n.y; ++j) {
     EXPECT_FLOAT_EQ(hh[size_t(j) * n.x + 0], 0.25f) << "no paint: the canvas floor";
     EXPECT_FLOAT_EQ(hh[size_t(j) * n.x + 1], 2.5f) << "top of the dried layer, half-full top cell";
     EXPECT_FLOAT_EQ(hh[size_t(j) * n.x + 2], 2.f) << "wet paint on dried paint: the dried top";
     EXPECT_FLOAT_EQ(hh[size_t(j) * n.x + 3], 0.25f) << "wet paint is not solid";
     EXPECT_FLOAT_EQ(hh[size_t(j) * n.x + 4], 5.f) << "the highest dried cell counts";
+    // The wet paint's surface: the solid's where there is no wet paint on it.
+    EXPECT_FLOAT_EQ(ww[size_t(j) * n.x + 0], 0.25f);
+    EXPECT_FLOAT_EQ(ww[size_t(j) * n.x + 1], 2.5f);
+    EXPECT_FLOAT_EQ(ww[size_t(j) * n.x + 2], 4.f) << "two wet cells on the dried ones";
+    EXPECT_FLOAT_EQ(ww[size_t(j) * n.x + 3], 3.f) << "three wet cells on the canvas";
+    EXPECT_FLOAT_EQ(ww[size_t(j) * n.x + 4], 5.f);
   }
   // A particle resting above column 1 is 0.5 cells from the solid; above column 3, 2.25.
   SolidView s;

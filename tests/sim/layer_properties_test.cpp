@@ -275,4 +275,57 @@ TEST_F(LayerPropertiesTest, WhiteBrushCarriesRedPastAWetRedBand) {
 }
 
 }  // namespace
+// --- support ------------------------------------------------------------------------------------
+
+TEST_F(LayerPropertiesTest, ParticlesComeToRestOnAWetLayer) {
+  // A wet blue layer 4 cells (0.8 mm) thick; a patch of red paint particles released 8 cells above
+  // it, 12 cells beside a lifted brush (inside D0, so they stay particles; outside D1).
+  constexpr int kW = 96, kH = 64;
+  constexpr float kLayer = 4.f;
+  SimConfig c = layer_config(CanvasDims{kW, kH, kDepth});
+  const BrushPose lifted = pose_at(c.brush, 48.f, kY, 0.f, false);
+  Simulator sim(c, lifted);
+  write_layer(sim, [](int, int, int z) {
+    PaintCell p;
+    if (float(z) < kLayer) p.density = 1.f, p.pigment_r = 0.1f, p.pigment_y = 0.15f, p.pigment_b = 0.85f, p.oil = 0.3f;
+    return p;
+  });
+  ParticleHost drop;
+  for (int j = 0; j < 6; ++j)
+    for (int i = 0; i < 6; ++i) {
+      drop.x.push_back(Vec3(60.5f + float(i), kY - 3.f + float(j), kLayer + 8.f));
+      drop.v.push_back(Vec3(0.f, 0.f, 0.f));
+      drop.m.push_back(0.5f * c.params.transfer.cell_mass());
+      drop.pigment_r.push_back(0.9f), drop.pigment_y.push_back(0.05f), drop.pigment_b.push_back(0.05f);
+      drop.oil.push_back(0.3f), drop.dryness.push_back(0.f);
+    }
+  sim.particles().append(drop);
+  Books books;
+  books.open(sim);
+  for (int s = 0; s < 30; ++s) sim.step(lifted, kDt);  // half a second
+  EXPECT_LT(books.max_drift(sim), 1e-4);
+  EXPECT_EQ(sim.counters().nonfinite_events, 0);
+  // Where the red paint is: the particles left, and the red in the canvas and window.
+  const ParticleHost left = sim.particles().to_host();
+  double zsum = 0, msum = 0;
+  for (size_t k = 0; k < left.size(); ++k)
+    if (left.pigment_r[k] > 0.5f) zsum += double(left.m[k]) * left.x[k].z, msum += left.m[k];
+  sim.grid().window().flush();
+  const auto f = canvas_fields(sim);
+  const double cell_mass = c.params.transfer.cell_mass();
+  for (int z = 0; z < kDepth; ++z)
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x) {
+        const size_t id = (size_t(z) * kH + y) * kW + x;
+        const double red = f[0][id] * std::max(0.0, double(f[1][id]) - 0.1) / 0.8;  // share of the red paint
+        zsum += red * cell_mass * (z + 0.5), msum += red * cell_mass;
+      }
+  const double mean_z = zsum / msum;
+  std::printf("red paint: %zu particles left, mean height %.2f cells (layer top %.0f)\n", left.size(), mean_z,
+              kLayer);
+  // On the wet surface, within a cell and a half; paint that fell through lies at z < 2.
+  EXPECT_GT(mean_z, kLayer - 1.5);
+  EXPECT_LT(mean_z, kLayer + 1.5);
+}
+
 }  // namespace wb::test

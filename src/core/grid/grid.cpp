@@ -346,6 +346,12 @@ void Grid::rheology() {
 
 void Grid::add_external_forces(float dt) {
   WB_PROFILE_SCOPE("grid.forces");
+  // Eq. 11's old grid velocity: after advection and the particles' momentum, before the forces,
+  // the viscous step and the projection (particles in the paint get their weight from the grid).
+  const GridDims g = dims();
+  GridView v = view();
+  for (int c = 0; c < 3; ++c)
+    mem::copy_on_device(device(), vel_pre_[c].data(), v.vel[c], size_t(g.faces(c)) * sizeof(float));
   if (params_.gravity <= 0.f) return;
   gravity_d(device(), view(), cell_tmp_.data(), params_.gravity * dt);
 }
@@ -355,9 +361,6 @@ void Grid::apply_viscosity(float dt) {
   const Device& d = device();
   const GridDims g = dims();
   GridView v = view();
-  // Eq. 11's old grid velocity: after advection, the particles' momentum and the forces.
-  for (int c = 0; c < 3; ++c)
-    mem::copy_on_device(d, vel_pre_[c].data(), v.vel[c], size_t(g.faces(c)) * sizeof(float));
   stats_.viscosity_faces = 0;
   stats_.viscosity_iterations = 0;
   stats_.viscosity_residual = 0;

@@ -92,10 +92,11 @@ class Grid {
   /// this step's forces: a force the paint resists below its yield stress must not yield it. One
   /// evaluation per step: the yield surface follows the flow with a lag of one step.
   void rheology();
-  /// Gravity on faces touching liquid, hydrostatic part split off (docs/GRID.md).
+  /// Keeps the velocity (Eq. 11's old grid velocity), then gravity on faces touching liquid,
+  /// hydrostatic part split off (docs/GRID.md).
   void add_external_forces(float dt);
-  /// Keeps the velocity (Eq. 11's old grid velocity), then implicit viscosity with the apparent
-  /// viscosity of each liquid cell at its strain rate, solved by PCG to viscosity_tolerance.
+  /// Implicit viscosity with the apparent viscosity of each liquid cell at its strain rate, solved
+  /// by PCG to viscosity_tolerance.
   void apply_viscosity(float dt);
   /// Projects with params().solver.
   void project();
@@ -105,7 +106,7 @@ class Grid {
   void step(float dt);
 
   // --- for the particles (FLIP/PIC, Eq. 11) ---
-  /// MAC velocity after the forces, before the viscous and pressure steps (component c = 0,1,2):
+  /// MAC velocity before the forces, the viscous and the pressure steps (component c = 0,1,2):
   /// the grid velocity Eq. 11's FLIP difference is taken against.
   const DeviceBuffer<float>& velocity_before_solve(int c) const { return vel_pre_[c]; }
   /// Apparent viscosity of each liquid cell at the last viscous step, Pa s (0 elsewhere).

@@ -11,11 +11,13 @@
 
 namespace wb {
 
-/// The solid the particles rest on: the canvas floor, optionally raised by a height map
-/// of dried paint over a window of columns (absolute z of the dried top, canvas cells).
+/// What the particles rest on: the canvas floor, optionally raised by a height map of dried
+/// paint over a window of columns (absolute z of the dried top, canvas cells), and the surface of
+/// the wet grid paint over the same columns.
 struct SolidView {
   float floor_z = 0.f;
-  const float* height = nullptr;  ///< nx * ny columns, index j * nx + i; nullptr: floor only
+  const float* height = nullptr;   ///< nx * ny columns, index j * nx + i; nullptr: floor only
+  const float* wet_top = nullptr;  ///< top of the wet paint per column (>= height); nullptr: none
   int nx = 0, ny = 0;
   int ox = 0, oy = 0;  ///< canvas cell of column (0, 0)
 };
@@ -26,6 +28,17 @@ WB_HD WB_INLINE float solid_surface_z(const SolidView& s, Vec3 p) {
   if (s.height) {
     const int i = int(floorf(p.x)) - s.ox, j = int(floorf(p.y)) - s.oy;
     if (i >= 0 && j >= 0 && i < s.nx && j < s.ny) z = maxf(z, s.height[int64_t(j) * s.nx + i]);
+  }
+  return z;
+}
+
+/// Surface of the paint under p: the wet paint's free surface where there is wet paint, else
+/// the solid's, canvas cells.
+WB_HD WB_INLINE float paint_surface_z(const SolidView& s, Vec3 p) {
+  float z = solid_surface_z(s, p);
+  if (s.wet_top) {
+    const int i = int(floorf(p.x)) - s.ox, j = int(floorf(p.y)) - s.oy;
+    if (i >= 0 && j >= 0 && i < s.nx && j < s.ny) z = maxf(z, s.wet_top[int64_t(j) * s.nx + i]);
   }
   return z;
 }
@@ -123,10 +136,16 @@ WB_HD WB_INLINE Vec3 local_frame_step(Vec3 p, Vec3 v, Vec3 a_k, const SampleFram
 /// p' from the nearest sample's frame (Eq. 9, only when d_B < D1), p'' in the canvas frame;
 /// blend (Eq. 10); keep it above the solid; velocity corrected from the positions,
 /// v = (p_new - p) / dt. `sample` may be null when no sample is near.
+/// One gravity for grid and particles: a particle inside the wet paint is part of it, and the grid
+/// gives that paint its weight and its support (§4.2 gravity with the hydrostatic part, resisted
+/// by the yield stress), which FLIP hands to the particle (Eq. 11); so g enters a_k only above
+/// the paint. There a free particle falls onto the wet surface and rests on it, as on the solid;
+/// a bristle holding it (Eq. 10 weight > 0) can still press it into the wet paint.
 WB_HD WB_INLINE void adhesion_update(Vec3& p, Vec3& v, const SampleFrame* sample, float d_B, const SolidView& solid,
                                      Vec3 gravity, float delta, float beta_L, float D1, float dt) {
   const float d = solid_distance(solid, p);
-  const Vec3 a_k = gravity + friction_accel(v, d, delta, dt);
+  const bool in_paint = p.z < paint_surface_z(solid, p);
+  const Vec3 a_k = (in_paint ? Vec3(0.f, 0.f, 0.f) : gravity) + friction_accel(v, d, delta, dt);
   const Vec3 p_canvas = canvas_frame_step(p, v, a_k, dt);
   Vec3 p_new = p_canvas;
   // Paint the canvas holds (Eq. 8's weight) does not also follow a bristle: without this a
@@ -135,8 +154,10 @@ WB_HD WB_INLINE void adhesion_update(Vec3& p, Vec3& v, const SampleFrame* sample
   // past D1, and lands up to 3 brush radii away (docs/PARTICLES.md "The canvas holds").
   const float w = adhesion_weight(d_B, D1) * (1.f - friction_weight(d, delta));
   if (sample && w > 0.f) p_new = p_canvas + (local_frame_step(p, v, a_k, *sample, beta_L, dt) - p_canvas) * w;
-  // The particle cannot enter the solid; the projection only sees the solid on the grid.
-  const float zs = solid_surface_z(solid, p_new);
+  // The particle cannot enter the solid (the projection only sees the solid on the grid), and
+  // a free one coming down from above lands on the wet paint's surface.
+  const bool free_fall = !in_paint && !(sample && w > 0.f);
+  const float zs = free_fall ? paint_surface_z(solid, p_new) : solid_surface_z(solid, p_new);
   if (p_new.z < zs) p_new.z = zs;
   v = (p_new - p) / dt;
   p = p_new;

@@ -42,11 +42,12 @@ void particles_compact_field(const Device& d, const int32_t* src, int32_t* dst, 
                              const uint32_t* pos, int64_t n);
 void particles_compact_field(const Device& d, const uint32_t* src, uint32_t* dst, const uint32_t* dead,
                              const uint32_t* pos, int64_t n);
-/// Height field of the solid the particles rest on over the window's columns (SolidView):
-/// the top of the highest dried cell (dryness at or above dry_threshold, the grid's
-/// solid test) in each column, absolute canvas z, or floor_z where none. nx * ny floats.
-void particles_solid_height(const Device& d, const PaintWindowView& pw, float dry_threshold, float floor_z,
-                            float* height);
+/// Height fields of what the particles rest on over the window's columns (SolidView), absolute
+/// canvas z, nx * ny floats each: `height`, the top of the highest dried cell (dryness at or above
+/// dry_threshold, the grid's solid test) or floor_z where none; `wet_top` (nullable), the top
+/// of the highest liquid cell above it (density >= liquid_threshold), or `height` where none.
+void particles_solid_height(const Device& d, const PaintWindowView& pw, float dry_threshold, float liquid_threshold,
+                            float floor_z, float* height, float* wet_top = nullptr);
 /// Scratch of particles [first, first + n): nearest = -1, d_B = 0, key = 0, dead = 0.
 void particles_init_scratch(const Device& d, const ParticleView& p, int64_t first, int64_t n);
 
@@ -63,7 +64,8 @@ void particles_init_scratch(const Device& d, const ParticleView& p, int64_t firs
   void particles_compact_field(const uint32_t* src, uint32_t* dst, const uint32_t* dead, const uint32_t* pos,       \
                                int64_t n);                                                                         \
   void particles_init_scratch(ParticleView p, int64_t first, int64_t n);                                         \
-  void particles_solid_height(PaintWindowView pw, float dry_threshold, float floor_z, float* height);
+  void particles_solid_height(PaintWindowView pw, float dry_threshold, float liquid_threshold, float floor_z,    \
+                              float* height, float* wet_top);
 
 namespace cpu {
 WB_PARTICLES_BACKEND_DECLS

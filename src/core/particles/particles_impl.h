@@ -77,10 +77,11 @@ void particles_init_scratch(ParticleView p, int64_t first, int64_t n) {
   });
 }
 
-void particles_solid_height(PaintWindowView pw, float dry_threshold, float floor_z, float* height) {
+void particles_solid_height(PaintWindowView pw, float dry_threshold, float liquid_threshold, float floor_z,
+                            float* height, float* wet_top) {
   parallel_for(int64_t(pw.nx) * pw.ny, [=] WB_HD(int64_t c) {
     const int64_t layer = int64_t(pw.nx) * pw.ny;
-    float top = floor_z;
+    float top = floor_z, wet = -1e30f;
     for (int k = pw.nz - 1; k >= 0; --k) {
       const int64_t id = int64_t(k) * layer + c;
       const float rho = pw.density[id];
@@ -89,8 +90,11 @@ void particles_solid_height(PaintWindowView pw, float dry_threshold, float floor
         top = maxf(top, float(pw.oz + k) + minf(rho, 1.f));
         break;
       }
+      // The highest liquid cell (the grid's liquid test) is the wet paint's free surface.
+      if (wet < -1e29f && rho >= liquid_threshold) wet = float(pw.oz + k) + minf(rho, 1.f);
     }
     height[c] = top;
+    if (wet_top) wet_top[c] = maxf(top, wet);
   });
 }
 

@@ -55,8 +55,10 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
   cells(raster_mass_);
   cells(raster_density_);
   cells(overlay_mass_);
-  solid_height_.set_device(d);
-  solid_height_.resize(size_t(g.nx) * size_t(g.ny));
+  for (auto* b : {&solid_height_, &wet_top_}) {
+    b->set_device(d);
+    b->resize(size_t(g.nx) * size_t(g.ny));
+  }
   for (int c = 0; c < 3; ++c) {
     cells(bristle_v_[c]);
     cells(cell_v_[c]);
@@ -283,13 +285,15 @@ void Simulator::particle_stage(float dt) {
   // Samples are at t + dt, particles at t: hash the samples rewound to t (hash_grid.h).
   hash_.build(brush_->samples(), prm.hash_cell, ws_, dt);
   hash_.query_nearest(particles_.view(), prm.D0);
-  // The particles rest on the canvas and on dried paint (d_k of Eq. 8 is measured to both).
+  // The particles rest on the canvas and on dried paint (d_k of Eq. 8 is measured to both), and
+  // free ones land on the wet paint's surface.
   ActiveWindow& win = grid_->window();
-  particles_solid_height(device(), win.paint().view(), config_.params.grid.dry_threshold, prm.floor_z,
-                         solid_height_.data());
+  particles_solid_height(device(), win.paint().view(), config_.params.grid.dry_threshold,
+                         config_.params.grid.liquid_threshold, prm.floor_z, solid_height_.data(), wet_top_.data());
   SolidView solid;
   solid.floor_z = prm.floor_z;
   solid.height = solid_height_.data();
+  solid.wet_top = wet_top_.data();
   solid.nx = win.dims().x;
   solid.ny = win.dims().y;
   solid.ox = win.origin().x;
