@@ -1,6 +1,7 @@
 // Rheology of the grid paint (docs/GRID.md "Rheology"): the regularised Herschel–Bulkley law,
 // shear thinning measured by the grid's own strain rate, and paint at rest — a stiff ridge and
-// stiff grooves hold their shape for 2 s, an oily ridge levels.
+// stiff grooves hold their shape for 2 s, an oily ridge levels, a drop on a slope of wet paint
+// slumps where the slope is steeper than its yield stress holds and stays on a gentle one.
 #include <cmath>
 #include <cstdio>
 
@@ -132,6 +133,59 @@ TEST_F(RheologyTest, StiffPaintHoldsRidgesAndGroovesOilyPaintLevels) {
   EXPECT_GE(stiff.groove_after, 0.9f * stiff.groove_before);
   const RestResult oily = paint_at_rest(device_, 0.8f, 2.f);
   EXPECT_LE(oily.ridge_after, 0.8f * oily.ridge_before);
+}
+
+namespace {
+/// A drop of red paint 4 cells (0.8 mm) thick on a slope of wet blue paint of the same oil
+/// (0.55: yield stress 3.7 Pa), left alone 2 s. Returns how far the drop's centre (the red pigment)
+/// moved downhill, cells. Uniform along y.
+float drop_on_slope(const Device& device, float slope) {
+  TileStore canvas(device, CanvasDims{128, 64, 64});
+  GridParams p;
+  Grid g(canvas, p, Int3{64, 6, 32}, Int3{0, 0, 0});
+  const GridDims d = g.dims();
+  auto surface = [&](int i) { return 2.f + slope * std::clamp(float(i) + 0.5f - 8.f, 0.f, 20.f); };
+  Fields f = empty_fields(g);
+  for (int k = 0; k < d.nz; ++k)
+    for (int j = 0; j < d.ny; ++j)
+      for (int i = 0; i < d.nx; ++i) {
+        const size_t c = size_t(d.cell(i, j, k));
+        const float z = float(k), s = surface(i);
+        const bool drop = i >= 15 && i < 21 && z >= s && z < s + 4.f;
+        if (z < s || drop) {
+          f[0][c] = 1.f, f[1][c] = drop ? 0.9f : 0.05f, f[2][c] = 0.05f, f[3][c] = drop ? 0.05f : 0.9f;
+          f[4][c] = 0.55f;
+        }
+      }
+  g.window().paint().from_host(f);
+  auto centre = [&] {
+    const auto rho = host_density(g);
+    const auto red = g.window().paint().pigment_r.to_host();
+    double m = 0, x = 0;
+    for (size_t c = 0; c < rho.size(); ++c) {
+      int i, j, k;
+      d.decompose_cell(int64_t(c), i, j, k);
+      const double w = rho[c] * std::max(0.f, red[c] - 0.05f);
+      m += w, x += w * (i + 0.5);
+    }
+    return float(x / m);
+  };
+  const float x0 = centre();
+  for (int s = 0; s < int(std::lround(2.f / p.dt)); ++s) g.step(p.dt);
+  const float moved = x0 - centre();
+  std::printf("[ slope ] %.2f (%.0f deg): the drop moved %.2f cells downhill in 2 s\n", slope,
+              std::atan(slope) * 180.f / 3.14159265f, moved);
+  return moved;
+}
+}  // namespace
+
+TEST_F(RheologyTest, DropSlumpsOnASteepSlopeAndHoldsOnAGentleOne) {
+  // A slope of a material with yield stress c stands up to the critical height
+  // H_c = 4 (c / rho0 g) sin(b) / (1 - cos(b)) (Culmann's wedge, no friction): with c = 3.7 Pa,
+  // 3.6 mm at 45 degrees, below the 5.2 mm of this slope, and 30 mm at 6 degrees; the drop itself,
+  // 0.8 mm high, is below the 1.5 mm of a vertical cut (b = 90 degrees).
+  EXPECT_GT(drop_on_slope(device_, 1.f), 2.f);
+  EXPECT_LT(std::fabs(drop_on_slope(device_, 0.1f)), 0.3f);
 }
 
 }  // namespace wb::test

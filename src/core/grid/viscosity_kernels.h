@@ -3,7 +3,7 @@
 //   u - dt div(nu grad u) = u_old,   nu = mu(gamma_dot) / rho0 (rheology.h),
 // on the faces that touch liquid, solved by Jacobi-preconditioned conjugate gradients to a
 // stated tolerance (grid.cpp). The matrix is symmetric positive definite: the link between two
-// fluid faces carries the mean of their viscosities, so each link is counted once from either side.
+// fluid faces carries the harmonic mean of their viscosities (link_nu), the same from either side.
 #pragma once
 #include <cstdint>
 
@@ -63,6 +63,12 @@ WB_HD WB_INLINE float face_nu_dt(const GridView& g, const float* mu, int c, int 
   return m * nu_scale;
 }
 
+/// Viscosity of the link between two faces: the harmonic mean, as for resistances in series. The
+/// shear stress is continuous across an interface, so a soft layer on a stiff one shears in the
+/// soft layer; the arithmetic mean would weld the soft paint to the stiff (a drop of oily paint on
+/// a slope of stiff paint then never slides, docs/GRID.md).
+WB_HD WB_INLINE float link_nu(float a, float b) { return (a + b) > 0.f ? 2.f * a * b / (a + b) : 0.f; }
+
 /// Row of the system for list entry e (fluid face c,i,j,k): its fluid neighbours' entries
 /// (nb[0..6), -1 where none), the diagonal 1 + sum of link weights and the right-hand side
 /// u_old + sum over walls of weight * wall velocity. nu is compact (entry-indexed), idx maps a
@@ -77,7 +83,7 @@ WB_HD WB_INLINE void viscous_row(const GridView& g, const float* nu, const uint3
       [&](int64_t t) {
         const uint32_t en = idx[t];
         nb[q++] = int32_t(en);
-        dsum += 0.5f * (nf + nu[en]);
+        dsum += link_nu(nf, nu[en]);
       },
       [&](float uw, float s) {
         dsum += s * nf;
@@ -95,7 +101,7 @@ WB_HD WB_INLINE float viscous_apply(const float* nu, const int32_t* nb, const fl
   for (int q = 0; q < 6; ++q) {
     const int32_t n = nb[6 * e + q];
     if (n < 0) break;
-    off += 0.5f * (nf + nu[n]) * x[n];
+    off += link_nu(nf, nu[n]) * x[n];
   }
   return diag * x[e] - off;
 }
