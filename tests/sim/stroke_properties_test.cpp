@@ -31,6 +31,7 @@ struct Stroke {
   float load = 1.f;
   std::optional<BrushSpec> brush;  ///< none: the scene's small round brush
   bool particles = true;   ///< false: grid-only paint (Fig. 7a/c)
+  float dt = kDt;          ///< simulation step, s
 };
 
 class StrokePropertiesTest : public SimulatorTest {
@@ -60,17 +61,19 @@ class StrokePropertiesTest : public SimulatorTest {
     PaintLoad paint = red();
     paint.load = st.load;
     sim.load_paint(paint);
-    for (int i = 1; i <= 4; ++i) sim.step(pose(kX0, st.pressure * 0.25f * float(i)), kDt);
-    const int substeps = std::max(1, int(std::ceil(st.speed * kDt / st.max_move)));
+    const float dt = st.dt;
+    const int land = int(std::lround(4.f * kDt / dt)), lift = int(std::lround(6.f * kDt / dt));
+    for (int i = 1; i <= land; ++i) sim.step(pose(kX0, st.pressure * float(i) / float(land)), dt);
+    const int substeps = std::max(1, int(std::ceil(st.speed * dt / st.max_move)));
     std::vector<BrushPose> poses(static_cast<size_t>(substeps), pose(kX0, st.pressure));
     float x = kX0;
     while (x < kX1) {
       for (int k = 0; k < substeps; ++k)
-        poses[size_t(k)] = pose(std::min(kX1, x + st.speed * kDt * float(k + 1) / float(substeps)), st.pressure);
-      sim.step(poses.data(), substeps, kDt);
-      x += st.speed * kDt;
+        poses[size_t(k)] = pose(std::min(kX1, x + st.speed * dt * float(k + 1) / float(substeps)), st.pressure);
+      sim.step(poses.data(), substeps, dt);
+      x += st.speed * dt;
     }
-    for (int i = 0; i < 6; ++i) sim.step(pose(kX1, 0.f, false), kDt);
+    for (int i = 0; i < lift; ++i) sim.step(pose(kX1, 0.f, false), dt);
     sim.settle();
     if (std::getenv("WB_STROKE_BOOKS")) {
       const PaintCensus cs = sim.census();
@@ -146,6 +149,31 @@ TEST_F(StrokePropertiesTest, SameStrokeWithMoreOrFewerSubstepsPaintsTheSame) {
   EXPECT_LT(l1(b, a), 0.3);
   EXPECT_LT(l1(b, c), 0.3);
   EXPECT_GE(coverage(b), 0.9) << "a continuous layer along the track at 160 mm/s";
+}
+
+TEST_F(StrokePropertiesTest, SameStrokeWithHalfTheTimeStepPaintsTheSame) {
+  // 160 mm/s, sub-steps of at most 2 cells, steps of 1/60 s and 1/120 s: the grid's viscous solve,
+  // projection and advection, the particles and the transfer all run twice as often.
+  Stroke coarse, fine;
+  fine.dt = 0.5f * kDt;
+  const std::vector<float> a = paint_stroke(coarse), b = paint_stroke(fine);
+  double ta = 0, tb = 0, d = 0;
+  for (float x : a) ta += x;
+  for (float x : b) tb += x;
+  for (int by = 0; by < kH; by += 4)  // L1 per 4 x 4-cell block, as for the sub-steps
+    for (int bx = 0; bx < kW; bx += 4) {
+      double sa = 0, sb = 0;
+      for (int y = by; y < by + 4; ++y)
+        for (int x = bx; x < bx + 4; ++x) sa += a[size_t(y) * kW + x], sb += b[size_t(y) * kW + x];
+      d += std::fabs(sa - sb);
+    }
+  std::printf("dt 1/60 s: %.1f cells of paint, coverage %.0f %%; dt 1/120 s: %.1f, %.0f %%; block L1 %.3f\n", ta,
+              100 * coverage(a), tb, 100 * coverage(b), d / ta);
+  // Tolerance: 15 % of the paint and block L1 0.35. Measured: +11.5 % of paint and L1 0.30 at the
+  // finer step; the per-step emit and absorb limits are not the cause (64 and 1024 give +10.8 %).
+  // The remaining step-size dependence is open (docs/TRANSFER.md "Step size").
+  EXPECT_NEAR(tb, ta, 0.15 * ta);
+  EXPECT_LT(d / ta, 0.35);
 }
 
 TEST_F(StrokePropertiesTest, SameStrokeAtAnySpeedLaysTheSameLayer) {
