@@ -121,7 +121,7 @@ def scumble():
 def stiff_and_oily():
     # Rheology (docs/GRID.md): the same flat brush and colour, one short stroke of stiff paint
     # (oil 0.1) and one of oily paint (oil 0.8) beside it, then the brush held up between them for
-    # 2 s so that both rest inside the active window: the stiff stroke keeps its ridges, the oily
+    # 1 s so that both rest inside the active window: the stiff stroke keeps its ridges, the oily
     # one levels.
     s = stroke(0.0, line((460, 490), (560, 490)), 0.8, 0.6, tilt=(15, 0))
     t = s[-1]["t"]
@@ -130,12 +130,12 @@ def stiff_and_oily():
     s += stroke(t2, line((460, 535), (560, 535)), 0.8, 0.6, tilt=(15, 0))
     t3 = s[-1]["t"]
     s += hover(t3, (560, 535), (510, 512), 0.3)
-    s += hover(round(t3 + 0.3, 4), (510, 512), (510, 512), 2.0)
+    s += hover(round(t3 + 0.3, 4), (510, 512), (510, 512), 0.7)
     events = [{"type": "clean", "t": round(t + 0.1, 4)},
               {"type": "dip", "t": round(t + 0.15, 4), "ryb": [0.85, 0.3, 0.05], "oil": 0.8, "load": 1.0}]
     write("stiff-and-oily.json",
           "Stiff and oily paint side by side: a flat brush lays a short stroke of stiff paint (oil 0.1) at y 490 "
-          "and one of oily paint (oil 0.8) at y 535, then rests above them for 2 s.",
+          "and one of oily paint (oil 0.8) at y 535, then rests above them for 1 s.",
           {"shape": "flat"}, {"ryb": [0.85, 0.3, 0.05], "oil": 0.1, "load": 1.0, "reload_on_pen_down": False},
           s, events)
 
