@@ -359,7 +359,6 @@ void Grid::add_external_forces(float dt) {
 void Grid::apply_viscosity(float dt) {
   WB_PROFILE_SCOPE("grid.viscosity");
   const Device& d = device();
-  const GridDims g = dims();
   GridView v = view();
   stats_.viscosity_faces = 0;
   stats_.viscosity_iterations = 0;
