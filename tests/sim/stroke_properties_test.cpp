@@ -74,6 +74,12 @@ class StrokePropertiesTest : public SimulatorTest {
       x += st.speed * dt;
     }
     for (int i = 0; i < lift; ++i) sim.step(pose(kX1, 0.f, false), dt);
+    if (std::getenv("WB_STROKE_TOTALS")) {
+      const TransferTotals& t = sim.books().totals();
+      std::printf("dt %.4f: emitted %.4g kg (%lld), absorbed %.4g (%lld), to_grid %.4g, to_particles %.4g, bristles left %.4g\n",
+                  dt, t.emitted, (long long)t.emitted_count, t.absorbed, (long long)t.absorbed_count, t.to_grid, t.to_particles,
+                  sim.census().bristles);
+    }
     sim.settle();
     if (std::getenv("WB_STROKE_BOOKS")) {
       const PaintCensus cs = sim.census();
