@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/render/renderer.h"
+#include "core/render/test_volumes.h"
 #include "sim/sim_fixture.h"
 
 namespace wb::test {
@@ -45,31 +46,8 @@ class LayerPropertiesTest : public SimulatorTest {
   /// Writes `cell` into every tile of the canvas (tiles left all empty are not allocated) and
   /// reloads the simulator's window from the canvas.
   static void write_layer(Simulator& sim, const CellFn& cell) {
-    TileStore& canvas = sim.canvas();
-    const size_t n = size_t(canvas.tile_cells());
-    for (int ty = 0; ty < canvas.tiles_y(); ++ty)
-      for (int tx = 0; tx < canvas.tiles_x(); ++tx) {
-        TileData t;
-        t.tile_x = tx, t.tile_y = ty;
-        t.density.assign(n, 0.f);
-        for (auto* f : {&t.pigment_r, &t.pigment_y, &t.pigment_b, &t.oil, &t.dryness}) f->assign(n, 0);
-        bool any = false;
-        for (int z = 0; z < canvas.dims().depth; ++z)
-          for (int ly = 0; ly < kTileSize; ++ly)
-            for (int lx = 0; lx < kTileSize; ++lx) {
-              const PaintCell c = cell(tx * kTileSize + lx, ty * kTileSize + ly, z);
-              if (c.density <= 0.f) continue;
-              const size_t i = (size_t(z) * kTileSize + ly) * kTileSize + lx;
-              t.density[i] = c.density;
-              t.pigment_r[i] = encode_unorm16(c.pigment_r);
-              t.pigment_y[i] = encode_unorm16(c.pigment_y);
-              t.pigment_b[i] = encode_unorm16(c.pigment_b);
-              t.oil[i] = encode_unorm16(c.oil);
-              t.dryness[i] = encode_unorm16(c.dryness);
-              any = true;
-            }
-        if (any) canvas.write_tile(t);
-      }
+    const CanvasDims d = sim.canvas().dims();
+    fill_volume(sim.canvas(), 0, 0, d.width, d.height, cell);
     sim.grid().window().reload();
   }
 

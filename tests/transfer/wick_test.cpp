@@ -19,6 +19,20 @@ class WickTest : public TransferTest {
     return samples_.view();
   }
   DeviceSamples samples_{device_};
+  /// One bristle of `per` samples at full capacity, full of paint except its emptied tip (sample 0).
+  static BristleLoadHost emptied_tip(int per, const TransferParams& prm) {
+    BristleLoadHost h;
+#define WB_X(name, doc) h.name.assign(size_t(per), 0.f);
+    WB_BRISTLE_LOAD_FIELDS(WB_X)
+#undef WB_X
+    for (int i = 0; i < per; ++i) {
+      h.potential[i] = h.capacity[i] = prm.M_max;
+      h.radius[i] = 0.75f;
+      h.m[i] = i == 0 ? 0.f : prm.M_max;
+    }
+    return h;
+  }
+
   static BristleLoadHost random_load(int n, std::mt19937& rng, const TransferParams& prm) {
     std::uniform_real_distribution<float> U(0.f, 1.f);
     BristleLoadHost h;
@@ -79,14 +93,8 @@ TEST_F(WickTest, FeedsAnEmptiedTipWithTheBristlesColour) {
   // its neighbours and turns blue; samples far up only give, so they keep their colour.
   const int per = 32;
   TransferParams prm;
-  BristleLoadHost h;
-#define WB_X(name, doc) h.name.assign(size_t(per), 0.f);
-  WB_BRISTLE_LOAD_FIELDS(WB_X)
-#undef WB_X
+  BristleLoadHost h = emptied_tip(per, prm);
   for (int i = 0; i < per; ++i) {
-    h.potential[i] = h.capacity[i] = prm.M_max;
-    h.radius[i] = 0.75f;
-    h.m[i] = i == 0 ? 0.f : prm.M_max;
     h.pigment_b[i] = i == 0 ? 0.f : 0.9f;
     h.pigment_y[i] = i == 0 ? 0.8f : 0.f;
     h.oil[i] = i == 0 ? 0.f : 0.4f;
@@ -116,15 +124,7 @@ TEST_F(WickTest, SlidingPumpsPaintDownAHeldBristleDoesNotLeak) {
   TransferParams prm;
   prm.wick_rate = 0.f;
   prm.wick_slide = 100.f;
-  BristleLoadHost h;
-#define WB_X(name, doc) h.name.assign(size_t(per), 0.f);
-  WB_BRISTLE_LOAD_FIELDS(WB_X)
-#undef WB_X
-  for (int i = 0; i < per; ++i) {
-    h.potential[i] = h.capacity[i] = prm.M_max;
-    h.radius[i] = 0.75f;
-    h.m[i] = i == 0 ? 0.f : prm.M_max;
-  }
+  const BristleLoadHost h = emptied_tip(per, prm);
   Transfer t(device_, prm);
   auto tip_after = [&](Vec3 vel, float dt) {
     BristleLoad load(device_, per, prm);

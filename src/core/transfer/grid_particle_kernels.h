@@ -37,9 +37,10 @@ struct CellField {
 WB_HD WB_INLINE int64_t to_fixed(float v) { return llrintf(v * 1099511627776.f); }
 WB_HD WB_INLINE float from_fixed(int64_t v) { return float(double(v) * (1.0 / 1099511627776.0)); }
 
-/// Trilinear value of a cell-centred field at canvas position p; nodes outside the field read 0.
-WB_HD WB_INLINE float cell_field_at(const CellField& g, Vec3 p) {
-  if (g.f == nullptr) return 0.f;
+/// Trilinear sum over the 8 cell centres of g's lattice around canvas position p: the weight of
+/// each node in the field times value(index of the cell); nodes outside the field are left out.
+template <class Value>
+WB_HD WB_INLINE float trilinear_cells(const CellField& g, Vec3 p, Value&& value) {
   const float sx = p.x - float(g.ox) - 0.5f, sy = p.y - float(g.oy) - 0.5f, sz = p.z - float(g.oz) - 0.5f;
   const float fx = floorf(sx), fy = floorf(sy), fz = floorf(sz);
   const int i0 = int(fx), j0 = int(fy), k0 = int(fz);
@@ -51,32 +52,25 @@ WB_HD WB_INLINE float cell_field_at(const CellField& g, Vec3 p) {
         const int i = i0 + a, j = j0 + b, k = k0 + c;
         if (i < 0 || j < 0 || k < 0 || i >= g.nx || j >= g.ny || k >= g.nz) continue;
         const float w = (a ? tx : 1.f - tx) * (b ? ty : 1.f - ty) * (c ? tz : 1.f - tz);
-        acc += w * g.f[(int64_t(k) * g.ny + j) * g.nx + i];
+        acc += w * value((int64_t(k) * g.ny + j) * g.nx + i);
       }
   return acc;
+}
+
+/// Trilinear value of a cell-centred field at canvas position p; nodes outside the field read 0.
+WB_HD WB_INLINE float cell_field_at(const CellField& g, Vec3 p) {
+  if (g.f == nullptr) return 0.f;
+  return trilinear_cells(g, p, [&](int64_t id) { return g.f[id]; });
 }
 
 /// Trilinear value of the wet part of a cell-centred density field at canvas position p: cells
 /// that are solid (dried, `cell_is_solid`) count as empty; nodes outside the field read 0.
 WB_HD WB_INLINE float wet_density_at(const CellField& density, const CellField& dryness, float dry_threshold, Vec3 p) {
   if (density.f == nullptr) return 0.f;
-  const float sx = p.x - float(density.ox) - 0.5f, sy = p.y - float(density.oy) - 0.5f,
-              sz = p.z - float(density.oz) - 0.5f;
-  const float fx = floorf(sx), fy = floorf(sy), fz = floorf(sz);
-  const int i0 = int(fx), j0 = int(fy), k0 = int(fz);
-  const float tx = sx - fx, ty = sy - fy, tz = sz - fz;
-  float acc = 0.f;
-  for (int c = 0; c < 2; ++c)
-    for (int b = 0; b < 2; ++b)
-      for (int a = 0; a < 2; ++a) {
-        const int i = i0 + a, j = j0 + b, k = k0 + c;
-        if (i < 0 || j < 0 || k < 0 || i >= density.nx || j >= density.ny || k >= density.nz) continue;
-        const int64_t id = (int64_t(k) * density.ny + j) * density.nx + i;
-        const float rho = density.f[id];
-        if (dryness.f && cell_is_solid(rho, dryness.f[id], dry_threshold)) continue;
-        acc += (a ? tx : 1.f - tx) * (b ? ty : 1.f - ty) * (c ? tz : 1.f - tz) * rho;
-      }
-  return acc;
+  return trilinear_cells(density, p, [&](int64_t id) {
+    const float rho = density.f[id];
+    return dryness.f && cell_is_solid(rho, dryness.f[id], dry_threshold) ? 0.f : rho;
+  });
 }
 
 /// Trilinear density of the liquid (non-solid) paint at window position q, constant
