@@ -88,7 +88,7 @@ void BM_GridProject(benchmark::State& state) {
                                             : wb::PressureSolver::Chebyshev;
   g.params().track_mass = false;
   g.classify();
-  for (auto _ : state) g.project();
+  for (auto _ : state) g.project(g.params().dt);
   g.params() = saved;
 }
 BENCHMARK(BM_GridProject)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);

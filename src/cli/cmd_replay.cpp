@@ -91,9 +91,10 @@ void apply_overrides(const ReplayArgs& a, Stroke& stroke) {
 
 /// `wetbrush bench`: every profiler scope's median, 90th percentile and share of the step
 /// (the paper's Figure 12), the step rate against the stroke's own clock, and memory.
-/// Per step of a bench run: the viscous solve's CG iterations and the residual it reached.
+/// Per step of a bench run: the viscous solve's CG iterations and the residual it reached,
+/// and the paint advection's sub-steps.
 struct SolveLog {
-  std::vector<double> iterations, residual;
+  std::vector<double> iterations, residual, substeps;
 };
 
 void report_bench(const ReplayArgs& a, const Simulator& sim, const Stroke& stroke, const Device& device,
@@ -125,6 +126,8 @@ void report_bench(const ReplayArgs& a, const Simulator& sim, const Stroke& strok
   const double res_med = pct(solve.residual, 0.5), res_max = pct(solve.residual, 1.0);
   std::printf("viscous solve: %.0f CG iterations median, %.0f most; residual %.2e median, %.2e worst (tolerance %.0e)\n",
               it_med, it_max, res_med, res_max, double(sim.config().params.grid.viscosity_tolerance));
+  std::printf("paint advection: %.0f sub-steps median, %.0f most (work bound %d)\n", pct(solve.substeps, 0.5),
+              pct(solve.substeps, 1.0), sim.config().params.grid.advect_max_substeps);
   if (!a.bench_json.empty()) {
     nlohmann::json j{{"stroke", a.strokes},
                      {"device", device.to_string()},
@@ -138,6 +141,7 @@ void report_bench(const ReplayArgs& a, const Simulator& sim, const Stroke& strok
                        {"iterations_max", it_max},
                        {"residual_median", res_med},
                        {"residual_max", res_max}}},
+                     {"advection_substeps", {{"median", pct(solve.substeps, 0.5)}, {"max", pct(solve.substeps, 1.0)}}},
                      {"stages", stages}};
     write_text_file(a.bench_json, j.dump(2) + "\n");
   }
@@ -201,6 +205,7 @@ int run_replay(const ReplayArgs& a) {
     if (a.bench) {
       solve.iterations.push_back(sim.grid().stats().viscosity_iterations);
       solve.residual.push_back(sim.grid().stats().viscosity_residual);
+      solve.substeps.push_back(sim.grid().stats().advect_substeps);
     }
     if (!a.frames_dir.empty() && done % a.every == 0) {
       char name[64];

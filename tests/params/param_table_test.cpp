@@ -42,8 +42,8 @@ TEST(ParamTable, ValidationRejectsBadValues) {
   EXPECT_THROW(apply_param_assignment(p, "grid.alpha=abc"), Error);
   apply_param_assignment(p, "grid.jacobi_L=5");
   EXPECT_EQ(p.grid.jacobi_L, 5);
-  apply_param_assignment(p, "grid.mass_correction=false");
-  EXPECT_FALSE(p.grid.mass_correction);
+  apply_param_assignment(p, "grid.track_mass=false");
+  EXPECT_FALSE(p.grid.track_mass);
 }
 
 TEST(ParamTable, JsonRoundTripAndUnknownKeys) {

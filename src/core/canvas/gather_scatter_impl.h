@@ -9,7 +9,8 @@ namespace wb::WB_BACKEND_NS {
 
 namespace detail {
 struct CanvasCellRef {
-  int64_t at = -1;  ///< offset into the pool, -1 when unallocated or off-canvas
+  int64_t at = -1;    ///< offset into the pool, -1 when unallocated or off-canvas
+  int32_t slot = -1;  ///< its tile's slot
 };
 WB_HD WB_INLINE CanvasCellRef locate(const TileStoreView& t, int cx, int cy, int cz) {
   CanvasCellRef r;
@@ -17,6 +18,7 @@ WB_HD WB_INLINE CanvasCellRef locate(const TileStoreView& t, int cx, int cy, int
   const int tile = (cy / kTileSize) * t.tiles_x + cx / kTileSize;
   const int32_t slot = t.slot_of_tile[tile];
   if (slot < 0) return r;
+  r.slot = slot;
   r.at = int64_t(slot) * t.tile_cells() + t.cell_offset(cx % kTileSize, cy % kTileSize, cz);
   return r;
 }
@@ -41,7 +43,16 @@ void gather_window(TileStoreView t, PaintWindowView w) {
     w.pigment_y[i] = decode_unorm16(t.pigment_y[c.at]);
     w.pigment_b[i] = decode_unorm16(t.pigment_b[c.at]);
     w.oil[i] = decode_unorm16(t.oil[c.at]);
-    w.dryness[i] = decode_unorm16(t.dryness[c.at]);
+    w.dryness[i] = t.dryness_at(c.slot, c.at);
+  });
+}
+
+void settle_tile_drying(TileStoreView t, const int32_t* slots, int64_t count) {
+  const int64_t n = t.tile_cells();
+  parallel_for(count * n, [=] WB_HD(int64_t i) {
+    const int32_t slot = slots[i / n];
+    const int64_t at = int64_t(slot) * n + i % n;
+    t.dryness[at] = encode_unorm16(t.dryness_at(slot, at));
   });
 }
 

@@ -1,6 +1,7 @@
 #include "core/canvas/tile_store.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/exec/algorithms.h"
 #include "core/exec/dispatch.h"
@@ -14,6 +15,9 @@ void mark_dispatch(const Device& d, TileStoreView t, PaintWindowView w, int tx0,
 }
 void scatter_dispatch(const Device& d, TileStoreView t, PaintWindowView w) { WB_DISPATCH(d, scatter_window(t, w)); }
 void dry_dispatch(const Device& d, TileStoreView t, int64_t cells) { WB_DISPATCH(d, dry_all(t, cells)); }
+void settle_dispatch(const Device& d, TileStoreView t, const int32_t* slots, int64_t n) {
+  WB_DISPATCH(d, settle_tile_drying(t, slots, n));
+}
 }  // namespace
 
 TileStore::TileStore(const Device& device, CanvasDims dims) : device_(device), dims_(dims) {
@@ -28,6 +32,8 @@ TileStore::TileStore(const Device& device, CanvasDims dims) : device_(device), d
   for (auto* b : {&pigment_r_, &pigment_y_, &pigment_b_, &oil_, &dryness_}) b->set_device(device);
   density_.set_device(device);
   tile_flags_.set_device(device);
+  dried_to_.set_device(device);
+  settle_slots_.set_device(device);
 }
 
 TileStoreView TileStore::view() {
@@ -39,6 +45,8 @@ TileStoreView TileStore::view() {
   v.pigment_b = pigment_b_.data();
   v.oil = oil_.data();
   v.dryness = dryness_.data();
+  v.dried_to = dried_to_.data();
+  v.clock = float(clock_);
   v.width = dims_.width;
   v.height = dims_.height;
   v.depth = dims_.depth;
@@ -55,6 +63,7 @@ void TileStore::grow_pool(int32_t slots) {
   const size_t used = size_t(slot_capacity_) * size_t(tile_cells());
   density_.grow_keep(cells);
   for (auto* b : {&pigment_r_, &pigment_y_, &pigment_b_, &oil_, &dryness_}) b->grow_keep(cells);
+  dried_to_.grow_keep(size_t(cap));
   // New slots start empty.
   mem::fill_zero(device_, density_.data() + used, (cells - used) * sizeof(float));
   for (auto* b : {&pigment_r_, &pigment_y_, &pigment_b_, &oil_, &dryness_})
@@ -69,6 +78,10 @@ int32_t TileStore::ensure_slot(int tile_id) {
   s = slots_used_++;
   tile_of_slot_.push_back(tile_id);
   slot_of_tile_.copy_range_from_host(&s, size_t(tile_id), 1);
+  // A new tile is empty: it is up to date with the clock.
+  host_dried_to_.resize(size_t(slots_used_));
+  host_dried_to_[size_t(s)] = float(clock_);
+  dried_to_.copy_range_from_host(&host_dried_to_[size_t(s)], size_t(s), 1);
   return s;
 }
 
@@ -91,10 +104,33 @@ void TileStore::scatter(PaintWindow& window) {
   mark_dispatch(device_, view(), window.view(), tx0, ty0, ntx, tile_flags_.data());
   host_flags_.resize(tile_flags_.size());
   tile_flags_.copy_to_host(host_flags_.data(), host_flags_.size());
+  std::vector<int32_t> touched;
   for (int j = 0; j < nty; ++j)
-    for (int i = 0; i < ntx; ++i)
-      if (host_flags_[size_t(j) * ntx + i]) ensure_slot((ty0 + j) * tiles_x_ + tx0 + i);
+    for (int i = 0; i < ntx; ++i) {
+      const int tile = (ty0 + j) * tiles_x_ + tx0 + i;
+      if (host_flags_[size_t(j) * ntx + i]) ensure_slot(tile);
+      if (host_slot_[size_t(tile)] >= 0) touched.push_back(host_slot_[size_t(tile)]);
+    }
+  // The window covers these tiles only in part: the rest of each must carry its drying before
+  // the tile is marked up to date.
+  settle_drying(touched);
   scatter_dispatch(device_, view(), window.view());
+}
+
+void TileStore::advance_drying(double amount) {
+  WB_REQUIRE(std::isfinite(amount) && amount >= 0.0, "advance_drying: amount must be finite and non-negative");
+  clock_ += amount;
+}
+
+void TileStore::settle_drying(const std::vector<int32_t>& slots) {
+  if (slots.empty()) return;
+  bool behind = false;
+  for (int32_t s : slots) behind = behind || host_dried_to_[size_t(s)] != float(clock_);
+  if (!behind) return;
+  settle_slots_.copy_from_host(slots);
+  settle_dispatch(device_, view(), settle_slots_.data(), int64_t(slots.size()));
+  for (int32_t s : slots) host_dried_to_[size_t(s)] = float(clock_);
+  dried_to_.copy_range_from_host(host_dried_to_.data(), 0, host_dried_to_.size());
 }
 
 void TileStore::dry_all() {
@@ -105,6 +141,7 @@ void TileStore::dry_all() {
 void TileStore::clear() {
   for (int32_t t : tile_of_slot_) host_slot_[size_t(t)] = -1;
   tile_of_slot_.clear();
+  host_dried_to_.clear();
   slots_used_ = 0;
   slot_of_tile_.copy_from_host(host_slot_);
   if (slot_capacity_ > 0) {
@@ -143,6 +180,8 @@ PaintCell TileStore::read_cell(int x, int y, int z) const {
   c.pigment_b = decode_unorm16(q[2]);
   c.oil = decode_unorm16(q[3]);
   c.dryness = decode_unorm16(q[4]);
+  const double lag = clock_ - double(host_dried_to_[size_t(slot)]);
+  if (c.density > 0.f && lag > 0.0) c.dryness = std::min(c.dryness + float(lag), 1.f);
   return c;
 }
 
@@ -165,6 +204,10 @@ TileData TileStore::read_tile(int tile_id) const {
   pigment_b_.copy_range_to_host(d.pigment_b.data(), at, n);
   oil_.copy_range_to_host(d.oil.data(), at, n);
   dryness_.copy_range_to_host(d.dryness.data(), at, n);
+  const float lag = float(clock_) - host_dried_to_[size_t(slot)];
+  if (lag > 0.f)
+    for (size_t i = 0; i < n; ++i)
+      if (d.density[i] > 0.f) d.dryness[i] = encode_unorm16(decode_unorm16(d.dryness[i]) + lag);
   return d;
 }
 
@@ -183,6 +226,8 @@ void TileStore::write_tile(const TileData& d) {
   pigment_b_.copy_range_from_host(d.pigment_b.data(), at, n);
   oil_.copy_range_from_host(d.oil.data(), at, n);
   dryness_.copy_range_from_host(d.dryness.data(), at, n);
+  host_dried_to_[size_t(slot)] = float(clock_);
+  dried_to_.copy_range_from_host(&host_dried_to_[size_t(slot)], size_t(slot), 1);
 }
 
 }  // namespace wb

@@ -5,6 +5,9 @@
 //   R, Y, B  unorm16   -- pigment mixes in small steps; 8 bits would band and drift
 //   oil      unorm16
 //   dryness  unorm16   -- 1/65535 resolution; drying rates are far coarser per step
+// Paint dries everywhere at once without a pass over the canvas: the canvas keeps a drying
+// clock (the dryness every painted cell has gained so far) and each tile the clock's value when
+// its stored dryness was last brought up to date; readers add the difference.
 // See docs/ARCHITECTURE.md ("The sparse canvas") for the reasoning.
 #pragma once
 #include <cstdint>
@@ -41,9 +44,19 @@ struct TileStoreView {
   uint16_t* pigment_b;
   uint16_t* oil;
   uint16_t* dryness;
+  const float* dried_to;        ///< per slot: the drying clock its stored dryness includes
+  float clock;                  ///< the canvas's drying clock (TileStore::advance_drying)
   int width, height, depth;
   int tiles_x, tiles_y;
   WB_HD int64_t tile_cells() const { return int64_t(kTileSize) * kTileSize * depth; }
+  /// Dryness of the cell at pool offset `at` of slot `slot`, with the drying its tile has not
+  /// stored yet: paint (density > 0) gains clock - dried_to, up to 1.
+  WB_HD float dryness_at(int32_t slot, int64_t at) const {
+    const float d = decode_unorm16(dryness[at]);
+    if (!(density[at] > 0.f)) return d;
+    const float lag = clock - dried_to[slot];
+    return lag > 0.f ? (d + lag < 1.f ? d + lag : 1.f) : d;
+  }
   WB_HD int64_t cell_offset(int lx, int ly, int z) const { return (int64_t(z) * kTileSize + ly) * kTileSize + lx; }
   WB_HD bool inside(int x, int y, int z) const {
     return x >= 0 && y >= 0 && z >= 0 && x < width && y < height && z < depth;
@@ -73,6 +86,11 @@ class TileStore {
   void scatter(PaintWindow& window);
   /// "Let it dry": every cell holding paint becomes fully dry (solid).
   void dry_all();
+  /// Every painted cell of the canvas gains `amount` of dryness (capped at 1), at the cost of
+  /// one addition: the tiles catch up when read. The window's own cells are dried by the grid.
+  void advance_drying(double amount);
+  /// The drying clock: dryness gained by paint since the canvas was made.
+  double drying_clock() const { return clock_; }
   /// Empties the canvas (keeps the pool's memory).
   void clear();
 
@@ -94,6 +112,8 @@ class TileStore {
  private:
   int32_t ensure_slot(int tile_id);
   void grow_pool(int32_t slots);
+  /// Brings the stored dryness of these slots up to the clock (scatter writes partial tiles).
+  void settle_drying(const std::vector<int32_t>& slots);
 
   Device device_;
   CanvasDims dims_;
@@ -107,16 +127,22 @@ class TileStore {
   DeviceBuffer<uint16_t> pigment_r_, pigment_y_, pigment_b_, oil_, dryness_;
   DeviceBuffer<int32_t> tile_flags_;  ///< scratch of scatter: which window tiles hold paint
   std::vector<int32_t> host_flags_;
+  double clock_ = 0.0;                 ///< drying clock
+  std::vector<float> host_dried_to_;   ///< per slot, mirror of dried_to_
+  DeviceBuffer<float> dried_to_;
+  DeviceBuffer<int32_t> settle_slots_;  ///< scratch of settle_drying
 };
 
 namespace cpu {
 void gather_window(TileStoreView t, PaintWindowView w);
+void settle_tile_drying(TileStoreView t, const int32_t* slots, int64_t count);
 void mark_painted_tiles(TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* flags);
 void scatter_window(TileStoreView t, PaintWindowView w);
 void dry_all(TileStoreView t, int64_t cells);
 }  // namespace cpu
 namespace cuda {
 void gather_window(TileStoreView t, PaintWindowView w);
+void settle_tile_drying(TileStoreView t, const int32_t* slots, int64_t count);
 void mark_painted_tiles(TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* flags);
 void scatter_window(TileStoreView t, PaintWindowView w);
 void dry_all(TileStoreView t, int64_t cells);

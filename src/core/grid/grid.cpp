@@ -19,15 +19,11 @@ void classify_d(const Device& d, GridView g, PaintWindowView pw, BristleField br
                 float lt, float dt) {
   WB_DISPATCH(d, grid_classify(g, pw, br, pd, cd.width, cd.height, cd.depth, lt, dt));
 }
-void advect_paint_d(const Device& d, GridView g, const float* u, const float* v, const float* w, PaintWindowView s,
-                    PaintWindowView t, float dt) {
-  WB_DISPATCH(d, grid_advect_paint(g, u, v, w, s, t, dt));
+void outflow_d(const Device& d, GridView g, const float* rho, float* out) {
+  WB_DISPATCH(d, grid_paint_outflow(g, rho, out));
 }
-void touched_d(const Device& d, const float* a, const float* b, const uint8_t* cls, float* out, int64_t n) {
-  WB_DISPATCH(d, grid_touched_density(a, b, cls, out, n));
-}
-void scale_touched_d(const Device& d, float* a, const float* b, const uint8_t* cls, float s, int64_t n) {
-  WB_DISPATCH(d, grid_scale_touched(a, b, cls, s, n));
+void advect_axis_d(const Device& d, GridView g, PaintWindowView s, PaintWindowView t, int axis, float dt) {
+  WB_DISPATCH(d, grid_advect_paint_axis(g, s, t, axis, dt));
 }
 void advect_vel_d(const Device& d, GridView g, const float* u, const float* v, const float* w, float dt) {
   WB_DISPATCH(d, grid_advect_velocity(g, u, v, w, dt));
@@ -62,7 +58,9 @@ void pcg_direction_d(const Device& d, int64_t n, float beta, const float* z, flo
 void visc_write_d(const Device& d, GridView g, const uint32_t* list, int64_t n, const float* x) {
   WB_DISPATCH(d, grid_viscous_write(g, list, n, x));
 }
-void rhs_d(const Device& d, GridView g, float* b) { WB_DISPATCH(d, grid_rhs(g, b)); }
+void rhs_d(const Device& d, GridView g, const float* rho, float inv_dt, float* b) {
+  WB_DISPATCH(d, grid_rhs(g, rho, inv_dt, b));
+}
 void jacobi_d(const Device& d, PoissonView s, const float* b, const float* x, float* out, float omega) {
   WB_DISPATCH(d, poisson_jacobi(s, b, x, out, omega));
 }
@@ -120,6 +118,9 @@ void check_params(const GridParams& p) {
   WB_REQUIRE(p.dry_rate >= 0.f && p.dry_rate <= 1000.f, "grid: dry_rate must be in [0, 1000] /s");
   WB_REQUIRE(p.dry_threshold > 0.f && p.dry_threshold <= 1.f, "grid: dry_threshold must be in (0, 1]");
   WB_REQUIRE(p.window_snap >= 1 && p.window_snap <= 64, "grid: window_snap must be in [1, 64]");
+  WB_REQUIRE(p.advect_courant >= 0.05f && p.advect_courant <= 0.5f, "grid: advect_courant must be in [0.05, 0.5]");
+  WB_REQUIRE(p.advect_max_substeps >= 1 && p.advect_max_substeps <= 1024,
+             "grid: advect_max_substeps must be in [1, 1024]");
 }
 }  // namespace
 
@@ -290,46 +291,27 @@ void Grid::advect(float dt) {
   WB_REQUIRE(dt > 0.f && std::isfinite(dt), "Grid::advect: dt must be positive");
   const Device& d = device();
   const GridDims g = dims();
-  const int64_t n = g.cells();
   PaintWindow& paint = window_.paint();
   paint_tmp_.set_origin(paint.origin());
   GridView v = view();
-  // Paint fields: departure points in the velocity of the last step, into the scratch window.
-  advect_paint_d(d, v, v.vel[0], v.vel[1], v.vel[2], paint.view(), paint_tmp_.view(), dt);
-  double before = 0, after = 0;
-  if (params_.track_mass || params_.mass_correction) {
-    before = reduce_sum(d, paint.density.data(), n, ws_);
-    after = reduce_sum(d, paint_tmp_.density.data(), n, ws_);
-  }
-  stats_.advect_change = after - before;
-  stats_.advect_correction = 0;
-  bool keep_old_paint = false;
-  if (params_.mass_correction && after != before) {
-    // Conservative and local: rescale density only in the cells advection changed, in proportion
-    // to their density (no smearing into empty cells, no change to untouched paint).
-    touched_d(d, paint_tmp_.density.data(), paint.density.data(), v.cls, cell_tmp_.data(), n);
-    const double touched = reduce_sum(d, cell_tmp_.data(), n, ws_);
-    if (touched > 1e-9) {
-      const double scale = 1.0 + (before - after) / touched;
-      if (scale >= 0.0 && scale <= 16.0) {
-        scale_touched_d(d, paint_tmp_.density.data(), paint.density.data(), v.cls, float(scale), n);
-        stats_.advect_correction = (scale - 1.0) * touched;
-      } else {
-        // A thin film moved so fast that the backtrace lost (or made) most of it: no local
-        // rescale can restore that, so the paint keeps its place this step (exactly conservative).
-        keep_old_paint = true;
-        stats_.advect_correction = before - after;
-      }
-    } else {
-      keep_old_paint = true;  // advection emptied the touched cells: nothing to rescale
-      stats_.advect_correction = before - after;
-    }
-  }
-  if (!keep_old_paint) {
+  // Paint: flux form on the faces of the last step's velocity, one axis at a time (Strang order
+  // x y z, then z y x), in sub-steps that keep each axis's outflow Courant number at most
+  // advect_courant: no cell gives more than it holds, and no global correction is needed.
+  outflow_d(d, v, paint.density.data(), cell_tmp_.data());
+  const float rate = reduce_max(d, cell_tmp_.data(), g.cells(), ws_);
+  const float courant = std::isfinite(rate) ? rate * dt : 0.f;
+  const int n = std::clamp(int(std::ceil(courant / params_.advect_courant)), 1, params_.advect_max_substeps);
+  stats_.advect_substeps = n;
+  stats_.advect_courant = courant / float(n);
+  const float h = dt / float(n);
+  for (int s = 0; s < n; ++s)
+    for (int a = 0; a < 3; ++a) {
+      const int axis = (s % 2 == 0) ? a : 2 - a;
+      advect_axis_d(d, v, paint.view(), paint_tmp_.view(), axis, h);
 #define WB_X(name, doc) paint.name.swap(paint_tmp_.name);
-    WB_PAINT_FIELDS(WB_X)
+      WB_PAINT_FIELDS(WB_X)
 #undef WB_X
-  }
+    }
   // Velocity: backtrace every open face through a copy of the field.
   for (int c = 0; c < 3; ++c)
     mem::copy_on_device(d, vel_tmp_[c].data(), v.vel[c], size_t(g.faces(c)) * sizeof(float));
@@ -409,14 +391,17 @@ void Grid::apply_viscosity(float dt) {
   visc_write_d(d, v, list, n, cg_x_.data());
 }
 
-void Grid::compute_rhs() { rhs_d(device(), view(), rhs_.data()); }
+void Grid::compute_rhs(float dt) {
+  rhs_d(device(), view(), dt > 0.f ? window_.paint().density.data() : nullptr, dt > 0.f ? 1.f / dt : 0.f,
+        rhs_.data());
+}
 
-void Grid::project() {
+void Grid::project(float dt) {
   WB_PROFILE_SCOPE("grid.project");
   const Device& d = device();
   const GridDims g = dims();
   GridView v = view();
-  compute_rhs();
+  compute_rhs(dt);
   SolverConfig cfg;
   cfg.kind = params_.solver;
   cfg.alpha = params_.alpha;
@@ -442,7 +427,9 @@ void Grid::project() {
 void Grid::dry(float dt) {
   WB_PROFILE_SCOPE("grid.dry");
   if (params_.dry_rate <= 0.f) return;
+  // §4.2 dries every cell: the window's cells here, the rest of the canvas by its clock.
   dry_d(device(), window_.paint().view(), params_.dry_rate * dt);
+  window_.canvas().advance_drying(double(params_.dry_rate) * double(dt));
 }
 
 void Grid::step(float dt) {
@@ -455,7 +442,7 @@ void Grid::step(float dt) {
   rheology();
   add_external_forces(dt);
   apply_viscosity(dt);
-  project();
+  project(dt);
   dry(dt);
   if (params_.track_mass) {
     stats_.window_mass = window_.window_mass(ws_);
@@ -464,8 +451,8 @@ void Grid::step(float dt) {
   }
 }
 
-double Grid::divergence_norm() {
-  compute_rhs();
+double Grid::divergence_norm(float dt) {
+  compute_rhs(dt);
   return norm2(device(), rhs_.data(), dims().cells(), scratch_, ws_);
 }
 

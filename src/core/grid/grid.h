@@ -20,8 +20,8 @@ struct GridStats {
   double canvas_mass = 0;       ///< canvas outside the window region (+ window region as last gathered)
   double window_mass = 0;       ///< sum of density in the window after the step
   double total_mass = 0;        ///< canvas + window without double counting (ActiveWindow::total_mass)
-  double advect_change = 0;     ///< window mass change made by semi-Lagrangian advection (before correction)
-  double advect_correction = 0; ///< mass the correction put back (0 when off)
+  int advect_substeps = 0;      ///< sub-steps the paint's flux-form advection took (Courant <= advect_courant)
+  float advect_courant = 0;     ///< largest one-axis outflow Courant number of a sub-step that moved paint
   double rhs_norm = 0;          ///< ||div||_2 over liquid cells before the projection
   double residual_norm = 0;     ///< ||div||_2 over liquid cells after it
   float chebyshev_rho = 0;      ///< rho used by the Chebyshev solver (estimated or given)
@@ -98,9 +98,11 @@ class Grid {
   /// Implicit viscosity with the apparent viscosity of each liquid cell at its strain rate, solved
   /// by PCG to viscosity_tolerance.
   void apply_viscosity(float dt);
-  /// Projects with params().solver.
-  void project();
-  /// Dryness += dry_rate * dt in every cell holding paint.
+  /// Projects with params().solver: the velocity loses its divergence, except where paint is
+  /// packed above density 1, which it expands back over dt (compression_source).
+  void project(float dt);
+  /// Dryness += dry_rate * dt in every cell holding paint: the window's, and the canvas's by
+  /// its drying clock (TileStore::advance_drying).
   void dry(float dt);
   /// classify, advect, classify, rheology, add_external_forces, apply_viscosity, project, dry.
   void step(float dt);
@@ -112,17 +114,19 @@ class Grid {
   /// Apparent viscosity of each liquid cell at the last viscous step, Pa s (0 elsewhere).
   const DeviceBuffer<float>& apparent_viscosity() const { return mu_; }
   const DeviceBuffer<float>& pressure() const { return pressure_; }
-  /// Right-hand side b = -div of the last projection (liquid cells).
+  /// Right-hand side of the last projection (liquid cells): -div plus the compression source.
   const DeviceBuffer<float>& rhs() const { return rhs_; }
 
   // --- diagnostics ---
   const GridStats& stats() const { return stats_; }
-  /// ||div||_2 of the current velocity over liquid cells (as the projection measures it).
-  double divergence_norm();
+  /// ||div||_2 of the current velocity over liquid cells, against the compression source of
+  /// packed paint when dt > 0 (as the projection of that step measures it).
+  double divergence_norm(float dt = 0.f);
   /// Largest |velocity| on faces touching liquid, cells/s.
   float max_fluid_speed();
-  /// Recomputes the right-hand side b = -div u into rhs() (used by project and the study).
-  void compute_rhs();
+  /// Recomputes the right-hand side b = -div u into rhs() (used by project and the study), plus
+  /// the compression source of packed paint when dt > 0.
+  void compute_rhs(float dt = 0.f);
   Workspace& workspace() { return ws_; }
   SolverScratch& solver_scratch() { return scratch_; }
 
@@ -150,10 +154,8 @@ class Grid {
 #define WB_GRID_BACKEND_DECLS                                                                                        \
   void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float* particle_density, int canvas_w, int canvas_h, int canvas_d,     \
                      float liquid_threshold, float dry_threshold);                                                   \
-  void grid_advect_paint(GridView g, const float* u, const float* v, const float* w, PaintWindowView src,            \
-                         PaintWindowView dst, float dt);                                                             \
-  void grid_touched_density(const float* rho_new, const float* rho_old, const uint8_t* cls, float* out, int64_t n); \
-  void grid_scale_touched(float* rho_new, const float* rho_old, const uint8_t* cls, float scale, int64_t n);         \
+  void grid_paint_outflow(GridView g, const float* rho, float* out);                                                 \
+  void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt);            \
   void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt);                  \
   void grid_gravity(GridView g, float* ph, float g_dt);                                                              \
   void grid_effective_viscosity(GridView g, const float* oil, HerschelBulkley stiff, HerschelBulkley oily, float m,  \
@@ -170,7 +172,7 @@ class Grid {
                        float* r, float* z, float* rz);                                                               \
   void grid_pcg_direction(int64_t n, float beta, const float* z, float* p);                                         \
   void grid_viscous_write(GridView g, const uint32_t* list, int64_t n, const float* x);                             \
-  void grid_rhs(GridView g, float* b);                                                                               \
+  void grid_rhs(GridView g, const float* rho, float inv_dt, float* b);                                                                               \
   void poisson_jacobi(PoissonView s, const float* b, const float* x, float* out, float omega);                      \
   void poisson_residual(PoissonView s, const float* b, const float* x, float* r);                                   \
   void poisson_chebyshev(PoissonView s, const float* b, const float* x, const float* x_prev, float* out,            \

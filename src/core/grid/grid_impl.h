@@ -60,33 +60,42 @@ void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float*
   });
 }
 
-void grid_advect_paint(GridView g, const float* u, const float* v, const float* w, PaintWindowView src,
-                       PaintWindowView dst, float dt) {
+void grid_paint_outflow(GridView g, const float* rho, float* out) {
   const GridDims d = g.d;
   parallel_for(d.cells(), [=] WB_HD(int64_t c) {
-    CellStencil s;
-    bool moved = false;
-    if (g.cls[c] != kCellSolid) {
-      int i, j, k;
-      d.decompose_cell(c, i, j, k);
-      const Vec3 x(float(i) + 0.5f, float(j) + 0.5f, float(k) + 0.5f);
-      moved = cell_stencil_fluid(d, g.cls, backtrace(u, v, w, d, x, dt), s);
-    }
-#define WB_X(name, doc) dst.name[c] = moved ? apply_stencil(s, src.name) : src.name[c];
-    WB_PAINT_FIELDS(WB_X)
-#undef WB_X
+    int i, j, k;
+    d.decompose_cell(c, i, j, k);
+    out[c] = cell_outflow_rate(g, rho, i, j, k);
   });
 }
 
-void grid_touched_density(const float* rho_new, const float* rho_old, const uint8_t* cls, float* out, int64_t n) {
-  parallel_for(n, [=] WB_HD(int64_t c) {
-    out[c] = (cls[c] != kCellSolid && rho_new[c] != rho_old[c]) ? rho_new[c] : 0.f;
-  });
-}
-
-void grid_scale_touched(float* rho_new, const float* rho_old, const uint8_t* cls, float scale, int64_t n) {
-  parallel_for(n, [=] WB_HD(int64_t c) {
-    if (cls[c] != kCellSolid && rho_new[c] != rho_old[c]) rho_new[c] *= scale;
+void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt) {
+  const GridDims d = g.d;
+  parallel_for(d.cells(), [=] WB_HD(int64_t c) {
+    int i, j, k;
+    d.decompose_cell(c, i, j, k);
+    int64_t from_lo, from_hi;
+    // Paint in through the low face, out through the high one (signed): the same face flux is
+    // computed, bit for bit, by the two cells it joins, so what one loses the other gains.
+    const float lo = face_paint_flux(g, src.density, axis, i, j, k, dt, from_lo);
+    const float hi = face_paint_flux(g, src.density, axis, i + (axis == 0), j + (axis == 1), k + (axis == 2), dt,
+                                     from_hi);
+    const float rho = src.density[c];
+    const float rho_new = rho + (lo - hi);
+    dst.density[c] = rho_new;
+    // Pigment, oil and dryness travel with the paint at their donor's value (mass-weighted),
+    // so each stays a convex mix of what met in the cell.
+    auto carry = [&](const float* q, float* out) {
+      const float in = from_lo >= 0 ? lo * q[from_lo] : 0.f;
+      const float gone = from_hi >= 0 ? hi * q[from_hi] : 0.f;
+      out[c] = rho_new > 1e-12f ? (rho * q[c] + (in - gone)) / rho_new : q[c];
+    };
+    static_assert(kPaintFieldCount == 6, "advect every paint field");
+    carry(src.pigment_r, dst.pigment_r);
+    carry(src.pigment_y, dst.pigment_y);
+    carry(src.pigment_b, dst.pigment_b);
+    carry(src.oil, dst.oil);
+    carry(src.dryness, dst.dryness);
   });
 }
 
@@ -237,7 +246,7 @@ void grid_viscous_write(GridView g, const uint32_t* list, int64_t n, const float
   });
 }
 
-void grid_rhs(GridView g, float* b) {
+void grid_rhs(GridView g, const float* rho, float inv_dt, float* b) {
   const GridDims d = g.d;
   parallel_for(d.cells(), [=] WB_HD(int64_t c) {
     if (g.cls[c] != kCellLiquid) {
@@ -246,7 +255,7 @@ void grid_rhs(GridView g, float* b) {
     }
     int i, j, k;
     d.decompose_cell(c, i, j, k);
-    b[c] = -cell_divergence(g, i, j, k);
+    b[c] = compression_source(rho ? rho[c] : 0.f, inv_dt) - cell_divergence(g, i, j, k);
   });
 }
 

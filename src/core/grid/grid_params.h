@@ -85,9 +85,12 @@ struct GridParams {
   float dry_threshold = 0.95f;
 
   // --- advection and mass ---
-  /// Rescale density in the cells advection touched so that advection conserves mass
-  /// (docs/GRID.md "Mass"). Default on.
-  bool mass_correction = true;
+  /// Largest outflow Courant number of a paint sub-step, per axis: the paint's flux-form
+  /// advection takes ceil(max outflow * dt / advect_courant) sub-steps. At 0.5 no cell gives more
+  /// than it holds (docs/GRID.md "Advection and mass"). Default 0.5, range [0.05, 0.5].
+  float advect_courant = 0.5f;
+  /// Work bound of the paint's advection, sub-steps per step. Default 64, range [1, 1024].
+  int advect_max_substeps = 64;
   /// Compute the mass books (canvas, window, advection change) each step: 3 reductions. Default on.
   bool track_mass = true;
 

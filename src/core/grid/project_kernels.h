@@ -4,6 +4,8 @@
 // pressure gradient update, velocity extrapolation into air, and gravity with its
 // hydrostatic part split off. Pressure p is scaled so that the update is u -= grad p.
 #pragma once
+#include <math.h>
+
 #include <cstdint>
 
 #include "core/grid/grid_fields.h"
@@ -82,6 +84,15 @@ WB_HD WB_INLINE float cell_divergence(const GridView& g, int i, int j, int k) {
   };
   return flux(0, d.uidx(i + 1, j, k)) - flux(0, d.uidx(i, j, k)) + flux(1, d.vidx(i, j + 1, k)) -
          flux(1, d.vidx(i, j, k)) + flux(2, d.widx(i, j, k + 1)) - flux(2, d.widx(i, j, k));
+}
+
+/// Divergence a liquid cell holding density rho > 1 must have to return to 1 in one step,
+/// ln(rho) / dt (rho(t + dt) = rho e^{-div dt}); 0 at or below 1. Paint is incompressible: where
+/// an unconverged projection let the flow pack it, the next projection pushes it out again
+/// (volume correction, Kim et al. 2007 "Simulation of bubbles" §4; Losasso et al. 2008 §6).
+/// Cells below 1 are not pulled in: partly filled cells are the free surface.
+WB_HD WB_INLINE float compression_source(float rho, float inv_dt) {
+  return rho > 1.f ? logf(rho) * inv_dt : 0.f;
 }
 
 /// Diagonal and off-diagonal sum of row i of A: diag = sum theta_f, off = sum theta_f x_nb

@@ -99,7 +99,7 @@ void StudyScene::prepare_system(int warmup_steps) {
   grid_.rheology();
   grid_.add_external_forces(dt);
   grid_.apply_viscosity(dt);
-  grid_.compute_rhs();
+  grid_.compute_rhs(dt);
 }
 
 PoissonView HostPoisson::view() const {

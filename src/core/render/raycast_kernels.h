@@ -111,7 +111,7 @@ WB_HD WB_INLINE RenderCell cell_full_raw(const RenderVolume& v, int x, int y, in
       const int64_t a = int64_t(slot) * v.tiles.tile_cells() + v.tiles.cell_offset(x % kTileSize, y % kTileSize, z);
       c = RenderCell{v.tiles.density[a], decode_unorm16(v.tiles.pigment_r[a]), decode_unorm16(v.tiles.pigment_y[a]),
                      decode_unorm16(v.tiles.pigment_b[a]), decode_unorm16(v.tiles.oil[a]),
-                     decode_unorm16(v.tiles.dryness[a])};
+                     v.tiles.dryness_at(slot, a)};
     }
   }
   if (v.has_splat && in_splat(v.splat, x, y, z)) {

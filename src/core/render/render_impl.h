@@ -20,8 +20,9 @@ void render_top_map(RenderVolume v, RenderParams P, int x0, int y0, int w, int h
     float sum = 0.f, dmax = 0.f;
     const bool tiles_only = !v.has_win && !v.has_splat;
     int64_t a0 = -1;  // tiles only: address of the column's bottom cell, -1 for an empty tile
+    int32_t slot = -1;
     if (tiles_only) {
-      const int32_t slot = v.tiles.slot_of_tile[(y / kTileSize) * v.tiles.tiles_x + x / kTileSize];
+      slot = v.tiles.slot_of_tile[(y / kTileSize) * v.tiles.tiles_x + x / kTileSize];
       if (slot >= 0) a0 = int64_t(slot) * v.tiles.tile_cells() + v.tiles.cell_offset(x % kTileSize, y % kTileSize, 0);
     }
     const int64_t dz = int64_t(kTileSize) * kTileSize;
@@ -57,7 +58,7 @@ void render_top_map(RenderVolume v, RenderParams P, int x0, int y0, int w, int h
           c.y = decode_unorm16(v.tiles.pigment_y[a]);
           c.b = decode_unorm16(v.tiles.pigment_b[a]);
           c.oil = decode_unorm16(v.tiles.oil[a]);
-          c.dryness = decode_unorm16(v.tiles.dryness[a]);
+          c.dryness = v.tiles.dryness_at(slot, a);
         } else {
           c = cell_full_raw(v, x, y, z);
           if (!(c.density > 0.f)) continue;

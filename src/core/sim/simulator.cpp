@@ -193,7 +193,7 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
     grid_->rheology();
     grid_->add_external_forces(dt);
     grid_->apply_viscosity(dt);
-    grid_->project();
+    grid_->project(dt);
     grid_->dry(dt);
   }
 
