@@ -1,9 +1,11 @@
 // The sparse canvas: empty cost, gather/scatter round trips at any position,
-// windows over the canvas edges, unallocated tiles, memory growing with paint.
+// windows over the canvas edges, unallocated tiles, memory growing with paint, drying by the
+// canvas clock and undo snapshots that keep it.
 #include <random>
 
 #include "backend_fixture.h"
 #include "core/canvas/tile_store.h"
+#include "core/io/undo_tiles.h"
 
 namespace wb::test {
 
@@ -131,6 +133,28 @@ TEST_F(TileStoreTest, TileReadWriteRoundTrip) {
   b.gather(wb);
   EXPECT_EQ(wa.to_host(), wb.to_host());
   EXPECT_THROW(b.write_tile(TileData{}), Error);
+}
+
+TEST_F(TileStoreTest, PaintDriesByTheClockAndUndoKeepsTheDrying) {
+  TileStore canvas(device_, CanvasDims{64, 64, 8});
+  TileData t = canvas.read_tile(0);
+  t.density[0] = 1.f;       // paint
+  t.dryness[1] = 1000;      // no paint: a stale dryness on an empty cell stays as it is
+  canvas.write_tile(t);
+  canvas.advance_drying(0.25);
+  EXPECT_NEAR(canvas.read_cell(0, 0, 0).dryness, 0.25f, 1e-4f);
+  EXPECT_EQ(canvas.read_tile(0).dryness[1], 1000);
+  const TileSnapshot snap = snapshot_tile(canvas, 0);
+  canvas.advance_drying(0.5);
+  canvas.advance_drying(0.5);  // past full: dryness stops at 1
+  EXPECT_EQ(canvas.read_cell(0, 0, 0).dryness, 1.f);
+  // Undo writes the old paint back with the drying it has had since the snapshot.
+  canvas.write_tile(t);  // the paint made wet again, as a stroke over it would
+  restore_tile(canvas, snap);
+  EXPECT_EQ(canvas.read_cell(0, 0, 0).dryness, 1.f);
+  canvas.advance_drying(0.1);
+  EXPECT_EQ(canvas.read_cell(0, 0, 0).dryness, 1.f);
+  EXPECT_THROW(canvas.advance_drying(-1.0), Error);
 }
 
 }  // namespace wb::test

@@ -38,6 +38,7 @@ TileSnapshot snapshot_tile(const TileStore& canvas, int tile_id) {
   TileSnapshot s;
   s.tile_id = tile_id;
   s.present = tile_present(canvas, tile_id);
+  s.clock = canvas.drying_clock();
   if (!s.present) return s;
   const TileData d = canvas.read_tile(tile_id);
   std::vector<uint8_t> raw;
@@ -74,6 +75,10 @@ void restore_tile(TileStore& canvas, const TileSnapshot& snap) {
   size_t at = 0;
   take(raw, at, d.density, cells);
   for (auto* v : {&d.pigment_r, &d.pigment_y, &d.pigment_b, &d.oil, &d.dryness}) take(raw, at, *v, cells);
+  const float since = float(canvas.drying_clock() - snap.clock);
+  if (since > 0.f)
+    for (size_t i = 0; i < cells; ++i)
+      if (d.density[i] > 0.f) d.dryness[i] = encode_unorm16(decode_unorm16(d.dryness[i]) + since);
   canvas.write_tile(d);
 }
 

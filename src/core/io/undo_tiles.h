@@ -14,12 +14,15 @@ namespace wb {
 struct TileSnapshot {
   int tile_id = -1;
   bool present = false;
+  double clock = 0.0;          ///< the canvas's drying clock when taken
   std::vector<uint8_t> zdata;  ///< compressed TileData fields (empty when absent)
 };
 
 /// Compresses one tile of the store (an unallocated tile gives present = false).
 TileSnapshot snapshot_tile(const TileStore& canvas, int tile_id);
-/// Writes the snapshot back; an absent tile is written as an empty (all-zero) tile when it
+/// Writes the snapshot back, its paint with the drying the canvas has done since it was taken
+/// (undo removes a stroke; it does not make the rest of the painting wetter). An absent tile is
+/// written as an empty (all-zero) tile when it
 /// is allocated now, and left alone otherwise.
 void restore_tile(TileStore& canvas, const TileSnapshot& snap);
 
