@@ -4,9 +4,13 @@
 // slumps where the slope is steeper than its yield stress holds and stays on a gentle one.
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <string>
 
 #include "backend_fixture.h"
 #include "core/grid/rheology.h"
+#include "core/io/document.h"
+#include "core/render/renderer.h"
 #include "grid/grid_test_util.h"
 
 namespace wb::test {
@@ -97,11 +101,12 @@ struct RestResult {
 };
 
 /// A ridge 15 cells (3 mm) high on a 4-cell layer and, beside it, grooves 2 cells (0.4 mm) apart,
-/// left alone for `seconds`. Uniform along y.
-RestResult paint_at_rest(const Device& device, float oil, float seconds) {
+/// left alone for `seconds`. Uniform along y, `width` cells wide. With WB_GALLERY_DIR set, the
+/// painting before and after is saved there (rest-oil-<oil>-<s>s.ora) for docs/EXAMPLES.md.
+RestResult paint_at_rest(const Device& device, float oil, float seconds, int width = 6) {
   TileStore canvas(device, CanvasDims{128, 64, 64});
   GridParams p;
-  Grid g(canvas, p, Int3{96, 6, 24}, Int3{0, 0, 0});
+  Grid g(canvas, p, Int3{96, width, 24}, Int3{0, 0, 0});
   const GridDims d = g.dims();
   auto height = [](int i) {
     if (i >= 8 && i < 40) return 4.f + 15.f * std::max(0.f, 1.f - std::fabs(float(i) + 0.5f - 24.f) / 16.f);
@@ -117,8 +122,19 @@ RestResult paint_at_rest(const Device& device, float oil, float seconds) {
     for (int i = 60; i < 84; i += 2) a += column(d, rho, i + 1, 3) - column(d, rho, i, 3);
     groove = float(a / 12.0);
   };
+  const char* gallery = std::getenv("WB_GALLERY_DIR");
+  auto save = [&](float at) {
+    if (gallery == nullptr) return;
+    g.window().flush();
+    char name[64];
+    std::snprintf(name, sizeof name, "/rest-oil-%.1f-%.0fs.ora", oil, at);
+    Renderer renderer(device);
+    save_painting(std::string(gallery) + name, canvas, renderer.render(canvas, Camera::top(canvas.dims())),
+                  nlohmann::json{{"generator", "RheologyTest paint_at_rest"}, {"oil", oil}, {"seconds", at}});
+  };
   RestResult r{};
   measure(r.ridge_before, r.groove_before);
+  save(0.f);
   const int steps = int(std::lround(seconds / p.dt));
   for (int s = 0; s < steps; ++s) {
     g.step(p.dt);
@@ -126,6 +142,7 @@ RestResult paint_at_rest(const Device& device, float oil, float seconds) {
     float& densest = s < steps / 2 ? r.densest_first : r.densest_last;
     for (float x : rho) densest = std::max(densest, x);
   }
+  save(seconds);
   measure(r.ridge_after, r.groove_after);
   std::printf("[ rest ] oil %.1f, %.0f s: ridge %.2f -> %.2f cells, grooves %.2f -> %.2f cells, densest cell %.2f then %.2f\n",
               oil, seconds, r.ridge_before, r.ridge_after, r.groove_before, r.groove_after, r.densest_first,
@@ -135,6 +152,10 @@ RestResult paint_at_rest(const Device& device, float oil, float seconds) {
 }  // namespace
 
 TEST_F(RheologyTest, StiffPaintHoldsRidgesAndGroovesOilyPaintLevels) {
+  if (std::getenv("WB_GALLERY_DIR")) {  // the gallery's wider strip: docs/EXAMPLES.md "Paint at rest"
+    for (float oil : {0.1f, 0.8f}) paint_at_rest(device_, oil, 2.f, 40);
+    return;
+  }
   const RestResult stiff = paint_at_rest(device_, 0.1f, 2.f);
   EXPECT_GE(stiff.ridge_after, 0.95f * stiff.ridge_before);
   EXPECT_GE(stiff.groove_after, 0.9f * stiff.groove_before);

@@ -19,11 +19,11 @@ void classify_d(const Device& d, GridView g, PaintWindowView pw, BristleField br
                 float lt, float dt) {
   WB_DISPATCH(d, grid_classify(g, pw, br, pd, cd.width, cd.height, cd.depth, lt, dt));
 }
-void outflow_d(const Device& d, GridView g, const float* rho, float* out) {
-  WB_DISPATCH(d, grid_paint_outflow(g, rho, out));
+void outflow_d(const Device& d, GridView g, const float* rho, float* out, float* top) {
+  WB_DISPATCH(d, grid_paint_outflow(g, rho, out, top));
 }
-void advect_axis_d(const Device& d, GridView g, PaintWindowView s, PaintWindowView t, int axis, float dt) {
-  WB_DISPATCH(d, grid_advect_paint_axis(g, s, t, axis, dt));
+void advect_axis_d(const Device& d, GridView g, PaintWindowView s, PaintWindowView t, int axis, float dt, int layers) {
+  WB_DISPATCH(d, grid_advect_paint_axis(g, s, t, axis, dt, layers));
 }
 void advect_vel_d(const Device& d, GridView g, const float* u, const float* v, const float* w, float dt) {
   WB_DISPATCH(d, grid_advect_velocity(g, u, v, w, dt));
@@ -297,17 +297,30 @@ void Grid::advect(float dt) {
   // Paint: flux form on the faces of the last step's velocity, one axis at a time (Strang order
   // x y z, then z y x), in sub-steps that keep each axis's outflow Courant number at most
   // advect_courant: no cell gives more than it holds, and no global correction is needed.
-  outflow_d(d, v, paint.density.data(), cell_tmp_.data());
+  outflow_d(d, v, paint.density.data(), cell_tmp_.data(), face_tmp_.data());
   const float rate = reduce_max(d, cell_tmp_.data(), g.cells(), ws_);
+  const int top = int(reduce_max(d, face_tmp_.data(), g.cells(), ws_));  // layers holding paint
   const float courant = std::isfinite(rate) ? rate * dt : 0.f;
   const int n = std::clamp(int(std::ceil(courant / params_.advect_courant)), 1, params_.advect_max_substeps);
   stats_.advect_substeps = n;
   stats_.advect_courant = courant / float(n);
+  // Work in proportion to the paint's height: a z pass moves paint at most one cell up, so above
+  // top + n layers nothing changes. Those layers of the scratch copy are made equal to the paint
+  // once, since the passes swap the two.
+  const int layers = std::min(g.nz, top + n);
+  const int64_t above = int64_t(layers) * g.nx * g.ny;
+  if (above < g.cells()) {
+#define WB_X(name, doc)                                                                     \
+  mem::copy_on_device(d, paint_tmp_.name.data() + above, paint.name.data() + above,         \
+                      size_t(g.cells() - above) * sizeof(float));
+    WB_PAINT_FIELDS(WB_X)
+#undef WB_X
+  }
   const float h = dt / float(n);
   for (int s = 0; s < n; ++s)
     for (int a = 0; a < 3; ++a) {
       const int axis = (s % 2 == 0) ? a : 2 - a;
-      advect_axis_d(d, v, paint.view(), paint_tmp_.view(), axis, h);
+      advect_axis_d(d, v, paint.view(), paint_tmp_.view(), axis, h, layers);
 #define WB_X(name, doc) paint.name.swap(paint_tmp_.name);
       WB_PAINT_FIELDS(WB_X)
 #undef WB_X

@@ -154,8 +154,9 @@ class Grid {
 #define WB_GRID_BACKEND_DECLS                                                                                        \
   void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float* particle_density, int canvas_w, int canvas_h, int canvas_d,     \
                      float liquid_threshold, float dry_threshold);                                                   \
-  void grid_paint_outflow(GridView g, const float* rho, float* out);                                                 \
-  void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt);            \
+  void grid_paint_outflow(GridView g, const float* rho, float* out, float* top);                                     \
+  void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt,             \
+                              int layers);                                                                           \
   void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt);                  \
   void grid_gravity(GridView g, float* ph, float g_dt);                                                              \
   void grid_effective_viscosity(GridView g, const float* oil, HerschelBulkley stiff, HerschelBulkley oily, float m,  \

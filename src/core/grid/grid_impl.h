@@ -60,20 +60,31 @@ void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float*
   });
 }
 
-void grid_paint_outflow(GridView g, const float* rho, float* out) {
+void grid_paint_outflow(GridView g, const float* rho, float* out, float* top) {
   const GridDims d = g.d;
   parallel_for(d.cells(), [=] WB_HD(int64_t c) {
     int i, j, k;
     d.decompose_cell(c, i, j, k);
     out[c] = cell_outflow_rate(g, rho, i, j, k);
+    top[c] = rho[c] != 0.f ? float(k + 1) : 0.f;
   });
 }
 
-void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt) {
+void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt, int layers) {
   const GridDims d = g.d;
-  parallel_for(d.cells(), [=] WB_HD(int64_t c) {
+  parallel_for(int64_t(layers) * d.nx * d.ny, [=] WB_HD(int64_t c) {
     int i, j, k;
     d.decompose_cell(c, i, j, k);
+    // Paint can only come from the cell or its two neighbours along the axis: air stays air.
+    const int64_t stride = axis == 0 ? 1 : (axis == 1 ? int64_t(d.nx) : int64_t(d.nx) * d.ny);
+    const int at = axis == 0 ? i : (axis == 1 ? j : k), n_axis = axis == 0 ? d.nx : (axis == 1 ? d.ny : d.nz);
+    if (src.density[c] == 0.f && (at == 0 || src.density[c - stride] == 0.f) &&
+        (at + 1 == n_axis || src.density[c + stride] == 0.f)) {
+#define WB_X(name, doc) dst.name[c] = src.name[c];
+      WB_PAINT_FIELDS(WB_X)
+#undef WB_X
+      return;
+    }
     int64_t from_lo, from_hi;
     // Paint in through the low face, out through the high one (signed): the same face flux is
     // computed, bit for bit, by the two cells it joins, so what one loses the other gains.
