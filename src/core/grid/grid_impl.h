@@ -92,14 +92,14 @@ void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst
     const float hi = face_paint_flux(g, src.density, axis, i + (axis == 0), j + (axis == 1), k + (axis == 2), dt,
                                      from_hi);
     const float rho = src.density[c];
-    const float rho_new = rho + (lo - hi);
+    const float rho_new = add_rn(rho, sub_rn(lo, hi));
     dst.density[c] = rho_new;
     // Pigment, oil and dryness travel with the paint at their donor's value (mass-weighted),
     // so each stays a convex mix of what met in the cell.
     auto carry = [&](const float* q, float* out) {
       const float in = from_lo >= 0 ? lo * q[from_lo] : 0.f;
       const float gone = from_hi >= 0 ? hi * q[from_hi] : 0.f;
-      out[c] = rho_new > 1e-12f ? (rho * q[c] + (in - gone)) / rho_new : q[c];
+      out[c] = rho_new > 1e-12f ? add_rn(rho * q[c], sub_rn(in, gone)) / rho_new : q[c];
     };
     static_assert(kPaintFieldCount == 6, "advect every paint field");
     carry(src.pigment_r, dst.pigment_r);

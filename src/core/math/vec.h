@@ -44,6 +44,24 @@ WB_HD WB_INLINE float clampf(float v, float lo, float hi) { return v < lo ? lo :
 WB_HD WB_INLINE int clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
 WB_HD WB_INLINE float minf(float a, float b) { return a < b ? a : b; }
 WB_HD WB_INLINE float maxf(float a, float b) { return a > b ? a : b; }
+/// a + b and a - b rounded as written, never fused with the multiply that made an operand (nvcc
+/// contracts x*y + z into one FMA): for sums two threads must round alike, such as a face's
+/// flux given by one cell and taken by the other. The host build turns contraction off
+/// (-ffp-contract=off in CMakeLists.txt).
+WB_HD WB_INLINE float add_rn(float a, float b) {
+#if defined(__CUDA_ARCH__)
+  return __fadd_rn(a, b);
+#else
+  return a + b;
+#endif
+}
+WB_HD WB_INLINE float sub_rn(float a, float b) {
+#if defined(__CUDA_ARCH__)
+  return __fsub_rn(a, b);
+#else
+  return a - b;
+#endif
+}
 
 /// Row-major 3x3 matrix; rows r[0..2].
 struct Mat3 {
