@@ -17,7 +17,7 @@ TEST_F(SimulatorTest, CleanBrushLeavesNoPaint) {
   for (int i = 0; i < 12; ++i) sim.step(pose_at(c.brush, 120.f + i, 128.f, 0.8f), 1.f / 60.f);
   sim.settle();
   EXPECT_EQ(sim.census().total(), 0.0);
-  EXPECT_EQ(sim.canvas().total_density(ws_), 0.0);
+  EXPECT_EQ(sim.canvas().total_density(), 0.0);
   EXPECT_EQ(sim.counters().nonfinite_events, 0);
 }
 
@@ -36,7 +36,7 @@ TEST_F(SimulatorTest, PressedLoadedBrushPaintsUnderItsFootprintAndBooksClose) {
   EXPECT_LT(std::abs(sim.books().max_drift()), 1e-4);
   EXPECT_NEAR(sim.census().total(), loaded, 1e-4 * loaded);
   EXPECT_LT(sim.books().totals().max_closure_error, 1e-5);
-  const double on_canvas = sim.canvas().total_density(ws_);
+  const double on_canvas = sim.canvas().total_density();
   ASSERT_GT(on_canvas, 0.0) << "a loaded brush pressed into the canvas left no paint";
   // Paint only under the footprint: within the brush's reach of the press point.
   const float reach = 0.5f * c.brush.width + c.brush.length * c.brush.max_press + 4.f;
@@ -76,7 +76,7 @@ TEST_F(SimulatorTest, DraggedBrushKeepsPaintingWithWickingAndGridOnlyHoldsNoPart
     EXPECT_LT(std::abs(sim.books().max_drift()), 1e-4);
     EXPECT_EQ(sim.counters().nonfinite_events, 0);
     if (held_max) *held_max = held;
-    return sim.canvas().total_density(ws_);
+    return sim.canvas().total_density();
   };
   const double wicked = drag(2000.f, true, nullptr);
   const double paper = drag(0.f, true, nullptr);

@@ -85,7 +85,7 @@ class StrokePropertiesTest : public SimulatorTest {
       const PaintCensus cs = sim.census();
       std::printf("books: expected %.4g kg, census %.4g (bristles %.3g, particles %.3g, grid %.3g), canvas %.1f cells\n",
                   sim.books().expected_total(), cs.total(), cs.bristles, cs.particles, cs.grid,
-                  sim.canvas().total_density(ws_));
+                  sim.canvas().total_density());
     }
     EXPECT_LT(std::abs(sim.books().max_drift()), 1e-4);
     EXPECT_EQ(sim.counters().nonfinite_events, 0);

@@ -83,6 +83,16 @@ void scatter_window(TileStoreView t, PaintWindowView w) {
   });
 }
 
+void scatter_mass(TileStoreView t, PaintWindowView w, float* before, float* after) {
+  parallel_for(w.size(), [=] WB_HD(int64_t i) {
+    int x, y, z;
+    detail::decompose(w, i, x, y, z);
+    const auto c = detail::locate(t, x + w.ox, y + w.oy, z + w.oz);
+    before[i] = c.at >= 0 ? t.density[c.at] : 0.f;
+    after[i] = c.at >= 0 ? w.density[i] : 0.f;  // what scatter_window will write there
+  });
+}
+
 void dry_all(TileStoreView t, int64_t cells) {
   parallel_for(cells, [=] WB_HD(int64_t i) {
     if (t.density[i] > 0.f) t.dryness[i] = 65535;

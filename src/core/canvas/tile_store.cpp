@@ -15,6 +15,9 @@ void mark_dispatch(const Device& d, TileStoreView t, PaintWindowView w, int tx0,
 }
 void scatter_dispatch(const Device& d, TileStoreView t, PaintWindowView w) { WB_DISPATCH(d, scatter_window(t, w)); }
 void dry_dispatch(const Device& d, TileStoreView t, int64_t cells) { WB_DISPATCH(d, dry_all(t, cells)); }
+void scatter_mass_dispatch(const Device& d, TileStoreView t, PaintWindowView w, float* before, float* after) {
+  WB_DISPATCH(d, scatter_mass(t, w, before, after));
+}
 void settle_dispatch(const Device& d, TileStoreView t, const int32_t* slots, int64_t n) {
   WB_DISPATCH(d, settle_tile_drying(t, slots, n));
 }
@@ -34,6 +37,9 @@ TileStore::TileStore(const Device& device, CanvasDims dims) : device_(device), d
   tile_flags_.set_device(device);
   dried_to_.set_device(device);
   settle_slots_.set_device(device);
+  ws_ = Workspace(device);
+  mass_before_.set_device(device);
+  mass_after_.set_device(device);
 }
 
 TileStoreView TileStore::view() {
@@ -114,6 +120,12 @@ void TileStore::scatter(PaintWindow& window) {
   // The window covers these tiles only in part: the rest of each must carry its drying before
   // the tile is marked up to date.
   settle_drying(touched);
+  // The running total: what the scatter writes less what it overwrites.
+  const int64_t cells = window.view().size();
+  mass_before_.resize(size_t(cells));
+  mass_after_.resize(size_t(cells));
+  scatter_mass_dispatch(device_, view(), window.view(), mass_before_.data(), mass_after_.data());
+  mass_ += reduce_sum(device_, mass_after_.data(), cells, ws_) - reduce_sum(device_, mass_before_.data(), cells, ws_);
   scatter_dispatch(device_, view(), window.view());
 }
 
@@ -143,6 +155,7 @@ void TileStore::clear() {
   tile_of_slot_.clear();
   host_dried_to_.clear();
   slots_used_ = 0;
+  mass_ = 0.0;
   slot_of_tile_.copy_from_host(host_slot_);
   if (slot_capacity_ > 0) {
     density_.fill_zero();
@@ -157,7 +170,7 @@ size_t TileStore::memory_bytes() const {
   return b;
 }
 
-double TileStore::total_density(Workspace& ws) const {
+double TileStore::recount_density(Workspace& ws) const {
   if (slots_used_ == 0) return 0.0;
   return reduce_sum(device_, density_.data(), int64_t(slots_used_) * tile_cells(), ws);
 }
@@ -220,6 +233,9 @@ void TileStore::write_tile(const TileData& d) {
              "write_tile: field sizes do not match the canvas depth");
   const int32_t slot = ensure_slot(d.tile_y * tiles_x_ + d.tile_x);
   const size_t at = size_t(slot) * n;
+  std::vector<float> old(n);
+  density_.copy_range_to_host(old.data(), at, n);
+  for (size_t i = 0; i < n; ++i) mass_ += double(d.density[i]) - double(old[i]);
   density_.copy_range_from_host(d.density.data(), at, n);
   pigment_r_.copy_range_from_host(d.pigment_r.data(), at, n);
   pigment_y_.copy_range_from_host(d.pigment_y.data(), at, n);

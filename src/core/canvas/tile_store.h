@@ -97,8 +97,12 @@ class TileStore {
   int allocated_tiles() const { return slots_used_; }
   /// Bytes held now: tile index (host and device) plus the pool's capacity.
   size_t memory_bytes() const;
-  /// Sum of density over all cells (in cell units), in double.
-  double total_density(Workspace& ws) const;
+  /// Sum of density over all cells (in cell units), in double: kept up to date by every write
+  /// (a scatter adds what it writes less what it overwrites), so reading it costs nothing
+  /// whatever the size of the painting.
+  double total_density() const { return mass_; }
+  /// The same sum counted over the whole tile pool (for tests of the running total).
+  double recount_density(Workspace& ws) const;
 
   PaintCell read_cell(int x, int y, int z) const;
   /// Ids (ty * tiles_x + tx) of the allocated tiles, in slot order.
@@ -128,6 +132,9 @@ class TileStore {
   DeviceBuffer<int32_t> tile_flags_;  ///< scratch of scatter: which window tiles hold paint
   std::vector<int32_t> host_flags_;
   double clock_ = 0.0;                 ///< drying clock
+  double mass_ = 0.0;                  ///< sum of density over the pool (total_density)
+  Workspace ws_;                       ///< scratch of the scatter's mass difference
+  DeviceBuffer<float> mass_before_, mass_after_;
   std::vector<float> host_dried_to_;   ///< per slot, mirror of dried_to_
   DeviceBuffer<float> dried_to_;
   DeviceBuffer<int32_t> settle_slots_;  ///< scratch of settle_drying
@@ -135,6 +142,7 @@ class TileStore {
 
 namespace cpu {
 void gather_window(TileStoreView t, PaintWindowView w);
+void scatter_mass(TileStoreView t, PaintWindowView w, float* before, float* after);
 void settle_tile_drying(TileStoreView t, const int32_t* slots, int64_t count);
 void mark_painted_tiles(TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* flags);
 void scatter_window(TileStoreView t, PaintWindowView w);
@@ -142,6 +150,7 @@ void dry_all(TileStoreView t, int64_t cells);
 }  // namespace cpu
 namespace cuda {
 void gather_window(TileStoreView t, PaintWindowView w);
+void scatter_mass(TileStoreView t, PaintWindowView w, float* before, float* after);
 void settle_tile_drying(TileStoreView t, const int32_t* slots, int64_t count);
 void mark_painted_tiles(TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* flags);
 void scatter_window(TileStoreView t, PaintWindowView w);

@@ -81,7 +81,7 @@ void ActiveWindow::reload() {
 }
 
 double ActiveWindow::total_mass(Workspace& ws) const {
-  return canvas_->total_density(ws) - gathered_mass_ + paint_.total_density(ws);
+  return canvas_->total_density() - gathered_mass_ + paint_.total_density(ws);
 }
 
 }  // namespace wb
