@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/exec/device.h"
+#include "core/canvas/tile_store.h"
 #include "core/grid/solver_study.h"
 
 namespace {
@@ -105,5 +106,31 @@ void BM_GridStep(benchmark::State& state) {
   for (auto _ : state) g.step(g.params().dt);
 }
 BENCHMARK(BM_GridStep)->Unit(benchmark::kMillisecond);
+
+// A step's cost must not grow with the painting: a 64 x 64 x 16 window with a 4-cell layer on a
+// canvas that holds state.range(0) painted tiles elsewhere (a 2-cell layer each; 10^4 tiles are
+// 570 MB of canvas). Books (track_mass) and drying on, as in the simulator.
+void BM_GridStepOnAPaintedCanvas(benchmark::State& state) {
+  const wb::Device device = wb::Device::from_env();
+  wb::TileStore canvas(device, wb::CanvasDims{2048, 2048, 16});
+  const int tiles = int(state.range(0));
+  for (int t = 0; t < tiles; ++t) {
+    const int id = canvas.tiles_x() * canvas.tiles_y() - 1 - t;  // from the far corner inwards
+    wb::TileData d = canvas.read_tile(id);
+    d.tile_x = id % canvas.tiles_x();
+    d.tile_y = id / canvas.tiles_x();
+    for (size_t i = 0; i < 2 * size_t(wb::kTileSize) * wb::kTileSize; ++i) d.density[i] = 1.f;
+    canvas.write_tile(d);
+  }
+  wb::Grid g(canvas, wb::GridParams{}, wb::Int3{64, 64, 16}, wb::Int3{32, 32, 0});
+  const wb::GridDims gd = g.dims();
+  std::vector<std::vector<float>> f(wb::kPaintFieldCount, std::vector<float>(size_t(gd.cells()), 0.f));
+  for (int64_t c = 0; c < gd.cells(); ++c)
+    if (c < 4 * int64_t(gd.nx) * gd.ny) f[0][size_t(c)] = 1.f, f[4][size_t(c)] = 0.3f;
+  g.window().paint().from_host(f);
+  for (auto _ : state) g.step(g.params().dt);
+  state.counters["painted_tiles"] = double(canvas.allocated_tiles());
+}
+BENCHMARK(BM_GridStepOnAPaintedCanvas)->Arg(0)->Arg(10000)->Unit(benchmark::kMillisecond);
 
 }  // namespace
