@@ -116,7 +116,8 @@ WB_HD WB_INLINE bool solid_cell(const SolidField& s, int cx, int cy, int cz) {
   const int32_t slot = t.slot_of_tile[(cy / kTileSize) * t.tiles_x + cx / kTileSize];
   if (slot < 0) return false;
   const int64_t at = int64_t(slot) * t.tile_cells() + t.cell_offset(cx % kTileSize, cy % kTileSize, cz);
-  return t.density[at] > 0.f && float(t.dryness[at]) >= s.dryness_threshold * 65535.f - 0.5f;
+  // With the drying the tile has not stored yet (TileStoreView::dryness_at), on the 16-bit lattice.
+  return t.density[at] > 0.f && t.dryness_at(slot, at) * 65535.f >= s.dryness_threshold * 65535.f - 0.5f;
 }
 
 /// Height a point at x must be lifted to: 0 below the canvas plane, the top of the run of
