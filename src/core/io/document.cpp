@@ -259,7 +259,9 @@ void write_file_atomic(const std::string& path, const std::vector<uint8_t>& byte
   namespace fs = std::filesystem;
   const fs::path target(path);
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  const std::string prefix = "." + target.filename().string() + ".tmp-";
+  std::string prefix = ".";  // appended, not "." + string&&: GCC 12 warns falsely (-Wrestrict) on that
+  prefix += target.filename().string();
+  prefix += ".tmp-";
   remove_stale_temporaries(dir, prefix);
   std::string tmpl = (dir / (prefix + std::to_string(::getpid()) + "-XXXXXX")).string();
   int fd = mkstemp(tmpl.data());
