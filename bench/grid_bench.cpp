@@ -88,7 +88,6 @@ void BM_GridProject(benchmark::State& state) {
   g.params().solver = state.range(0) == 0   ? wb::PressureSolver::FixedPoint
                       : state.range(0) == 1 ? wb::PressureSolver::Jacobi
                                             : wb::PressureSolver::Chebyshev;
-  g.params().track_mass = false;
   g.classify();
   for (auto _ : state) g.project(g.params().dt);
   g.params() = saved;
@@ -109,7 +108,7 @@ BENCHMARK(BM_GridStep)->Unit(benchmark::kMillisecond);
 
 // A step's cost must not grow with the painting: a 64 x 64 x 16 window with a 4-cell layer on a
 // canvas that holds state.range(0) painted tiles elsewhere (a 2-cell layer each; 10^4 tiles are
-// 570 MB of canvas). Books (track_mass) and drying on, as in the simulator.
+// 570 MB of canvas). Drying on, as in the simulator.
 void BM_GridStepOnAPaintedCanvas(benchmark::State& state) {
   const wb::Device device = wb::Device::from_env();
   wb::TileStore canvas(device, wb::CanvasDims{2048, 2048, 16});

@@ -43,7 +43,9 @@ class ProjectTest : public BackendTest {
 TEST_F(ProjectTest, ReducesDivergenceOnRandomWindows) {
   TileStore canvas(device_, CanvasDims{256, 256, 64});
   for (unsigned seed = 1; seed <= 3; ++seed) {
-    Grid g(canvas, GridParams{}, Int3{32, 32, 16}, Int3{16, 16, 0});
+    GridParams p;
+    p.projection_norms = true;
+    Grid g(canvas, p, Int3{32, 32, 16}, Int3{16, 16, 0});
     randomise(g, seed);
     HostBristles br(device_, g.dims().cells());
     br.psi.copy_from_host(psi_host_);
@@ -136,6 +138,7 @@ TEST_F(ProjectTest, ResidualIsTheDivergenceOfTheProjectedVelocity) {
   scene.prepare_system();
   Grid& g = scene.grid();
   g.params().jacobi_L = 3;
+  g.params().projection_norms = true;
   g.project(g.params().dt);
   const double after = g.divergence_norm(g.params().dt);
   EXPECT_NEAR(after, g.stats().residual_norm, 1e-4 * g.stats().rhs_norm);

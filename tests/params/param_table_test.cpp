@@ -42,8 +42,8 @@ TEST(ParamTable, ValidationRejectsBadValues) {
   EXPECT_THROW(apply_param_assignment(p, "grid.alpha=abc"), Error);
   apply_param_assignment(p, "grid.jacobi_L=5");
   EXPECT_EQ(p.grid.jacobi_L, 5);
-  apply_param_assignment(p, "grid.track_mass=false");
-  EXPECT_FALSE(p.grid.track_mass);
+  apply_param_assignment(p, "grid.projection_norms=true");
+  EXPECT_TRUE(p.grid.projection_norms);
 }
 
 TEST(ParamTable, JsonRoundTripAndUnknownKeys) {

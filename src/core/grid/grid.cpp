@@ -428,7 +428,7 @@ void Grid::project(float dt) {
     stats_.chebyshev_rho = cfg.rho;
   }
   solve_pressure(d, v.poisson(), rhs_.data(), pressure_.data(), cfg, scratch_);
-  if (params_.track_mass) {
+  if (params_.projection_norms) {
     stats_.rhs_norm = norm2(d, rhs_.data(), g.cells(), scratch_, ws_);
     residual_d(d, v.poisson(), rhs_.data(), pressure_.data(), scratch_.r.data());
     stats_.residual_norm = norm2(d, scratch_.r.data(), g.cells(), scratch_, ws_);
@@ -445,23 +445,19 @@ void Grid::dry(float dt) {
   window_.canvas().advance_drying(double(params_.dry_rate) * double(dt));
 }
 
-void Grid::step(float dt) {
+void Grid::step(float dt, const std::function<void()>& after_advection) {
   WB_PROFILE_SCOPE("grid.step");
   WB_REQUIRE(dt > 0.f && dt <= 0.1f, "Grid::step: dt must be in (0, 0.1] s");
   check_params(params_);
   classify();  // solids for the backtrace (dried paint is never moved)
   advect(dt);
+  if (after_advection) after_advection();  // the simulator joins the particles' fields here
   classify();  // liquid where the paint now is
   rheology();
   add_external_forces(dt);
   apply_viscosity(dt);
   project(dt);
   dry(dt);
-  if (params_.track_mass) {
-    stats_.window_mass = window_.window_mass(ws_);
-    stats_.total_mass = window_.total_mass(ws_);
-    stats_.canvas_mass = stats_.total_mass - stats_.window_mass;
-  }
 }
 
 double Grid::divergence_norm(float dt) {

@@ -15,15 +15,12 @@
 
 namespace wb {
 
-/// One step's books (mass in density-cells: sum of density; 1 = one full cell of paint).
+/// One step's counts and solver figures (the mass books are the simulator's, PaintBooks).
 struct GridStats {
-  double canvas_mass = 0;       ///< canvas outside the window region (+ window region as last gathered)
-  double window_mass = 0;       ///< sum of density in the window after the step
-  double total_mass = 0;        ///< canvas + window without double counting (ActiveWindow::total_mass)
   int advect_substeps = 0;      ///< sub-steps the paint's flux-form advection took (Courant <= advect_courant)
   float advect_courant = 0;     ///< largest one-axis outflow Courant number of a sub-step that moved paint
-  double rhs_norm = 0;          ///< ||div||_2 over liquid cells before the projection
-  double residual_norm = 0;     ///< ||div||_2 over liquid cells after it
+  double rhs_norm = 0;          ///< with projection_norms: ||rhs||_2 over liquid cells before the projection
+  double residual_norm = 0;     ///< with projection_norms: ||residual||_2 after it
   float chebyshev_rho = 0;      ///< rho used by the Chebyshev solver (estimated or given)
   int viscosity_faces = 0;      ///< fluid faces of the last viscous solve
   int viscosity_iterations = 0; ///< CG iterations it took
@@ -104,8 +101,10 @@ class Grid {
   /// Dryness += dry_rate * dt in every cell holding paint: the window's, and the canvas's by
   /// its drying clock (TileStore::advance_drying).
   void dry(float dt);
-  /// classify, advect, classify, rheology, add_external_forces, apply_viscosity, project, dry.
-  void step(float dt);
+  /// classify, advect, after_advection (the simulator joins the particles' density and momentum
+  /// to the grid there, §4.3), classify, rheology, add_external_forces, apply_viscosity, project,
+  /// dry. The one step driver of the grid stage.
+  void step(float dt, const std::function<void()>& after_advection = {});
 
   // --- for the particles (FLIP/PIC, Eq. 11) ---
   /// MAC velocity before the forces, the viscous and the pressure steps (component c = 0,1,2):

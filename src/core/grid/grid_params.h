@@ -91,8 +91,9 @@ struct GridParams {
   float advect_courant = 0.5f;
   /// Work bound of the paint's advection, sub-steps per step. Default 64, range [1, 1024].
   int advect_max_substeps = 64;
-  /// Compute the mass books (canvas, window, advection change) each step: 3 reductions. Default on.
-  bool track_mass = true;
+  /// Measure ||div|| before and after each projection (GridStats::rhs_norm, residual_norm): two
+  /// norms, two host reads a step. Default off.
+  bool projection_norms = false;
 
   // --- active window (§4.2 last paragraph) ---
   /// Window origins snap to multiples of this many cells, so the window moves (a scatter and a

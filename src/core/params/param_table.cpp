@@ -90,8 +90,8 @@ std::vector<ParamInfo> build_table() {
                "Largest outflow per axis of a paint sub-step, in cell volumes"),
       WB_PARAM(grid.advect_max_substeps, "Advection sub-steps", "", "", 1, 1024,
                "Work bound of the paint's advection, sub-steps per step"),
-      WB_PARAM(grid.track_mass, "Mass books", "", "", 0, 1,
-               "Compute the window's and canvas's mass every step (three reductions)"),
+      WB_PARAM(grid.projection_norms, "Projection norms", "", "", 0, 1,
+               "Measure the divergence before and after each projection (two reductions a step)"),
       WB_PARAM(grid.window_snap, "Window snap", "cells", "§4.2", 1, 64,
                "The active window moves in steps of this many cells"),
       // Particles (§4.3, Table 1).

@@ -186,15 +186,9 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
   //          fixed-point projection (Alg. 1), drying ---------------------------------------
   {
     WB_PROFILE_SCOPE("grid");
-    grid_->classify();
-    grid_->advect(dt);
-    if (config_.particles && particles_.size() > 0) joint_fields_stage();
-    grid_->classify();
-    grid_->rheology();
-    grid_->add_external_forces(dt);
-    grid_->apply_viscosity(dt);
-    grid_->project(dt);
-    grid_->dry(dt);
+    grid_->step(dt, [&] {
+      if (config_.particles && particles_.size() > 0) joint_fields_stage();
+    });
   }
 
   // --- 7. FLIP/PIC (Eq. 11): the grid keeps its velocity for the next step ---------------
