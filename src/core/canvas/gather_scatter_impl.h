@@ -54,6 +54,8 @@ void settle_tile_drying(TileStoreView t, const int32_t* slots, int64_t count) {
     const int64_t at = int64_t(slot) * n + i % n;
     t.dryness[at] = encode_unorm16(t.dryness_at(slot, at));
   });
+  // Then each slot is up to date (after every cell has read its old clock).
+  parallel_for(count, [=] WB_HD(int64_t k) { t.dried_to[slots[k]] = t.clock; });
 }
 
 void mark_painted_tiles(TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* flags) {
@@ -68,11 +70,14 @@ void mark_painted_tiles(TileStoreView t, PaintWindowView w, int tx0, int ty0, in
   });
 }
 
-void scatter_window(TileStoreView t, PaintWindowView w) {
+void scatter_window(TileStoreView t, PaintWindowView w, float* before, float* after) {
   parallel_for(w.size(), [=] WB_HD(int64_t i) {
     int x, y, z;
     detail::decompose(w, i, x, y, z);
     const auto c = detail::locate(t, x + w.ox, y + w.oy, z + w.oz);
+    // The density overwritten and written, for the canvas's running mass.
+    before[i] = c.at >= 0 ? t.density[c.at] : 0.f;
+    after[i] = c.at >= 0 ? w.density[i] : 0.f;
     if (c.at < 0) return;  // off-canvas, or an unallocated tile that received no paint
     t.density[c.at] = w.density[i];
     t.pigment_r[c.at] = encode_unorm16(w.pigment_r[i]);
@@ -80,16 +85,6 @@ void scatter_window(TileStoreView t, PaintWindowView w) {
     t.pigment_b[c.at] = encode_unorm16(w.pigment_b[i]);
     t.oil[c.at] = encode_unorm16(w.oil[i]);
     t.dryness[c.at] = encode_unorm16(w.dryness[i]);
-  });
-}
-
-void scatter_mass(TileStoreView t, PaintWindowView w, float* before, float* after) {
-  parallel_for(w.size(), [=] WB_HD(int64_t i) {
-    int x, y, z;
-    detail::decompose(w, i, x, y, z);
-    const auto c = detail::locate(t, x + w.ox, y + w.oy, z + w.oz);
-    before[i] = c.at >= 0 ? t.density[c.at] : 0.f;
-    after[i] = c.at >= 0 ? w.density[i] : 0.f;  // what scatter_window will write there
   });
 }
 

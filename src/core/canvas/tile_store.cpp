@@ -13,11 +13,10 @@ void gather_dispatch(const Device& d, TileStoreView t, PaintWindowView w) { WB_D
 void mark_dispatch(const Device& d, TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* f) {
   WB_DISPATCH(d, mark_painted_tiles(t, w, tx0, ty0, ntx, f));
 }
-void scatter_dispatch(const Device& d, TileStoreView t, PaintWindowView w) { WB_DISPATCH(d, scatter_window(t, w)); }
-void dry_dispatch(const Device& d, TileStoreView t, int64_t cells) { WB_DISPATCH(d, dry_all(t, cells)); }
-void scatter_mass_dispatch(const Device& d, TileStoreView t, PaintWindowView w, float* before, float* after) {
-  WB_DISPATCH(d, scatter_mass(t, w, before, after));
+void scatter_dispatch(const Device& d, TileStoreView t, PaintWindowView w, float* before, float* after) {
+  WB_DISPATCH(d, scatter_window(t, w, before, after));
 }
+void dry_dispatch(const Device& d, TileStoreView t, int64_t cells) { WB_DISPATCH(d, dry_all(t, cells)); }
 void settle_dispatch(const Device& d, TileStoreView t, const int32_t* slots, int64_t n) {
   WB_DISPATCH(d, settle_tile_drying(t, slots, n));
 }
@@ -110,23 +109,22 @@ void TileStore::scatter(PaintWindow& window) {
   mark_dispatch(device_, view(), window.view(), tx0, ty0, ntx, tile_flags_.data());
   host_flags_.resize(tile_flags_.size());
   tile_flags_.copy_to_host(host_flags_.data(), host_flags_.size());
-  std::vector<int32_t> touched;
+  touched_.clear();
   for (int j = 0; j < nty; ++j)
     for (int i = 0; i < ntx; ++i) {
       const int tile = (ty0 + j) * tiles_x_ + tx0 + i;
       if (host_flags_[size_t(j) * ntx + i]) ensure_slot(tile);
-      if (host_slot_[size_t(tile)] >= 0) touched.push_back(host_slot_[size_t(tile)]);
+      if (host_slot_[size_t(tile)] >= 0) touched_.push_back(host_slot_[size_t(tile)]);
     }
   // The window covers these tiles only in part: the rest of each must carry its drying before
   // the tile is marked up to date.
-  settle_drying(touched);
+  settle_drying(touched_);
   // The running total: what the scatter writes less what it overwrites.
   const int64_t cells = window.view().size();
   mass_before_.resize(size_t(cells));
   mass_after_.resize(size_t(cells));
-  scatter_mass_dispatch(device_, view(), window.view(), mass_before_.data(), mass_after_.data());
+  scatter_dispatch(device_, view(), window.view(), mass_before_.data(), mass_after_.data());
   mass_ += reduce_sum(device_, mass_after_.data(), cells, ws_) - reduce_sum(device_, mass_before_.data(), cells, ws_);
-  scatter_dispatch(device_, view(), window.view());
 }
 
 void TileStore::advance_drying(double amount) {
@@ -140,9 +138,8 @@ void TileStore::settle_drying(const std::vector<int32_t>& slots) {
   for (int32_t s : slots) behind = behind || host_dried_to_[size_t(s)] != float(clock_);
   if (!behind) return;
   settle_slots_.copy_from_host(slots);
-  settle_dispatch(device_, view(), settle_slots_.data(), int64_t(slots.size()));
+  settle_dispatch(device_, view(), settle_slots_.data(), int64_t(slots.size()));  // sets dried_to too
   for (int32_t s : slots) host_dried_to_[size_t(s)] = float(clock_);
-  dried_to_.copy_range_from_host(host_dried_to_.data(), 0, host_dried_to_.size());
 }
 
 void TileStore::dry_all() {
@@ -193,8 +190,7 @@ PaintCell TileStore::read_cell(int x, int y, int z) const {
   c.pigment_b = decode_unorm16(q[2]);
   c.oil = decode_unorm16(q[3]);
   c.dryness = decode_unorm16(q[4]);
-  const double lag = clock_ - double(host_dried_to_[size_t(slot)]);
-  if (c.density > 0.f && lag > 0.0) c.dryness = std::min(c.dryness + float(lag), 1.f);
+  if (c.density > 0.f) c.dryness = with_drying(c.dryness, owed_drying(slot));
   return c;
 }
 
@@ -217,10 +213,10 @@ TileData TileStore::read_tile(int tile_id) const {
   pigment_b_.copy_range_to_host(d.pigment_b.data(), at, n);
   oil_.copy_range_to_host(d.oil.data(), at, n);
   dryness_.copy_range_to_host(d.dryness.data(), at, n);
-  const float lag = float(clock_) - host_dried_to_[size_t(slot)];
+  const float lag = owed_drying(slot);
   if (lag > 0.f)
     for (size_t i = 0; i < n; ++i)
-      if (d.density[i] > 0.f) d.dryness[i] = encode_unorm16(decode_unorm16(d.dryness[i]) + lag);
+      if (d.density[i] > 0.f) d.dryness[i] = encode_unorm16(with_drying(decode_unorm16(d.dryness[i]), lag));
   return d;
 }
 

@@ -35,6 +35,10 @@ WB_HD WB_INLINE uint16_t encode_unorm16(float v) {
 }
 WB_HD WB_INLINE float decode_unorm16(uint16_t q) { return float(q) * (1.f / 65535.f); }
 
+/// Dryness `d` of paint after `lag` more drying: drying is linear and stops at 1, so drying owed
+/// can be added late, in one go (the canvas's drying clock, TileStore::advance_drying).
+WB_HD WB_INLINE float with_drying(float d, float lag) { return lag > 0.f ? (d + lag < 1.f ? d + lag : 1.f) : d; }
+
 /// POD view of the tile pool, passed by value to kernels.
 struct TileStoreView {
   const int32_t* slot_of_tile;  ///< tiles_x * tiles_y entries, -1 = not allocated
@@ -44,7 +48,7 @@ struct TileStoreView {
   uint16_t* pigment_b;
   uint16_t* oil;
   uint16_t* dryness;
-  const float* dried_to;        ///< per slot: the drying clock its stored dryness includes
+  float* dried_to;              ///< per slot: the drying clock its stored dryness includes
   float clock;                  ///< the canvas's drying clock (TileStore::advance_drying)
   int width, height, depth;
   int tiles_x, tiles_y;
@@ -53,9 +57,7 @@ struct TileStoreView {
   /// stored yet: paint (density > 0) gains clock - dried_to, up to 1.
   WB_HD float dryness_at(int32_t slot, int64_t at) const {
     const float d = decode_unorm16(dryness[at]);
-    if (!(density[at] > 0.f)) return d;
-    const float lag = clock - dried_to[slot];
-    return lag > 0.f ? (d + lag < 1.f ? d + lag : 1.f) : d;
+    return density[at] > 0.f ? with_drying(d, clock - dried_to[slot]) : d;
   }
   WB_HD int64_t cell_offset(int lx, int ly, int z) const { return (int64_t(z) * kTileSize + ly) * kTileSize + lx; }
   WB_HD bool inside(int x, int y, int z) const {
@@ -118,6 +120,8 @@ class TileStore {
   void grow_pool(int32_t slots);
   /// Brings the stored dryness of these slots up to the clock (scatter writes partial tiles).
   void settle_drying(const std::vector<int32_t>& slots);
+  /// Drying the tile in `slot` is owed (clock less the clock its stored dryness includes).
+  float owed_drying(int32_t slot) const { return float(clock_) - host_dried_to_[size_t(slot)]; }
 
   Device device_;
   CanvasDims dims_;
@@ -134,7 +138,8 @@ class TileStore {
   double clock_ = 0.0;                 ///< drying clock
   double mass_ = 0.0;                  ///< sum of density over the pool (total_density)
   Workspace ws_;                       ///< scratch of the scatter's mass difference
-  DeviceBuffer<float> mass_before_, mass_after_;
+  DeviceBuffer<float> mass_before_, mass_after_;  ///< per window cell: density overwritten, written
+  std::vector<int32_t> touched_;       ///< scratch of scatter: slots of the window's tiles
   std::vector<float> host_dried_to_;   ///< per slot, mirror of dried_to_
   DeviceBuffer<float> dried_to_;
   DeviceBuffer<int32_t> settle_slots_;  ///< scratch of settle_drying
@@ -142,18 +147,16 @@ class TileStore {
 
 namespace cpu {
 void gather_window(TileStoreView t, PaintWindowView w);
-void scatter_mass(TileStoreView t, PaintWindowView w, float* before, float* after);
 void settle_tile_drying(TileStoreView t, const int32_t* slots, int64_t count);
 void mark_painted_tiles(TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* flags);
-void scatter_window(TileStoreView t, PaintWindowView w);
+void scatter_window(TileStoreView t, PaintWindowView w, float* before, float* after);
 void dry_all(TileStoreView t, int64_t cells);
 }  // namespace cpu
 namespace cuda {
 void gather_window(TileStoreView t, PaintWindowView w);
-void scatter_mass(TileStoreView t, PaintWindowView w, float* before, float* after);
 void settle_tile_drying(TileStoreView t, const int32_t* slots, int64_t count);
 void mark_painted_tiles(TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* flags);
-void scatter_window(TileStoreView t, PaintWindowView w);
+void scatter_window(TileStoreView t, PaintWindowView w, float* before, float* after);
 void dry_all(TileStoreView t, int64_t cells);
 }  // namespace cuda
 

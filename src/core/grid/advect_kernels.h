@@ -44,39 +44,6 @@ WB_HD WB_INLINE Vec3 backtrace(const float* u, const float* v, const float* w, c
   return p;
 }
 
-/// Trilinear weights of the 8 cell centres around p (cell-centred lattice), with the
-/// solid cells left out and the rest renormalised, so that advection never copies
-/// dried paint into moving cells. Returns false when all 8 are solid.
-struct CellStencil {
-  int64_t idx[8];
-  float wgt[8];
-};
-WB_HD WB_INLINE bool cell_stencil_fluid(const GridDims& d, const uint8_t* cls, Vec3 p, CellStencil& s) {
-  const Stencil1 sx = stencil1(p.x, 0.5f, d.nx), sy = stencil1(p.y, 0.5f, d.ny), sz = stencil1(p.z, 0.5f, d.nz);
-  const int i0 = sx.i0, i1 = sx.i1, j0 = sy.i0, j1 = sy.i1, k0 = sz.i0, k1 = sz.i1;
-  const float fx = sx.w1, fy = sy.w1, fz = sz.w1;
-  float total = 0.f;
-  for (int n = 0; n < 8; ++n) {
-    const int i = (n & 1) ? i1 : i0, j = (n & 2) ? j1 : j0, k = (n & 4) ? k1 : k0;
-    const float wx = (n & 1) ? fx : 1.f - fx, wy = (n & 2) ? fy : 1.f - fy, wz = (n & 4) ? fz : 1.f - fz;
-    const int64_t c = d.cell(i, j, k);
-    const float wgt = cls[c] == kCellSolid ? 0.f : wx * wy * wz;
-    s.idx[n] = c;
-    s.wgt[n] = wgt;
-    total += wgt;
-  }
-  if (total <= 1e-12f) return false;
-  const float inv = 1.f / total;
-  for (int n = 0; n < 8; ++n) s.wgt[n] *= inv;
-  return true;
-}
-
-WB_HD WB_INLINE float apply_stencil(const CellStencil& s, const float* f) {
-  float acc = 0.f;
-  for (int n = 0; n < 8; ++n) acc += s.wgt[n] * f[s.idx[n]];
-  return acc;
-}
-
 /// Volume flux through face (c; i,j,k) per unit face area, cells/s: the mixture velocity
 /// theta u + (1 - theta) u_solid, whose divergence the projection zeroes (cell_divergence).
 /// Zero through closed faces and through every wall of the window (the top included), so
@@ -85,9 +52,7 @@ WB_HD WB_INLINE float face_volume_flux(const GridView& g, int c, int i, int j, i
   const GridDims& d = g.d;
   if ((c == 0 && (i == 0 || i == d.nx)) || (c == 1 && (j == 0 || j == d.ny)) || (c == 2 && (k == 0 || k == d.nz)))
     return 0.f;
-  const int64_t f = d.fidx(c, i, j, k);
-  const float t = g.theta[c][f];
-  return t * g.vel[c][f] + (1.f - t) * g.solid_vel[c][f];
+  return face_mixture_velocity(g, c, d.fidx(c, i, j, k));
 }
 
 /// Paint crossing face (c; i,j,k) in time dt as the scheme reconstructs it, density units (cell

@@ -94,4 +94,12 @@ struct GridView {
   }
 };
 
+/// Volume flux through face f of component c per unit face area, cells/s: the fluid part
+/// moves at the grid velocity, the bristle-covered part with the bristles (theta u + (1 - theta)
+/// u_solid). The projection zeroes its divergence; paint advection moves paint with it.
+WB_HD WB_INLINE float face_mixture_velocity(const GridView& g, int c, int64_t f) {
+  const float t = g.theta[c][f];
+  return t * g.vel[c][f] + (1.f - t) * g.solid_vel[c][f];
+}
+
 }  // namespace wb

@@ -78,10 +78,7 @@ WB_HD WB_INLINE bool face_is_fluid(const GridDims& d, const uint8_t* cls, const 
 /// This is the discrete divergence of the mixture velocity that the projection zeroes.
 WB_HD WB_INLINE float cell_divergence(const GridView& g, int i, int j, int k) {
   const GridDims& d = g.d;
-  auto flux = [&](int c, int64_t f) {
-    const float t = g.theta[c][f];
-    return t * g.vel[c][f] + (1.f - t) * g.solid_vel[c][f];
-  };
+  auto flux = [&](int c, int64_t f) { return face_mixture_velocity(g, c, f); };
   return flux(0, d.uidx(i + 1, j, k)) - flux(0, d.uidx(i, j, k)) + flux(1, d.vidx(i, j + 1, k)) -
          flux(1, d.vidx(i, j, k)) + flux(2, d.widx(i, j, k + 1)) - flux(2, d.widx(i, j, k));
 }

@@ -78,7 +78,7 @@ void restore_tile(TileStore& canvas, const TileSnapshot& snap) {
   const float since = float(canvas.drying_clock() - snap.clock);
   if (since > 0.f)
     for (size_t i = 0; i < cells; ++i)
-      if (d.density[i] > 0.f) d.dryness[i] = encode_unorm16(decode_unorm16(d.dryness[i]) + since);
+      if (d.density[i] > 0.f) d.dryness[i] = encode_unorm16(with_drying(decode_unorm16(d.dryness[i]), since));
   canvas.write_tile(d);
 }
 
