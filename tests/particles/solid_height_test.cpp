@@ -24,7 +24,7 @@ TEST_F(SolidHeightTest, DriedPaintRaisesTheFloorWetPaintDoesNot) {
   }
   w.from_host(f);
   DeviceBuffer<float> h(device_, size_t(n.x) * n.y), wet(device_, size_t(n.x) * n.y);
-  particles_solid_height(device_, w.view(), 0.95f, 0.5f, 0.25f, h.data(), wet.data());
+  particles_solid_height(device_, w.view(), nullptr, 0.95f, 0.5f, 0.25f, h.data(), wet.data());
   const std::vector<float> hh = h.to_host(), ww = wet.to_host();
   for (int j = 0; j < n.y; ++j) {
     EXPECT_FLOAT_EQ(hh[size_t(j) * n.x + 0], 0.25f) << "no paint: the canvas floor";

@@ -1,6 +1,6 @@
 // Properties of a stroke over paint already on the canvas, measured on the paint the stroke
-// leaves: a white brush drawn through wet red carries pink past it. Small brush, short
-// strokes (CI on two CPU cores).
+// leaves: a white brush drawn through wet red carries pink past it; a clean brush ploughs a wet
+// layer. Small brush, short strokes (CI on two CPU cores).
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -37,6 +37,7 @@ class LayerPropertiesTest : public SimulatorTest {
     c.brush.bristle_radius = env_or("WB_LAYER_BRISTLE_RADIUS", c.brush.bristle_radius);
     c.params.particles.delta = env_or("WB_LAYER_DELTA", c.params.particles.delta);
     c.params.particles.D1 = env_or("WB_LAYER_D1", c.params.particles.D1);
+    c.params.particles.D0 = env_or("WB_LAYER_D0", c.params.particles.D0);
     c.params.grid.dry_threshold = env_or("WB_LAYER_DRY_THRESHOLD", c.params.grid.dry_threshold);
     c.params.transfer.absorb_limit = int(env_or("WB_LAYER_ABSORB_LIMIT", float(c.params.transfer.absorb_limit)));
     c.params.transfer.bleed = env_or("WB_LAYER_BLEED", c.params.transfer.bleed);
@@ -252,6 +253,58 @@ TEST_F(LayerPropertiesTest, WhiteBrushCarriesRedPastAWetRedBand) {
   EXPECT_GE(redness(after) - redness(before), 0.04) << "the paint past the band looks pink";
 }
 
+
+// --- ploughing ---------------------------------------------------------------------------------
+
+TEST_F(LayerPropertiesTest, CleanBrushPloughsAWetLayer) {
+  // A wet uniform layer 4 cells (0.8 mm) thick, oil 0.3; a clean brush dragged through it at
+  // 60 mm/s, pressure 0.6. Paint per column across the track, averaged along its body. Most of
+  // the layer near the bristles is particles (§5.2): they rest in the joint paint, not on the
+  // canvas under it (docs/PARTICLES.md "Support in the joint paint").
+  constexpr int kW = 192, kH = 64;
+  constexpr float kLayer = 4.f, kX0 = 24.f, kX1 = 152.f;
+  SimConfig c = layer_config(CanvasDims{kW, kH, kDepth});
+  Simulator sim(c, pose_at(c.brush, kX0, kY, 0.f, false));
+  write_layer(sim, [](int, int, int z) {
+    PaintCell p;
+    if (float(z) < kLayer) p.density = 1.f, p.pigment_r = 0.1f, p.pigment_y = 0.15f, p.pigment_b = 0.85f, p.oil = 0.3f;
+    return p;
+  });
+  PaintLoad clean;
+  clean.load = 0.f;
+  sim.load_paint(clean);
+  Books books;
+  books.open(sim);
+  drag(sim, kX0, kX1, 300.f, 0.6f);
+  EXPECT_LT(books.max_drift(sim), 1e-4);
+  EXPECT_EQ(sim.counters().nonfinite_events, 0);
+  const auto f = canvas_fields(sim);
+  std::vector<double> col(kH, 0.0);
+  const int xa = int(kX0) + 32, xb = int(kX1) - 24;
+  for (int y = 0; y < kH; ++y)
+    for (int x = xa; x < xb; ++x)
+      for (int z = 0; z < kDepth; ++z) col[size_t(y)] += f[0][(size_t(z) * kH + y) * kW + x] / double(xb - xa);
+  if (verbose())
+    for (int y = 0; y < kH; ++y) std::printf("%d:%.2f%c", y, col[size_t(y)], y + 1 < kH ? ' ' : '\n');
+  const auto range = [&](int y0, int y1, bool want_max) {
+    double v = want_max ? 0.0 : 1e9;
+    for (int y = y0; y <= y1; ++y) v = want_max ? std::max(v, col[size_t(y)]) : std::min(v, col[size_t(y)]);
+    return v;
+  };
+  const int yc = int(kY);
+  const double track = range(yc - 2, yc + 1, false);
+  const double left = range(yc - 12, yc - 3, true), right = range(yc + 2, yc + 12, true);
+  double far = 0;
+  for (int y = 0; y < 8; ++y) far += 0.5 * (col[size_t(y)] + col[size_t(kH - 1 - y)]) / 8.0;
+  std::printf("column paint (cells): track %.2f, side ridges %.2f / %.2f, undisturbed %.2f; brush holds %.3g kg\n",
+              track, left, right, far, sim.census().bristles);
+  // Tolerances: the track loses at least a quarter of the layer; each side rises by at least 3 %
+  // of it (0.12 cells, 30x the far field's deviation); the layer away from the brush is untouched.
+  EXPECT_NEAR(far, kLayer, 0.01 * kLayer) << "the layer away from the brush";
+  EXPECT_LT(track, 0.75 * kLayer) << "the brush lowers its track";
+  EXPECT_GT(left, 1.03 * kLayer) << "paint pushed up beside the track";
+  EXPECT_GT(right, 1.03 * kLayer) << "paint pushed up beside the track";
+}
 }  // namespace
 // --- support ------------------------------------------------------------------------------------
 

@@ -45,11 +45,13 @@ WB_HD WB_INLINE bool inside_window(Vec3 q, int nx, int ny, int nz) {
 }
 
 /// Rasterises one particle of mass m and velocity vel at canvas position p: mass onto the
-/// cell centres, momentum m v_c and weight m onto the faces of each component c.
+/// cell centres, momentum m v_c and weight m onto the faces of each component c (mass only
+/// when g.mom[0] is null).
 WB_HD WB_INLINE void rasterise_particle(const ParticleRasterView& g, Vec3 p, Vec3 vel, float m) {
   const Vec3 q(p.x - float(g.ox), p.y - float(g.oy), p.z - float(g.oz));
   if (!inside_window(q, g.nx, g.ny, g.nz)) return;
   splat_nodes(g.mass, g.nx, g.ny, g.nz, 0.5f, 0.5f, 0.5f, q, m);
+  if (g.mom[0] == nullptr) return;
   splat_nodes(g.mom[0], g.nx + 1, g.ny, g.nz, 0.f, 0.5f, 0.5f, q, m * vel.x);
   splat_nodes(g.weight[0], g.nx + 1, g.ny, g.nz, 0.f, 0.5f, 0.5f, q, m);
   splat_nodes(g.mom[1], g.nx, g.ny + 1, g.nz, 0.5f, 0.f, 0.5f, q, m * vel.y);

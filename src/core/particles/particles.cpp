@@ -34,8 +34,9 @@ void particles_adhesion_step(const Device& d, const ParticleView& p, const Sampl
 
 void particles_rasterise(const Device& d, const ParticleView& p, const ParticleRasterView& g) {
   check_grid(g.nx, g.ny, g.nz, "rasterisation target");
-  WB_REQUIRE(g.mass && g.mom[0] && g.mom[1] && g.mom[2] && g.weight[0] && g.weight[1] && g.weight[2],
-             "particles_rasterise: a target field is null");
+  const bool faces = g.mom[0] && g.mom[1] && g.mom[2] && g.weight[0] && g.weight[1] && g.weight[2];
+  const bool mass_only = !g.mom[0] && !g.mom[1] && !g.mom[2] && !g.weight[0] && !g.weight[1] && !g.weight[2];
+  WB_REQUIRE(g.mass && (faces || mass_only), "particles_rasterise: a target field is null");
   WB_DISPATCH(d, particles_rasterise(p, g));
 }
 
@@ -75,13 +76,14 @@ void particles_compact_field(const Device& d, const uint32_t* src, uint32_t* dst
                              const uint32_t* pos, int64_t n) {
   WB_DISPATCH(d, particles_compact_field(src, dst, dead, pos, n));
 }
-void particles_solid_height(const Device& d, const PaintWindowView& pw, float dry_threshold, float liquid_threshold,
-                            float floor_z, float* height, float* wet_top) {
+void particles_solid_height(const Device& d, const PaintWindowView& pw, const float* particle_density,
+                            float dry_threshold, float liquid_threshold, float floor_z, float* height,
+                            float* wet_top) {
   WB_REQUIRE(pw.density && pw.dryness && height, "particles_solid_height: missing fields");
   WB_REQUIRE(std::isfinite(dry_threshold) && dry_threshold > 0.f && std::isfinite(liquid_threshold) &&
                  liquid_threshold > 0.f && std::isfinite(floor_z),
              "particles_solid_height: bad threshold or floor");
-  WB_DISPATCH(d, particles_solid_height(pw, dry_threshold, liquid_threshold, floor_z, height, wet_top));
+  WB_DISPATCH(d, particles_solid_height(pw, particle_density, dry_threshold, liquid_threshold, floor_z, height, wet_top));
 }
 
 void particles_init_scratch(const Device& d, const ParticleView& p, int64_t first, int64_t n) {

@@ -23,7 +23,8 @@ namespace wb {
 void particles_adhesion_step(const Device& d, const ParticleView& p, const SampleView& s, const SolidView& solid,
                              const ParticleParams& prm, float dt);
 /// Adds the particles' mass (cell centres) and momentum and mass weight (MAC faces) into g,
-/// trilinearly (flip_kernels.h). Particles outside the window are skipped.
+/// trilinearly (flip_kernels.h); the mass only when the face fields are all null. Particles
+/// outside the window are skipped.
 void particles_rasterise(const Device& d, const ParticleView& p, const ParticleRasterView& g);
 /// vel[c][f] = mom / weight on faces with weight > 0, else `empty` (e.g. 0).
 void particles_face_velocity(const Device& d, const ParticleRasterView& g, float* const vel[3], float empty);
@@ -45,9 +46,12 @@ void particles_compact_field(const Device& d, const uint32_t* src, uint32_t* dst
 /// Height fields of what the particles rest on over the window's columns (SolidView), absolute
 /// canvas z, nx * ny floats each: `height`, the top of the highest dried cell (dryness at or above
 /// dry_threshold, the grid's solid test) or floor_z where none; `wet_top` (nullable), the top
-/// of the highest liquid cell above it (density >= liquid_threshold), or `height` where none.
-void particles_solid_height(const Device& d, const PaintWindowView& pw, float dry_threshold, float liquid_threshold,
-                            float floor_z, float* height, float* wet_top = nullptr);
+/// of the highest liquid cell above it, or `height` where none. Liquid is the grid's joint test:
+/// density plus `particle_density` (the particles' raster, nullable) at or above liquid_threshold;
+/// where the layer near the bristles is mostly particles (§5.2), its grid density alone is air.
+void particles_solid_height(const Device& d, const PaintWindowView& pw, const float* particle_density,
+                            float dry_threshold, float liquid_threshold, float floor_z, float* height,
+                            float* wet_top = nullptr);
 /// Scratch of particles [first, first + n): nearest = -1, d_B = 0, key = 0, dead = 0.
 void particles_init_scratch(const Device& d, const ParticleView& p, int64_t first, int64_t n);
 
@@ -64,8 +68,8 @@ void particles_init_scratch(const Device& d, const ParticleView& p, int64_t firs
   void particles_compact_field(const uint32_t* src, uint32_t* dst, const uint32_t* dead, const uint32_t* pos,       \
                                int64_t n);                                                                         \
   void particles_init_scratch(ParticleView p, int64_t first, int64_t n);                                         \
-  void particles_solid_height(PaintWindowView pw, float dry_threshold, float liquid_threshold, float floor_z,    \
-                              float* height, float* wet_top);
+  void particles_solid_height(PaintWindowView pw, const float* particle_density, float dry_threshold,            \
+                              float liquid_threshold, float floor_z, float* height, float* wet_top);
 
 namespace cpu {
 WB_PARTICLES_BACKEND_DECLS

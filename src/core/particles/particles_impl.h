@@ -77,8 +77,8 @@ void particles_init_scratch(ParticleView p, int64_t first, int64_t n) {
   });
 }
 
-void particles_solid_height(PaintWindowView pw, float dry_threshold, float liquid_threshold, float floor_z,
-                            float* height, float* wet_top) {
+void particles_solid_height(PaintWindowView pw, const float* particle_density, float dry_threshold,
+                            float liquid_threshold, float floor_z, float* height, float* wet_top) {
   parallel_for(int64_t(pw.nx) * pw.ny, [=] WB_HD(int64_t c) {
     const int64_t layer = int64_t(pw.nx) * pw.ny;
     float top = floor_z, wet = -1e30f;
@@ -90,8 +90,9 @@ void particles_solid_height(PaintWindowView pw, float dry_threshold, float liqui
         top = maxf(top, float(pw.oz + k) + minf(rho, 1.f));
         break;
       }
-      // The highest liquid cell (the grid's liquid test) is the wet paint's free surface.
-      if (wet < -1e29f && rho >= liquid_threshold) wet = float(pw.oz + k) + minf(rho, 1.f);
+      // The highest liquid cell (the grid's joint liquid test) is the wet paint's free surface.
+      const float joint = rho + (particle_density ? particle_density[id] : 0.f);
+      if (wet < -1e29f && joint >= liquid_threshold) wet = float(pw.oz + k) + minf(joint, 1.f);
     }
     height[c] = top;
     if (wet_top) wet_top[c] = maxf(top, wet);

@@ -280,9 +280,17 @@ void Simulator::particle_stage(float dt) {
   hash_.build(brush_->samples(), prm.hash_cell, ws_, dt);
   hash_.query_nearest(particles_.view(), prm.D0);
   // The particles rest on the canvas and on dried paint (d_k of Eq. 8 is measured to both), and
-  // free ones land on the wet paint's surface.
+  // free ones land on the wet paint's surface. The wet paint is the joint paint, grid and
+  // particles, as the grid's liquid test counts it: near the bristles most of a layer is
+  // particles (§5.2), and its grid part alone would read as air that its particles fall through.
   ActiveWindow& win = grid_->window();
-  particles_solid_height(device(), win.paint().view(), config_.params.grid.dry_threshold,
+  const Int3 n = win.dims(), o = win.origin();
+  raster_mass_.fill_zero();
+  particles_rasterise(device(), particles_.view(),
+                      ParticleRasterView{raster_mass_.data(), {}, {}, n.x, n.y, n.z, o.x, o.y, o.z});
+  joint_scale(device(), raster_mass_.data(), raster_density_.data(), int64_t(raster_mass_.size()),
+              1.f / transfer_->params().cell_mass());
+  particles_solid_height(device(), win.paint().view(), raster_density_.data(), config_.params.grid.dry_threshold,
                          config_.params.grid.liquid_threshold, prm.floor_z, solid_height_.data(), wet_top_.data());
   SolidView solid;
   solid.floor_z = prm.floor_z;
