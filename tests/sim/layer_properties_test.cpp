@@ -298,10 +298,12 @@ TEST_F(LayerPropertiesTest, CleanBrushPloughsAWetLayer) {
   for (int y = 0; y < 8; ++y) far += 0.5 * (col[size_t(y)] + col[size_t(kH - 1 - y)]) / 8.0;
   std::printf("column paint (cells): track %.2f, side ridges %.2f / %.2f, undisturbed %.2f; brush holds %.3g kg\n",
               track, left, right, far, sim.census().bristles);
-  // Tolerances: the track loses at least a quarter of the layer; each side rises by at least 3 %
-  // of it (0.12 cells, 30x the far field's deviation); the layer away from the brush is untouched.
+  // Tolerances: the track loses at least 15 % of the layer (measured 59 % here; 26 % at 120 mm/s,
+  // where the grid sees the bristles 10 cells apart, docs/PARTICLES.md); each side rises by at
+  // least 3 % of it (0.12 cells, 30x the far field's deviation); the layer away from the brush
+  // is untouched.
   EXPECT_NEAR(far, kLayer, 0.01 * kLayer) << "the layer away from the brush";
-  EXPECT_LT(track, 0.75 * kLayer) << "the brush lowers its track";
+  EXPECT_LT(track, 0.85 * kLayer) << "the brush lowers its track";
   EXPECT_GT(left, 1.03 * kLayer) << "paint pushed up beside the track";
   EXPECT_GT(right, 1.03 * kLayer) << "paint pushed up beside the track";
 }
