@@ -149,6 +149,12 @@ class LayerPropertiesTest : public SimulatorTest {
               if (on_ridge) zr = std::min(zr, xs[j].z), gr = std::min(gr, lh.gap[j]), near_r += xs[j].z < 3.f + Rm;
               else zv = std::min(zv, xs[j].z), gv = std::min(gv, lh.gap[j]), near_v += xs[j].z < Rm;
             }
+            int deciles[10] = {};
+            for (size_t j = 0; j < xs.size(); ++j)
+              if ((int(std::floor(xs[j].x)) & 7) >= 4 && xs[j].z < 2.5f) ++deciles[(j % per) * 10 / per];
+            std::printf("  valley samples below z 2.5 by position along the bristle (root..tip):");
+            for (int dd : deciles) std::printf(" %d", dd);
+            std::printf("\n");
             std::printf("  over ridges: lowest sample z %.2f, least gap %.2f, %d within R_m of the top; over valleys: "
                         "lowest z %.2f, least gap %.2f, %d within R_m of the floor\n", zr, gr, near_r, zv, gv, near_v);
           }
@@ -307,6 +313,7 @@ TEST_F(LayerPropertiesTest, CleanBrushPloughsAWetLayer) {
   EXPECT_GT(left, 1.03 * kLayer) << "paint pushed up beside the track";
   EXPECT_GT(right, 1.03 * kLayer) << "paint pushed up beside the track";
 }
+
 }  // namespace
 // --- support ------------------------------------------------------------------------------------
 
