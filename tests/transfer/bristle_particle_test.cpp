@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/color/ryb.h"
+#include "core/particles/particle_params.h"
 #include "transfer/transfer_fixture.h"
 
 namespace wb::test {
@@ -329,6 +330,46 @@ TEST_F(BristleParticleTest, AbsorptionConservesMassAndTakesEachParticleOnce) {
   p.compact(ws_);
   EXPECT_NEAR(p.total_mass(ws_) + load.total_mass(ws_), particles_before + load_before, 1e-6 * particles_before);
   EXPECT_EQ(p.size(), int64_t(xs.size()) - n_dead);
+}
+
+TEST_F(BristleParticleTest, AbsorptionNeedsTheNearestSampleOnlyWithinTheLargestLoadSphere) {
+  // The same cloud absorbed after a nearest-sample query reaching D0 and one reaching only
+  // absorb_range(): the same particles go to the same samples (the step queries the latter).
+  HostSamples h = vertical_brush(3, 16, 0.8f, 16.f, 16.f, 10.f, 3.f);
+  DeviceSamples s(device_);
+  s.upload(h);
+  const TransferParams prm;
+  const ParticleParams pp;
+  ASSERT_LT(prm.absorb_range(), pp.D0);
+  std::vector<Vec3> xs;
+  for (int i = 0; i < 400; ++i) {
+    const float a = 0.37f * float(i), r = 0.1f + 2.5f * float(i % 17) / 17.f;
+    xs.push_back(Vec3(16.f + 3.f * float(i % 3 - 1) + r * std::cos(a), 16.f + r * std::sin(a),
+                      10.f + 0.031f * float(i)));
+  }
+  PaintWindow w = make_window({32, 32, 8}, {0, 0, 0}, [](int, int, int) { return 0.f; }, Vec3());
+  struct Result {
+    std::vector<uint32_t> dead;
+    BristleLoadHost load;
+  };
+  const auto absorb_after_query = [&](float range) {
+    BristleLoad load(device_, s.view().count(), prm);
+    ParticleStore p(device_);
+    p.append(particles_at(xs, 2e-10f, Vec3(0.f, 1.f, 0.f), 0.6f));
+    query_nearest(s, p, range);
+    Transfer t(device_, prm);
+    t.update_capacity(s.view(), load, env_for(w));
+    const BristleLoadHost lh = load.to_host();
+    for (float R : lh.radius) EXPECT_LE(R, prm.absorb_range() * (1.f + 1e-6f)) << "a load sphere beyond the range";
+    TransferRecord rec;
+    t.absorb(s.view(), load, p, rec);
+    EXPECT_GT(rec.absorbed_count, 0);
+    return Result{p.dead.to_host(), load.to_host()};
+  };
+  const Result wide = absorb_after_query(pp.D0), near = absorb_after_query(prm.absorb_range());
+  EXPECT_EQ(wide.dead, near.dead);
+  EXPECT_EQ(wide.load.m, near.load.m);
+  EXPECT_EQ(wide.load.pigment_y, near.load.pigment_y);
 }
 
 TEST_F(BristleParticleTest, AbsorptionStopsAtCapacityAndLimit) {

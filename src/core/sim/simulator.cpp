@@ -206,9 +206,10 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
   {
     WB_PROFILE_SCOPE("transfer");
     if (config_.particles) {
-      // The emission and absorption candidates are found against this step's samples.
+      // The absorption candidates are found against this step's samples, as far as the
+      // largest load sphere reaches (Eq. 14 takes a particle only inside R_j).
       hash_.build(brush_->samples(), config_.params.particles.hash_cell, ws_, 0.f);
-      hash_.query_nearest(particles_.view(), config_.params.particles.D0);
+      hash_.query_nearest(particles_.view(), transfer_->params().absorb_range());
     }
     TransferEnv env = transfer_env();
     env.dt = dt;  // wicking along the bristles over this step
@@ -276,9 +277,10 @@ void Simulator::particle_stage(float dt) {
   if (particles_.size() == 0) return;
   WB_PROFILE_SCOPE("particles");
   const ParticleParams& prm = config_.params.particles;
-  // Samples are at t + dt, particles at t: hash the samples rewound to t (hash_grid.h).
+  // Samples are at t + dt, particles at t: hash the samples rewound to t (hash_grid.h). The
+  // query reaches D1, the range of Eq. 10: beyond it no sample moves a particle.
   hash_.build(brush_->samples(), prm.hash_cell, ws_, dt);
-  hash_.query_nearest(particles_.view(), prm.D0);
+  hash_.query_nearest(particles_.view(), prm.D1);
   // The particles rest on the canvas and on dried paint (d_k of Eq. 8 is measured to both), and
   // free ones land on the wet paint's surface. The wet paint is the joint paint, grid and
   // particles, as the grid's liquid test counts it: near the bristles most of a layer is

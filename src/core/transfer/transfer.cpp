@@ -10,8 +10,14 @@
 #include "core/exec/dispatch.h"
 #include "core/exec/error.h"
 #include "core/exec/profile.h"
+#include "core/transfer/bristle_particle_kernels.h"
 
 namespace wb {
+
+float TransferParams::absorb_range() const {
+  // M'_j = max((1 - mu psi) M_max, M_min) (Eq. 12) is at most max(M_max, M_min).
+  return load_radius(std::max(M_max, M_min), cell_mass());
+}
 namespace {
 
 // One dispatcher per backend pass (WB_DISPATCH returns from the function it is in).

@@ -99,6 +99,9 @@ struct TransferParams {
 
   /// Mass of one full cell, kg: rho0 cell^3 (8e-9 kg by default).
   float cell_mass() const { return rho0 * cell_size * cell_size * cell_size; }
+  /// Largest load sphere of a sample (R_j of §5.1 at the largest capacity), cells: a particle
+  /// farther than this from every sample is absorbed by none (Eq. 14).
+  float absorb_range() const;
   /// M_max for a brush: rho0 times the sphere of `radii` bristle radii (cells) around a sample.
   static float capacity_for(float bristle_radius_cells, float radii = 3.f, float rho0 = 1000.f,
                             float cell_size = 2e-4f) {
