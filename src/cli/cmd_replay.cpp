@@ -110,14 +110,22 @@ void report_bench(const ReplayArgs& a, const Simulator& sim, const Stroke& strok
   nlohmann::json stages = nlohmann::json::object();
   std::printf("%s on %s: %lld steps, %lld particles at most\n", a.strokes.c_str(), device.to_string().c_str(),
               static_cast<long long>(steps), static_cast<long long>(sim.counters().particles_max));
-  std::printf("%-28s %10s %10s %7s %6s\n", "stage", "median ms", "p90 ms", "calls", "step%");
+  // Host reads per call of a scope, the mean over its calls (each read waits for the GPU).
+  auto mean_reads = [&](const std::string& name) {
+    const std::vector<int64_t>& r = prof.host_reads(name);
+    double s = 0;
+    for (int64_t x : r) s += double(x);
+    return r.empty() ? 0.0 : s / double(r.size());
+  };
+  std::printf("%-28s %10s %10s %7s %6s %8s\n", "stage", "median ms", "p90 ms", "calls", "step%", "reads");
   for (const std::string& name : prof.names()) {
     const std::vector<double>& v = prof.samples(name);
     const double med = prof.median_ms(name), p90 = pct(v, 0.9);
-    std::printf("%-28s %10.3f %10.3f %7zu %5.1f%%\n", name.c_str(), med, p90, v.size(),
-                step_ms > 0 ? 100.0 * med / step_ms : 0.0);
-    stages[name] = {{"median_ms", med}, {"p90_ms", p90}, {"calls", v.size()}};
+    std::printf("%-28s %10.3f %10.3f %7zu %5.1f%% %8.1f\n", name.c_str(), med, p90, v.size(),
+                step_ms > 0 ? 100.0 * med / step_ms : 0.0, mean_reads(name));
+    stages[name] = {{"median_ms", med}, {"p90_ms", p90}, {"calls", v.size()}, {"host_reads_mean", mean_reads(name)}};
   }
+  const double waits = mean_reads("sim.step");
   const double rate = step_ms > 0 ? 1e3 / step_ms : 0.0;
   std::printf("step rate %.1f steps/s, %.2f x real time (dt %.4g s); %s memory %.1f MiB peak, %.1f MiB held\n",
               rate, rate * stroke.dt, stroke.dt, device.is_cpu() ? "host" : "device",
@@ -128,6 +136,7 @@ void report_bench(const ReplayArgs& a, const Simulator& sim, const Stroke& strok
               it_med, it_max, res_med, res_max, double(sim.config().params.grid.viscosity_tolerance));
   std::printf("paint advection: %.0f sub-steps median, %.0f most (work bound %d)\n", pct(solve.substeps, 0.5),
               pct(solve.substeps, 1.0), sim.config().params.grid.advect_max_substeps);
+  std::printf("host waits: %.1f a step (mean; reads of device results, column `reads`)\n", waits);
   if (!a.bench_json.empty()) {
     nlohmann::json j{{"stroke", a.strokes},
                      {"device", device.to_string()},
@@ -135,6 +144,7 @@ void report_bench(const ReplayArgs& a, const Simulator& sim, const Stroke& strok
                      {"particles_max", sim.counters().particles_max},
                      {"step_rate", rate},
                      {"real_time_factor", rate * stroke.dt},
+                     {"host_waits_per_step", waits},
                      {"memory_peak_bytes", use.peak},
                      {"viscous_solve",
                       {{"iterations_median", it_med},

@@ -9,6 +9,7 @@
 #include "backend_fixture.h"
 #include "core/exec/algorithms.h"
 #include "core/exec/buffer.h"
+#include "core/exec/memory.h"
 #include "core/exec/selftest.h"
 
 namespace wb::test {
@@ -87,6 +88,30 @@ TEST_F(AlgorithmsTest, ReductionsAndNonFinite) {
   v[n - 1] = std::numeric_limits<float>::infinity();
   d.copy_from_host(v);
   EXPECT_EQ(count_nonfinite(device_, d.data(), n, ws_), 2);
+}
+
+TEST_F(AlgorithmsTest, SumIntoDeviceMemoryIsNotAHostRead) {
+  // reduce_sum_into leaves its result on the device; every primitive that returns a value to
+  // the host counts one host read, as does a copy to the host.
+  const int64_t n = 100003;
+  std::vector<float> v(static_cast<size_t>(n));
+  for (int64_t i = 0; i < n; ++i) v[size_t(i)] = float(i % 7) - 3.f + 0.25f;
+  DeviceBuffer<float> d(device_, static_cast<size_t>(n));
+  d.copy_from_host(v);
+  DeviceBuffer<double> out(device_, 2);
+  const int64_t r0 = mem::host_reads();
+  reduce_sum_into(device_, d.data(), n, out.data(), ws_);
+  reduce_sum_into(device_, d.data(), 0, out.data() + 1, ws_);
+  EXPECT_EQ(mem::host_reads(), r0);
+  const double direct = reduce_sum(device_, d.data(), n, ws_);
+  EXPECT_EQ(mem::host_reads(), r0 + 1);
+  const std::vector<double> h = out.to_host();
+  EXPECT_EQ(mem::host_reads(), r0 + 2);
+  double expect = 0.0;
+  for (float x : v) expect += double(x);
+  EXPECT_NEAR(h[0], expect, 1e-9 * double(n));
+  EXPECT_NEAR(h[0], direct, 1e-9 * double(n));
+  EXPECT_EQ(h[1], 0.0) << "the sum of nothing";
 }
 
 TEST_F(AlgorithmsTest, FloatAtomicsUnderContention) {

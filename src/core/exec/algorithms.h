@@ -15,23 +15,33 @@ void sort_by_key(const Device& device, uint32_t* keys, uint32_t* values, int64_t
 uint32_t exclusive_scan(const Device& device, const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);
 /// Sum in double precision (mass books need more than float accumulation).
 double reduce_sum(const Device& device, const float* in, int64_t n, Workspace& ws);
+/// The same sum written to *out, a device pointer: the result stays on the device for the
+/// kernels that use it, and the host does not wait for it (not a host read).
+void reduce_sum_into(const Device& device, const float* in, int64_t n, double* out, Workspace& ws);
 float reduce_max(const Device& device, const float* in, int64_t n, Workspace& ws);
 float reduce_min(const Device& device, const float* in, int64_t n, Workspace& ws);
 /// Number of NaN or infinite values.
 int64_t count_nonfinite(const Device& device, const float* in, int64_t n, Workspace& ws);
+/// The same count written to *out, a device pointer (not a host read): several arrays' counts
+/// gathered in one device buffer come back to the host in one copy.
+void count_nonfinite_into(const Device& device, const float* in, int64_t n, int64_t* out, Workspace& ws);
 
 namespace cpu {
+void count_nonfinite_into(const float* in, int64_t n, int64_t* out, Workspace& ws);
 void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Workspace& ws);
 uint32_t exclusive_scan(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);
 double reduce_sum(const float* in, int64_t n, Workspace& ws);
+void reduce_sum_into(const float* in, int64_t n, double* out, Workspace& ws);
 float reduce_max(const float* in, int64_t n, Workspace& ws);
 float reduce_min(const float* in, int64_t n, Workspace& ws);
 int64_t count_nonfinite(const float* in, int64_t n, Workspace& ws);
 }  // namespace cpu
 namespace cuda {
+void count_nonfinite_into(const float* in, int64_t n, int64_t* out, Workspace& ws);
 void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Workspace& ws);
 uint32_t exclusive_scan(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);
 double reduce_sum(const float* in, int64_t n, Workspace& ws);
+void reduce_sum_into(const float* in, int64_t n, double* out, Workspace& ws);
 float reduce_max(const float* in, int64_t n, Workspace& ws);
 float reduce_min(const float* in, int64_t n, Workspace& ws);
 int64_t count_nonfinite(const float* in, int64_t n, Workspace& ws);

@@ -86,6 +86,25 @@ double reduce_sum(const float* in, int64_t n, Workspace& ws) {
   return reduce(thrust::make_transform_iterator(in, ToDouble{}), n, ::cuda::std::plus<double>{}, 0.0, ws);
 }
 
+void reduce_sum_into(const float* in, int64_t n, double* out, Workspace& ws) {
+  // CUB writes the sum of an empty range as the initial value, so n == 0 gives 0 too.
+  auto it = thrust::make_transform_iterator(in, ToDouble{});
+  size_t temp = 0;
+  WB_CUDA_CHECK(cub::DeviceReduce::Reduce(nullptr, temp, it, out, n, ::cuda::std::plus<double>{}, 0.0, wb::cuda_stream()));
+  void* base = ws.get(temp);
+  WB_CUDA_CHECK(cub::DeviceReduce::Reduce(base, temp, it, out, n, ::cuda::std::plus<double>{}, 0.0, wb::cuda_stream()));
+}
+
+void count_nonfinite_into(const float* in, int64_t n, int64_t* out, Workspace& ws) {
+  static_assert(sizeof(int64_t) == sizeof(long long), "count type");
+  auto it = thrust::make_transform_iterator(in, NonFinite{});
+  auto* dst = reinterpret_cast<long long*>(out);
+  size_t temp = 0;
+  WB_CUDA_CHECK(cub::DeviceReduce::Reduce(nullptr, temp, it, dst, n, ::cuda::std::plus<long long>{}, 0LL, wb::cuda_stream()));
+  void* base = ws.get(temp);
+  WB_CUDA_CHECK(cub::DeviceReduce::Reduce(base, temp, it, dst, n, ::cuda::std::plus<long long>{}, 0LL, wb::cuda_stream()));
+}
+
 float reduce_max(const float* in, int64_t n, Workspace& ws) {
   return reduce(in, n, MaxOp{}, -::cuda::std::numeric_limits<float>::infinity(), ws);
 }

@@ -56,6 +56,12 @@ void reset_peak() {
   for (Usage& u : l.use) u.peak = u.in_use;
 }
 
+namespace {
+thread_local int64_t t_host_reads = 0;  // per thread: the studio's UI and simulation threads apart
+}
+int64_t host_reads() { return t_host_reads; }
+void count_host_read() { ++t_host_reads; }
+
 void* allocate(const Device& device, size_t bytes) {
   if (bytes == 0) bytes = 1;
   if (device.is_cpu()) {
@@ -88,6 +94,7 @@ void release(const Device& device, void* ptr) noexcept {
 }
 
 void copy_to_host(const Device& device, void* host_dst, const void* dev_src, size_t bytes) {
+  count_host_read();
   if (device.is_cpu()) {
     std::memcpy(host_dst, dev_src, bytes);
     return;

@@ -22,4 +22,12 @@ struct Usage {
 Usage usage(bool cuda);
 void reset_peak();
 
+/// Reads by the host of results the device computed (a copy to the host, a reduction's value, a
+/// scan's total) made by the calling thread so far. On CUDA each one drains the stream and
+/// waits; on the CPU backend the same call sites are counted, so a test there measures what
+/// the GPU would wait for.
+int64_t host_reads();
+/// Counts one such read (copy_to_host and every primitive of algorithms.h that returns a value).
+void count_host_read();
+
 }  // namespace wb::mem

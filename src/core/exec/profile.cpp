@@ -31,6 +31,11 @@ const std::vector<double>& Profiler::samples(const std::string& name) const {
   auto it = samples_.find(name);
   return it == samples_.end() ? empty : it->second;
 }
+const std::vector<int64_t>& Profiler::host_reads(const std::string& name) const {
+  static const std::vector<int64_t> empty;
+  auto it = reads_.find(name);
+  return it == reads_.end() ? empty : it->second;
+}
 std::vector<std::string> Profiler::names() const {
   std::vector<std::string> n;
   for (auto& [k, v] : samples_) n.push_back(k);

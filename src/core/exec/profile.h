@@ -1,6 +1,7 @@
 // Per-stage timing. WB_PROFILE_SCOPE("grid.project") times the enclosing scope into
-// the profiler installed on this thread (none: free). On CUDA the scope synchronises
-// at its ends so that the time is the stage's, not the launch's.
+// the profiler installed on this thread (none: free), and counts the host reads made in it
+// (mem::host_reads). On CUDA the scope synchronises at its ends so that the time is the
+// stage's, not the launch's.
 #pragma once
 #include <chrono>
 #include <map>
@@ -8,13 +9,17 @@
 #include <vector>
 
 #include "core/exec/device.h"
+#include "core/exec/memory.h"
 
 namespace wb {
 
 class Profiler {
  public:
   explicit Profiler(Device device = {}) : device_(device) {}
-  void add(const char* name, double ms) { samples_[name].push_back(ms); }
+  void add(const char* name, double ms, int64_t host_reads = 0) {
+    samples_[name].push_back(ms);
+    reads_[name].push_back(host_reads);
+  }
   /// Median of the recorded samples of `name` in ms (0 when none).
   double median_ms(const std::string& name) const;
   double total_ms(const std::string& name) const;
@@ -22,7 +27,12 @@ class Profiler {
   std::vector<std::string> names() const;
   /// Every recorded duration of `name`, in ms, in order.
   const std::vector<double>& samples(const std::string& name) const;
-  void clear() { samples_.clear(); }
+  /// Host reads (mem::host_reads) made in each recorded call of `name`, in order.
+  const std::vector<int64_t>& host_reads(const std::string& name) const;
+  void clear() {
+    samples_.clear();
+    reads_.clear();
+  }
   const Device& device() const { return device_; }
 
   /// The profiler of the calling thread (may be null).
@@ -32,6 +42,7 @@ class Profiler {
  private:
   Device device_;
   std::map<std::string, std::vector<double>> samples_;
+  std::map<std::string, std::vector<int64_t>> reads_;
 };
 
 class ProfileScope {
@@ -39,13 +50,15 @@ class ProfileScope {
   explicit ProfileScope(const char* name) : name_(name), prof_(Profiler::current()) {
     if (prof_) {
       prof_->device().synchronize();
+      reads_ = mem::host_reads();
       start_ = std::chrono::steady_clock::now();
     }
   }
   ~ProfileScope() {
     if (!prof_) return;
     prof_->device().synchronize();
-    prof_->add(name_, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count());
+    prof_->add(name_, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count(),
+               mem::host_reads() - reads_);
   }
   ProfileScope(const ProfileScope&) = delete;
   ProfileScope& operator=(const ProfileScope&) = delete;
@@ -53,6 +66,7 @@ class ProfileScope {
  private:
   const char* name_;
   Profiler* prof_;
+  int64_t reads_ = 0;
   std::chrono::steady_clock::time_point start_{};
 };
 

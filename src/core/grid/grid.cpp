@@ -48,12 +48,12 @@ void pcg_start_d(const Device& d, int64_t n, const float* b, const float* ax, co
                  float* p, float* rz, float* bz) {
   WB_DISPATCH(d, grid_pcg_start(n, b, ax, diag, r, z, p, rz, bz));
 }
-void pcg_update_d(const Device& d, int64_t n, float alpha, const float* p, const float* q, const float* diag, float* x,
-                  float* r, float* z, float* rz) {
-  WB_DISPATCH(d, grid_pcg_update(n, alpha, p, q, diag, x, r, z, rz));
+void pcg_update_d(const Device& d, int64_t n, const double* rz_old, const double* pq, const float* p, const float* q,
+                  const float* diag, float* x, float* r, float* z, float* rz) {
+  WB_DISPATCH(d, grid_pcg_update(n, rz_old, pq, p, q, diag, x, r, z, rz));
 }
-void pcg_direction_d(const Device& d, int64_t n, float beta, const float* z, float* p) {
-  WB_DISPATCH(d, grid_pcg_direction(n, beta, z, p));
+void pcg_direction_d(const Device& d, int64_t n, const double* rz_new, const double* rz_old, const float* z, float* p) {
+  WB_DISPATCH(d, grid_pcg_direction(n, rz_new, rz_old, z, p));
 }
 void visc_write_d(const Device& d, GridView g, const uint32_t* list, int64_t n, const float* x) {
   WB_DISPATCH(d, grid_viscous_write(g, list, n, x));
@@ -251,6 +251,8 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   cg_nb_.set_device(d);
   for (auto* b : {&cg_nu_, &cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_, &cg_dot_a_, &cg_dot_b_})
     b->set_device(d);
+  cg_sums_.set_device(d);
+  cg_sums_.resize(4);
   paint_tmp_ = PaintWindow(d, dims);
   scratch_.reserve(d, g.cells());
   classify();
@@ -380,24 +382,34 @@ void Grid::apply_viscosity(float dt) {
   visc_setup_d(d, v, list, n, idx, mu_.data(), nu_scale, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_b_.data(),
                cg_x_.data());
   // Jacobi-preconditioned conjugate gradients (Saad 2003, Alg. 9.1) from the current velocity.
+  // alpha and beta are formed on the device from sums kept there (cg_sums_: r.z of the current
+  // and the next iteration, p.Ap, b.D^-1 b), so an iteration makes no host read; the host reads
+  // r.z to test convergence every kCgCheckEvery iterations (one read instead of two an iteration;
+  // the few extra iterations only reduce the residual further).
+  constexpr int kCgCheckEvery = 8;
+  double* sums = cg_sums_.data();
   visc_apply_d(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_x_.data(), cg_q_.data(), cg_dot_a_.data());
   pcg_start_d(d, n, cg_b_.data(), cg_q_.data(), cg_diag_.data(), cg_r_.data(), cg_z_.data(), cg_p_.data(),
               cg_dot_a_.data(), cg_dot_b_.data());
-  double rz = reduce_sum(d, cg_dot_a_.data(), n, ws_);
-  const double bnorm = reduce_sum(d, cg_dot_b_.data(), n, ws_);
+  reduce_sum_into(d, cg_dot_a_.data(), n, sums + 0, ws_);
+  reduce_sum_into(d, cg_dot_b_.data(), n, sums + 3, ws_);
+  double host[4];
+  cg_sums_.copy_to_host(host, 4);
+  double rz = host[0];
+  const double bnorm = host[3];
   const double target = double(params_.viscosity_tolerance) * double(params_.viscosity_tolerance) * bnorm;
-  int it = 0;
+  int it = 0, cur = 0;
   while (it < params_.viscosity_max_iterations && rz > target && rz > 0.0) {
+    const int next = 1 - cur;
     visc_apply_d(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_p_.data(), cg_q_.data(), cg_dot_a_.data());
-    const double pq = reduce_sum(d, cg_dot_a_.data(), n, ws_);
-    if (!(pq > 0.0)) break;  // SPD: only round-off at convergence gets here
-    const float alpha = float(rz / pq);
-    pcg_update_d(d, n, alpha, cg_p_.data(), cg_q_.data(), cg_diag_.data(), cg_x_.data(), cg_r_.data(), cg_z_.data(),
-                 cg_dot_a_.data());
-    const double rz_new = reduce_sum(d, cg_dot_a_.data(), n, ws_);
-    pcg_direction_d(d, n, float(rz_new / rz), cg_z_.data(), cg_p_.data());
-    rz = rz_new;
+    reduce_sum_into(d, cg_dot_a_.data(), n, sums + 2, ws_);
+    pcg_update_d(d, n, sums + cur, sums + 2, cg_p_.data(), cg_q_.data(), cg_diag_.data(), cg_x_.data(), cg_r_.data(),
+                 cg_z_.data(), cg_dot_a_.data());
+    reduce_sum_into(d, cg_dot_a_.data(), n, sums + next, ws_);
+    pcg_direction_d(d, n, sums + next, sums + cur, cg_z_.data(), cg_p_.data());
+    cur = next;
     ++it;
+    if (it % kCgCheckEvery == 0 || it == params_.viscosity_max_iterations) cg_sums_.copy_range_to_host(&rz, size_t(cur), 1);
   }
   stats_.viscosity_iterations = it;
   stats_.viscosity_residual = bnorm > 0.0 ? std::sqrt(std::max(rz, 0.0) / bnorm) : 0.0;

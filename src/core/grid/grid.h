@@ -144,6 +144,8 @@ class Grid {
   DeviceBuffer<uint32_t> visc_idx_, visc_list_;
   DeviceBuffer<int32_t> cg_nb_;
   DeviceBuffer<float> cg_nu_, cg_x_, cg_b_, cg_r_, cg_z_, cg_p_, cg_q_, cg_diag_, cg_dot_a_, cg_dot_b_;
+  /// The CG's scalars on the device: r.z of the two latest iterations, p.Ap, b.D^-1 b.
+  DeviceBuffer<double> cg_sums_;
   PaintWindow paint_tmp_;
   SolverScratch scratch_;
   Workspace ws_;
@@ -168,9 +170,9 @@ class Grid {
                           float* q, float* pq);                                                                      \
   void grid_pcg_start(int64_t n, const float* b, const float* ax, const float* diag, float* r, float* z, float* p,  \
                       float* rz, float* bz);                                                                         \
-  void grid_pcg_update(int64_t n, float alpha, const float* p, const float* q, const float* diag, float* x,         \
-                       float* r, float* z, float* rz);                                                               \
-  void grid_pcg_direction(int64_t n, float beta, const float* z, float* p);                                         \
+  void grid_pcg_update(int64_t n, const double* rz_old, const double* pq, const float* p, const float* q,            \
+                       const float* diag, float* x, float* r, float* z, float* rz);                                 \
+  void grid_pcg_direction(int64_t n, const double* rz_new, const double* rz_old, const float* z, float* p);        \
   void grid_viscous_write(GridView g, const uint32_t* list, int64_t n, const float* x);                             \
   void grid_rhs(GridView g, const float* rho, float inv_dt, float* b);                                                                               \
   void poisson_jacobi(PoissonView s, const float* b, const float* x, float* out, float omega);                      \

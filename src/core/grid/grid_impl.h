@@ -233,9 +233,12 @@ void grid_pcg_start(int64_t n, const float* b, const float* ax, const float* dia
   });
 }
 
-void grid_pcg_update(int64_t n, float alpha, const float* p, const float* q, const float* diag, float* x, float* r,
-                     float* z, float* rz) {
+void grid_pcg_update(int64_t n, const double* rz_old, const double* pq, const float* p, const float* q,
+                     const float* diag, float* x, float* r, float* z, float* rz) {
   parallel_for(n, [=] WB_HD(int64_t e) {
+    // alpha = (r.z) / (p.Ap) from the device sums; 0 (no step) where p.Ap is not positive,
+    // which an SPD system reaches only by round-off at convergence.
+    const float alpha = *pq > 0.0 ? float(*rz_old / *pq) : 0.f;
     x[e] += alpha * p[e];
     r[e] -= alpha * q[e];
     z[e] = r[e] / diag[e];
@@ -243,8 +246,11 @@ void grid_pcg_update(int64_t n, float alpha, const float* p, const float* q, con
   });
 }
 
-void grid_pcg_direction(int64_t n, float beta, const float* z, float* p) {
-  parallel_for(n, [=] WB_HD(int64_t e) { p[e] = z[e] + beta * p[e]; });
+void grid_pcg_direction(int64_t n, const double* rz_new, const double* rz_old, const float* z, float* p) {
+  parallel_for(n, [=] WB_HD(int64_t e) {
+    const float beta = *rz_old > 0.0 ? float(*rz_new / *rz_old) : 0.f;
+    p[e] = z[e] + beta * p[e];
+  });
 }
 
 void grid_viscous_write(GridView g, const uint32_t* list, int64_t n, const float* x) {

@@ -59,6 +59,7 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
     b->set_device(d);
     b->resize(size_t(g.nx) * size_t(g.ny));
   }
+  nonfinite_counts_.set_device(d);
   for (int c = 0; c < 3; ++c) {
     cells(bristle_v_[c]);
     cells(cell_v_[c]);
@@ -337,6 +338,7 @@ void Simulator::joint_fields_stage() {
 void Simulator::contain_nonfinite() {
   // A non-finite value anywhere in the live state is zeroed (grid) or removed (particles)
   // before anything renders or scatters it; the event is counted and the books show the loss.
+  // Every array is counted on the device and the counts come back in one copy (one host read).
   ActiveWindow& win = grid_->window();
   PaintWindow& paint = win.paint();
   int64_t bad = 0;
@@ -346,16 +348,21 @@ void Simulator::contain_nonfinite() {
 #undef WB_X
       {win.velocity(0).data(), int64_t(win.velocity(0).size())},
       {win.velocity(1).data(), int64_t(win.velocity(1).size())},
-      {win.velocity(2).data(), int64_t(win.velocity(2).size())}};
-  for (const auto& [p, n] : arrays) {
-    const int64_t k = count_nonfinite(device(), p, n, ws_);
-    if (k) joint_zero_nonfinite(device(), p, n);
-    bad += k;
+      {win.velocity(2).data(), int64_t(win.velocity(2).size())},
+      {reinterpret_cast<float*>(particles_.x.data()), 3 * particles_.size()},
+      {particles_.m.data(), particles_.size()}};
+  constexpr size_t kArrays = std::size(arrays), kParticleArrays = 2;
+  if (nonfinite_counts_.size() < kArrays) nonfinite_counts_.resize(kArrays);
+  for (size_t i = 0; i < kArrays; ++i)
+    count_nonfinite_into(device(), arrays[i].first, arrays[i].second, nonfinite_counts_.data() + i, ws_);
+  int64_t counts[kArrays];
+  nonfinite_counts_.copy_to_host(counts, kArrays);
+  for (size_t i = 0; i + kParticleArrays < kArrays; ++i) {
+    if (counts[i]) joint_zero_nonfinite(device(), arrays[i].first, arrays[i].second);
+    bad += counts[i];
   }
-  if (particles_.size() > 0) {
-    const int64_t k = count_nonfinite(device(), reinterpret_cast<const float*>(particles_.x.data()),
-                                      3 * particles_.size(), ws_) +
-                      count_nonfinite(device(), particles_.m.data(), particles_.size(), ws_);
+  {
+    const int64_t k = counts[kArrays - 2] + counts[kArrays - 1];
     if (k) {
       joint_kill_nonfinite(device(), particles_.view());
       particles_.compact(ws_);

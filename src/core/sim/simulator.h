@@ -111,6 +111,7 @@ class Simulator {
   DeviceBuffer<float> psi_, bristle_v_[3], cell_v_[3];
   DeviceBuffer<float> raster_mass_, raster_density_, raster_mom_[3], raster_w_[3];
   DeviceBuffer<float> overlay_mass_;
+  DeviceBuffer<int64_t> nonfinite_counts_;  ///< per checked array, read back in one copy
   DeviceBuffer<float> solid_height_;  ///< dried-paint top per window column (particles' solid, Eq. 8)
   DeviceBuffer<float> wet_top_;       ///< wet-paint surface per window column (free particles land on it)
 };
