@@ -126,10 +126,7 @@ BENCHMARK(BM_TransferCapacity)->Unit(benchmark::kMicrosecond)->Iterations(20);
 void BM_TransferAbsorb(benchmark::State& state) {
   TransferScene& s = scene();
   s.transfer.update_capacity(s.ds.view(), s.load, s.env);
-  run_stage(state, [](TransferScene& sc) {
-    TransferRecord rec;
-    sc.transfer.absorb(sc.ds.view(), sc.load, sc.store, rec);
-  });
+  run_stage(state, [](TransferScene& sc) { sc.transfer.absorb(sc.ds.view(), sc.load, sc.store); });
   state.SetItemsProcessed(state.iterations() * s.store.size());
 }
 BENCHMARK(BM_TransferAbsorb)->Unit(benchmark::kMillisecond)->Iterations(20);
@@ -142,10 +139,7 @@ BENCHMARK(BM_TransferDistance)->Unit(benchmark::kMicrosecond)->Iterations(20);
 void BM_TransferToGrid(benchmark::State& state) {
   TransferScene& s = scene();
   s.transfer.update_distance(s.ds.view(), s.env);
-  run_stage(state, [](TransferScene& sc) {
-    TransferRecord rec;
-    sc.transfer.particles_to_grid(sc.store, sc.env, rec);
-  });
+  run_stage(state, [](TransferScene& sc) { sc.transfer.particles_to_grid(sc.store, sc.env); });
 }
 BENCHMARK(BM_TransferToGrid)->Unit(benchmark::kMillisecond)->Iterations(20);
 
@@ -175,7 +169,10 @@ BENCHMARK(BM_TransferGridToParticles)->Unit(benchmark::kMillisecond)->Iterations
 void BM_TransferStep(benchmark::State& state) {
   TransferScene& s = scene();
   TransferRecord last;
-  run_stage(state, [&](TransferScene& sc) { last = sc.transfer.step(sc.ds.view(), sc.load, sc.store, sc.env); });
+  run_stage(state, [&](TransferScene& sc) {
+    last = sc.transfer.step(sc.ds.view(), sc.load, sc.store, sc.env);
+    sc.transfer.collect(last);
+  });
   state.counters["absorbed"] = double(last.absorbed_count);
   state.counters["emitted"] = double(last.emitted_count);
   state.counters["to_particles"] = double(last.to_particles_count);

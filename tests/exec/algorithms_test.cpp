@@ -98,10 +98,13 @@ TEST_F(AlgorithmsTest, SumIntoDeviceMemoryIsNotAHostRead) {
   for (int64_t i = 0; i < n; ++i) v[size_t(i)] = float(i % 7) - 3.f + 0.25f;
   DeviceBuffer<float> d(device_, static_cast<size_t>(n));
   d.copy_from_host(v);
-  DeviceBuffer<double> out(device_, 2);
+  DeviceBuffer<double> out(device_, 3);
+  out.fill_zero();
   const int64_t r0 = mem::host_reads();
   reduce_sum_into(device_, d.data(), n, out.data(), ws_);
   reduce_sum_into(device_, d.data(), 0, out.data() + 1, ws_);
+  reduce_sum_add_into(device_, d.data(), n, out.data() + 2, ws_);  // accumulates: twice the sum
+  reduce_sum_add_into(device_, d.data(), n, out.data() + 2, ws_);
   EXPECT_EQ(mem::host_reads(), r0);
   const double direct = reduce_sum(device_, d.data(), n, ws_);
   EXPECT_EQ(mem::host_reads(), r0 + 1);
@@ -112,6 +115,7 @@ TEST_F(AlgorithmsTest, SumIntoDeviceMemoryIsNotAHostRead) {
   EXPECT_NEAR(h[0], expect, 1e-9 * double(n));
   EXPECT_NEAR(h[0], direct, 1e-9 * double(n));
   EXPECT_EQ(h[1], 0.0) << "the sum of nothing";
+  EXPECT_NEAR(h[2], 2.0 * expect, 2e-9 * double(n));
 }
 
 TEST_F(AlgorithmsTest, FloatAtomicsUnderContention) {

@@ -307,7 +307,8 @@ TEST_F(BristleParticleTest, AbsorptionConservesMassAndTakesEachParticleOnce) {
   t.update_capacity(s.view(), load, env_for(w));
   const double particles_before = p.total_mass(ws_), load_before = load.total_mass(ws_);
   TransferRecord rec;
-  t.absorb(s.view(), load, p, rec);
+  t.absorb(s.view(), load, p);
+  t.collect(rec);
   EXPECT_GT(rec.absorbed_count, 0);
   // Each absorbed particle is flagged once and counted once; the sample side equals it.
   const std::vector<uint32_t> dead = p.dead.to_host();
@@ -365,7 +366,8 @@ TEST_F(BristleParticleTest, AbsorptionNeedsTheNearestSampleOnlyWithinTheLargestL
     const BristleLoadHost lh = load.to_host();
     for (float R : lh.radius) EXPECT_LE(R, prm.absorb_range() * (1.f + 1e-6f)) << "a load sphere beyond the range";
     TransferRecord rec;
-    t.absorb(s.view(), load, p, rec);
+    t.absorb(s.view(), load, p);
+    t.collect(rec);
     EXPECT_GT(rec.absorbed_count, 0);
     return Result{p.dead.to_host(), load.to_host()};
   };
@@ -400,7 +402,8 @@ TEST_F(BristleParticleTest, AbsorptionStopsAtCapacityAndLimit) {
   Transfer t(device_, prm);
   t.update_capacity(s.view(), load, env_for(w));
   TransferRecord rec;
-  t.absorb(s.view(), load, p, rec);
+  t.absorb(s.view(), load, p);
+  t.collect(rec);
   // §5.1: the sample absorbs while m_j < M_j, so it ends within one particle above M_j.
   EXPECT_EQ(rec.absorbed_count, 10);
   EXPECT_GE(load.total_mass(ws_), double(prm.M_max) * (1 - 1e-5));
@@ -415,7 +418,8 @@ TEST_F(BristleParticleTest, AbsorptionStopsAtCapacityAndLimit) {
   query_nearest(s, p3, 5.f);
   t3.update_capacity(s.view(), load3, env_for(w));
   TransferRecord rec3;
-  t3.absorb(s.view(), load3, p3, rec3);
+  t3.absorb(s.view(), load3, p3);
+  t3.collect(rec3);
   EXPECT_EQ(rec3.absorbed_count, 3);
   EXPECT_NEAR(load3.total_mass(ws_), 3.0 * mk, 1e-6 * mk);
 }
@@ -443,7 +447,8 @@ TEST_F(BristleParticleTest, SaturatedSampleAbsorbsNoMassButBleedsColour) {
   t.update_capacity(s.view(), load, env_for(w));
   const double load_before = load.total_mass(ws_), part_before = p.total_mass(ws_);
   TransferRecord rec;
-  t.absorb(s.view(), load, p, rec);
+  t.absorb(s.view(), load, p);
+  t.collect(rec);
   EXPECT_EQ(rec.absorbed_count, 0);
   EXPECT_EQ(rec.bleeding_count, 4);
   EXPECT_DOUBLE_EQ(load.total_mass(ws_), load_before);
@@ -488,6 +493,7 @@ TEST_F(BristleParticleTest, EmissionSettlesInTheBandBelowTheSamples) {
     TransferRecord rec;
     const int64_t before = p.size();
     t.emit(s.view(), load, p, env, rec);
+    t.collect(rec);
     if (steps == 0) EXPECT_EQ(rec.emitted_count, ns * prm.emit_limit) << "per-step limit";
     EXPECT_LT(rec.max_closure_error(), 1e-6);
     EXPECT_EQ(p.size() - before, rec.emitted_count);
@@ -535,6 +541,7 @@ TEST_F(BristleParticleTest, EmissionRespectsTheParticleLimit) {
   t.update_capacity(s.view(), load, env_for(w));
   TransferRecord rec;
   t.emit(s.view(), load, p, env_for(w), rec);
+  t.collect(rec);
   EXPECT_EQ(p.size(), 50);
   EXPECT_EQ(rec.emitted_count, 50);
   EXPECT_EQ(rec.emission_dropped, 32 * prm.emit_limit - 50);
@@ -566,7 +573,8 @@ TEST_F(BristleParticleTest, BrushWithoutPaintLeavesNone) {
   PaintWindow w = make_window({32, 32, 16}, {0, 0, 0}, [](int, int, int) { return 0.f; }, Vec3());
   Transfer t(device_, prm);
   for (int i = 0; i < 5; ++i) {
-    const TransferRecord rec = t.step(s.view(), load, p, env_for(w, 10.f));
+    TransferRecord rec = t.step(s.view(), load, p, env_for(w, 10.f));
+    t.collect(rec);
     EXPECT_EQ(rec.emitted_count + rec.to_particles_count + rec.absorbed_count + rec.to_grid_count, 0);
   }
   EXPECT_EQ(p.size(), 0);

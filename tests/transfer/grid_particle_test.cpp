@@ -96,6 +96,7 @@ TEST_F(GridParticleTest, LayerNearTheBristlesBecomesParticlesWithExactMass) {
   t.update_distance(s.view(), env);
   TransferRecord rec;
   t.grid_to_particles(p, env, rec);
+  t.collect(rec);
   ASSERT_GT(rec.to_particles_count, 0);
   EXPECT_EQ(p.size(), rec.to_particles_count);
   EXPECT_EQ(rec.to_particles_dropped, 0);
@@ -158,6 +159,7 @@ TEST_F(GridParticleTest, ClampOnAnIsolatedCellCreatesNoPaint) {
   t.update_distance(s.view(), env);
   TransferRecord rec;
   t.grid_to_particles(p, env, rec);
+  t.collect(rec);
   EXPECT_EQ(rec.to_particles_count, 27);
   const WindowFields after = w.to_host();
   const size_t c = (size_t(2) * 16 + 8) * 16 + 8;
@@ -193,7 +195,8 @@ TEST_F(GridParticleTest, SlowFarParticlesReturnAndMixColour) {
   const double grid_before = w.total_density(ws_) * cm, part_before = p.total_mass(ws_);
   t.update_distance(s.view(), env);
   TransferRecord rec;
-  t.particles_to_grid(p, env, rec);
+  t.particles_to_grid(p, env);
+  t.collect(rec);
   EXPECT_EQ(rec.to_grid_count, int64_t(xs.size()));
   EXPECT_LT(rec.max_closure_error(), 1e-6);
   p.compact(ws_);
@@ -229,7 +232,8 @@ TEST_F(GridParticleTest, ParticlesNearTheBristlesStay) {
   TransferEnv env = env_for(w, 8.f);
   t.update_distance(s.view(), env);
   TransferRecord rec;
-  t.particles_to_grid(p, env, rec);
+  t.particles_to_grid(p, env);
+  t.collect(rec);
   EXPECT_EQ(rec.to_grid_count, 1) << "only the particle 20 cells away goes back";
   const std::vector<uint32_t> dead = p.dead.to_host();
   EXPECT_EQ(dead[0], 0u);
@@ -263,7 +267,8 @@ TEST_F(GridParticleTest, WholeStepsKeepTheBooks) {
   int64_t moved_any = 0;
   for (int step = 0; step < 6; ++step) {
     query_nearest(s, p, 12.f);
-    const TransferRecord rec = t.step(s.view(), load, p, env_for(w, 12.f));
+    TransferRecord rec = t.step(s.view(), load, p, env_for(w, 12.f));
+    t.collect(rec);
     EXPECT_LT(rec.max_closure_error(), 1e-6) << "step " << step;
     moved_any += rec.absorbed_count + rec.emitted_count + rec.to_grid_count + rec.to_particles_count;
     const double drift = books.record(rec, census());

@@ -151,6 +151,8 @@ Brush::Brush(const Device& device, const BrushSpec& spec, const BrushPose& pose,
   scratch_b_.set_device(device);
   scratch_a_.resize(size_t(std::max(N, S)));
   scratch_b_.resize(size_t(std::max(N, S)));
+  nonfinite_.set_device(device);
+  nonfinite_.resize(2);
   // Reserve the sort's scratch now so that the first step does not allocate.
   ws_.get(size_t(std::max(N, S)) * 2 * sizeof(uint32_t) + 4096);
 
@@ -262,10 +264,14 @@ BrushFrame Brush::substep(const BrushPose& pose, float dt, const BrushEnvironmen
     brush_inextensible_on(device_, s, r, f, env.solid);
   }
   brush_velocities_on(device_, s, f, env.solid, dt);
-  // Containment: a non-finite vertex never propagates; the step is undone.
+  // Containment: a non-finite vertex never propagates; the step is undone. Both counts come
+  // back in one copy (one host read a sub-step).
   const int64_t N = vertex_count();
-  const int64_t bad = count_nonfinite(device_, reinterpret_cast<const float*>(xb_.data()), 3 * N, ws_) +
-                      count_nonfinite(device_, reinterpret_cast<const float*>(vb_.data()), 3 * N, ws_);
+  count_nonfinite_into(device_, reinterpret_cast<const float*>(xb_.data()), 3 * N, nonfinite_.data(), ws_);
+  count_nonfinite_into(device_, reinterpret_cast<const float*>(vb_.data()), 3 * N, nonfinite_.data() + 1, ws_);
+  int64_t counts[2];
+  nonfinite_.copy_to_host(counts, 2);
+  const int64_t bad = counts[0] + counts[1];
   if (bad > 0) {
     brush_restore_on(device_, s, f);
     ++rollbacks_;

@@ -69,9 +69,12 @@ class Brush {
   /// once, with the motion they made over the whole step (v, omega from the step's start and
   /// end states, a, alpha from the previous step's), so that Eq. 9's rewind x - v dt is exact
   /// whatever the sub-step count. Allocates nothing. A non-finite sub-step is rolled back
-  /// (see stats().nonfinite).
+  /// (see rollbacks()).
   void step(const BrushPose* poses, int substeps, float dt, const BrushEnvironment& env);
   void step(const BrushPose& pose, float dt, const BrushEnvironment& env) { step(&pose, 1, dt, env); }
+  /// Sub-steps whose result was non-finite and rolled back, since construction (no device work;
+  /// stats().nonfinite is the same count).
+  int64_t rollbacks() const { return rollbacks_; }
 
   /// Bristle density psi (occupied volume fraction, clamped to 1) and the psi-weighted
   /// mean bristle velocity (cells/s) on the cell-centred window at `window_origin`, sized
@@ -142,6 +145,7 @@ class Brush {
   // Scratch: contact keys, reductions.
   DeviceBuffer<uint32_t> contact_keys_, contact_vals_;
   DeviceBuffer<float> scratch_a_, scratch_b_;
+  DeviceBuffer<int64_t> nonfinite_;  ///< the sub-step's non-finite counts (positions, velocities)
 };
 
 }  // namespace wb

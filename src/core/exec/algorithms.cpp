@@ -30,6 +30,10 @@ void reduce_sum_into(const Device& d, const float* in, int64_t n, double* out, W
   check_ws(d, ws);
   WB_DISPATCH(d, reduce_sum_into(in, n, out, ws));
 }
+void reduce_sum_add_into(const Device& d, const float* in, int64_t n, double* out, Workspace& ws) {
+  check_ws(d, ws);
+  WB_DISPATCH(d, reduce_sum_add_into(in, n, out, ws));
+}
 void count_nonfinite_into(const Device& d, const float* in, int64_t n, int64_t* out, Workspace& ws) {
   check_ws(d, ws);
   WB_DISPATCH(d, count_nonfinite_into(in, n, out, ws));

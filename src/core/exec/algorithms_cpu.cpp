@@ -59,6 +59,8 @@ double reduce_sum(const float* in, int64_t n, Workspace&) {
 
 void reduce_sum_into(const float* in, int64_t n, double* out, Workspace& ws) { *out = reduce_sum(in, n, ws); }
 
+void reduce_sum_add_into(const float* in, int64_t n, double* out, Workspace& ws) { *out += reduce_sum(in, n, ws); }
+
 void count_nonfinite_into(const float* in, int64_t n, int64_t* out, Workspace& ws) { *out = count_nonfinite(in, n, ws); }
 
 float reduce_max(const float* in, int64_t n, Workspace&) {

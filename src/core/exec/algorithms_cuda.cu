@@ -95,6 +95,24 @@ void reduce_sum_into(const float* in, int64_t n, double* out, Workspace& ws) {
   WB_CUDA_CHECK(cub::DeviceReduce::Reduce(base, temp, it, out, n, ::cuda::std::plus<double>{}, 0.0, wb::cuda_stream()));
 }
 
+namespace {
+__global__ void add_to(double* out, const double* v) { *out += *v; }
+}  // namespace
+
+void reduce_sum_add_into(const float* in, int64_t n, double* out, Workspace& ws) {
+  // The sum into the workspace's first slot, then one thread adds it (stream order, no wait).
+  auto it = thrust::make_transform_iterator(in, ToDouble{});
+  size_t temp = 0;
+  WB_CUDA_CHECK(cub::DeviceReduce::Reduce(nullptr, temp, it, static_cast<double*>(nullptr), n,
+                                          ::cuda::std::plus<double>{}, 0.0, wb::cuda_stream()));
+  auto* base = static_cast<unsigned char*>(ws.get(256 + temp));
+  auto* sum = reinterpret_cast<double*>(base);
+  WB_CUDA_CHECK(cub::DeviceReduce::Reduce(base + 256, temp, it, sum, n, ::cuda::std::plus<double>{}, 0.0,
+                                          wb::cuda_stream()));
+  add_to<<<1, 1, 0, wb::cuda_stream()>>>(out, sum);
+  WB_CUDA_CHECK(cudaGetLastError());
+}
+
 void count_nonfinite_into(const float* in, int64_t n, int64_t* out, Workspace& ws) {
   static_assert(sizeof(int64_t) == sizeof(long long), "count type");
   auto it = thrust::make_transform_iterator(in, NonFinite{});

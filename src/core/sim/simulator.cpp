@@ -99,8 +99,9 @@ void Simulator::settle() {
     none.bristles = 0;  // no bristles: every particle is far from them
     TransferRecord rec;
     transfer_->update_distance(none, env);
-    transfer_->particles_to_grid(particles_, env, rec);
+    transfer_->particles_to_grid(particles_, env);
     particles_.compact(ws_);
+    transfer_->collect(rec);
     books_.record(rec, census());
   }
   grid_->window().flush();
@@ -162,7 +163,6 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
   // --- 1-2. Brush (§4.1) in sub-steps, then its samples ------------------------------------
   const Vec3 footprint_before = footprint_centre(brush_->pose(), config_.brush.length);
   brush_stage(poses, substeps, dt);
-  TransferRecord rec;
 
   // --- 3. Window: follow the brush; rasterise the bristles into it (boundary of §4.2) -----
   {
@@ -173,7 +173,7 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
     const Vec3 footprint_after = footprint_centre(brush_->pose(), config_.brush.length);
     const Int3 next = grid_->window().origin_for(0.5f * (footprint_before + footprint_after),
                                                  config_.params.grid.window_snap);
-    if (particles_.size() > 0) deposit_leaving_particles(next, rec);
+    if (particles_.size() > 0) deposit_leaving_particles(next);
     grid_->move_window(next);
     brush_->rasterize(grid_->window().origin(), grid_->window().dims(), psi_.data(), bristle_v_[0].data(),
                       bristle_v_[1].data(), bristle_v_[2].data());
@@ -204,6 +204,7 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
   }
 
   // --- 8. Transfer (§5): bristle <-> particle, grid <-> particle ---------------------------
+  TransferRecord rec;
   {
     WB_PROFILE_SCOPE("transfer");
     if (config_.particles) {
@@ -215,18 +216,15 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
     TransferEnv env = transfer_env();
     env.dt = dt;  // wicking along the bristles over this step
     env.particle_density = grid_->particle_density();  // this step's raster, if any
-    const TransferRecord moved = transfer_->step(brush_->samples(), *load_, particles_, env);
-    const TransferRecord pre = rec;  // particles deposited before the window moved
-    rec = moved;
-    rec.to_grid_count += pre.to_grid_count;
-    rec.to_grid_from_particles += pre.to_grid_from_particles;
-    rec.to_grid_into_grid += pre.to_grid_into_grid;
+    // The device's sums include the particles deposited before the window moved.
+    rec = transfer_->step(brush_->samples(), *load_, particles_, env);
   }
 
   contain_nonfinite();
   clamp_particles_to_canvas();
   {
     WB_PROFILE_SCOPE("books");
+    transfer_->collect(rec);
     books_.record(rec, census());
   }
   ++counters_.steps;
@@ -234,7 +232,7 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
   counters_.particles_max = std::max(counters_.particles_max, particles_.size());
 }
 
-void Simulator::deposit_leaving_particles(Int3 next, TransferRecord& rec) {
+void Simulator::deposit_leaving_particles(Int3 next) {
   // Particles live only inside the window (they are rasterised into it and go back to the
   // grid through it). Those outside the part of the window that stays, less a margin for
   // the kernel of Eq. 16, return to the grid before the window moves.
@@ -247,7 +245,7 @@ void Simulator::deposit_leaving_particles(Int3 next, TransferRecord& rec) {
                          Int3{std::min(cur.x, next.x) + n.x - cur.x - m, std::min(cur.y, next.y) + n.y - cur.y - m,
                               n.z - kKeepRimTop});
   transfer_->update_distance(brush_->samples(), env);
-  transfer_->particles_to_grid(particles_, env, rec);
+  transfer_->particles_to_grid(particles_, env);
   particles_.compact(ws_);
 }
 
@@ -261,7 +259,7 @@ SolidField Simulator::solid_field() {
 
 void Simulator::brush_stage(const BrushPose* poses, int substeps, float dt) {
   ActiveWindow& win = grid_->window();
-  const int64_t rollbacks_before = brush_->stats().nonfinite;
+  const int64_t rollbacks_before = brush_->rollbacks();
   // The grid velocity kept from the last step drags the bristles (Eq. 2's a_i, §4.3).
   joint_cell_velocity(device(), grid_->view(), cell_v_[0].data(), cell_v_[1].data(), cell_v_[2].data());
   const Int3 n = win.dims(), o = win.origin();
@@ -271,7 +269,7 @@ void Simulator::brush_stage(const BrushPose* poses, int substeps, float dt) {
   env.drag = config_.params.bristle_drag > 0.f ? &drag : nullptr;
   env.solid = solid_field();
   brush_->step(poses, substeps, dt, env);
-  counters_.nonfinite_events += brush_->stats().nonfinite - rollbacks_before;
+  counters_.nonfinite_events += brush_->rollbacks() - rollbacks_before;
 }
 
 void Simulator::particle_stage(float dt) {

@@ -86,7 +86,7 @@ class Simulator {
  private:
   void brush_stage(const BrushPose* poses, int substeps, float dt);
   void particle_stage(float dt);
-  void deposit_leaving_particles(Int3 next_origin, TransferRecord& rec);
+  void deposit_leaving_particles(Int3 next_origin);
   void joint_fields_stage();
   void contain_nonfinite();
   void clamp_particles_to_canvas();

@@ -159,7 +159,8 @@ Transfer::Transfer(const Device& device, const TransferParams& params)
   d2_tmp_.set_device(device);
   edt_z_.set_device(device);
   edt_v_.set_device(device);
-  counters_ = DeviceBuffer<int32_t>(device, 8);
+  sums_ = DeviceBuffer<TransferSums>(device, 1);
+  sums_.fill_zero();
 }
 
 void Transfer::ensure_samples(int64_t n) {
@@ -192,7 +193,7 @@ TransferRecord Transfer::step(const SampleView& samples, BristleLoad& load, Part
   }
   {
     WB_PROFILE_SCOPE("transfer.absorb");
-    absorb(samples, load, particles, rec);
+    absorb(samples, load, particles);
   }
   {
     WB_PROFILE_SCOPE("transfer.distance");
@@ -200,7 +201,7 @@ TransferRecord Transfer::step(const SampleView& samples, BristleLoad& load, Part
   }
   {
     WB_PROFILE_SCOPE("transfer.to_grid");
-    particles_to_grid(particles, env, rec);
+    particles_to_grid(particles, env);
   }
   {
     WB_PROFILE_SCOPE("transfer.compact");
@@ -216,6 +217,24 @@ TransferRecord Transfer::step(const SampleView& samples, BristleLoad& load, Part
   }
   ++step_index_;
   return rec;
+}
+
+void Transfer::collect(TransferRecord& rec) {
+  TransferSums s{};
+  sums_.copy_to_host(&s, 1);
+  sums_.fill_zero();
+  const double cm = double(params_.cell_mass());
+  rec.absorbed_count += s.absorb_counts[0];
+  rec.bleeding_count += s.absorb_counts[1];
+  rec.absorbed_from_particles += s.absorbed_from_particles;
+  rec.absorbed_into_bristles += s.absorbed_into_bristles;
+  rec.emitted_from_bristles += s.emitted_from_bristles;
+  rec.emitted_into_particles += s.emitted_into_particles;
+  rec.to_particles_from_grid += s.to_particles_from_grid * cm;
+  rec.to_particles_into_particles += s.to_particles_into_particles;
+  rec.to_grid_count += s.to_grid_count;
+  rec.to_grid_from_particles += s.to_grid_from_particles;
+  rec.to_grid_into_grid += s.to_grid_into_grid * cm;
 }
 
 void Transfer::update_capacity(const SampleView& samples, BristleLoad& load, const TransferEnv& env) {
@@ -251,7 +270,7 @@ void Transfer::wick(const SampleView& samples, BristleLoad& load, float dt) {
          params_.wick_slide, dt, s_f32_[0].data(), s_f32_[1].data());
 }
 
-void Transfer::absorb(const SampleView& samples, BristleLoad& load, ParticleStore& particles, TransferRecord& rec) {
+void Transfer::absorb(const SampleView& samples, BristleLoad& load, ParticleStore& particles) {
   const int64_t ns = samples.count(), np = particles.size();
   WB_REQUIRE(ns == load.size(), "Transfer::absorb: " + std::to_string(ns) + " samples but a load of " +
                                     std::to_string(load.size()));
@@ -261,7 +280,6 @@ void Transfer::absorb(const SampleView& samples, BristleLoad& load, ParticleStor
   for (auto& b : s_f32_) b.fill_zero();
   s_u32_[0].fill_zero();
   p_moved_.fill_zero();
-  counters_.fill_zero();
   AbsorbScratch a{};
   a.ticket = s_u32_[0].data();
   a.claimed = s_f32_[0].data();
@@ -273,18 +291,14 @@ void Transfer::absorb(const SampleView& samples, BristleLoad& load, ParticleStor
   for (int c = 0; c < 3; ++c) a.bl_c[c] = s_f32_[8 + c].data();
   a.bl_b = s_f32_[11].data();
   a.moved = p_moved_.data();
-  a.counters = counters_.data();
+  a.counters = sums_.data()->absorb_counts;  // address only: the counts accumulate in the record
   const BristleLoadView lv = load.view();
   if (np > 0 && ns > 0) {
     d_absorb(device_, particles.view(), samples, lv, a, params_);
     d_absorb_apply(device_, lv, a);
   }
-  int32_t counts[8];
-  counters_.copy_to_host(counts, 8);
-  rec.absorbed_count = counts[0];
-  rec.bleeding_count = counts[1];
-  rec.absorbed_from_particles = reduce_sum(device_, p_moved_.data(), np, ws_);
-  rec.absorbed_into_bristles = reduce_sum(device_, a.acc_m, ns, ws_);
+  reduce_sum_add_into(device_, p_moved_.data(), np, sum_field(&TransferSums::absorbed_from_particles), ws_);
+  reduce_sum_add_into(device_, a.acc_m, ns, sum_field(&TransferSums::absorbed_into_bristles), ws_);
 }
 
 void Transfer::update_distance(const SampleView& samples, const TransferEnv& env) {
@@ -332,7 +346,7 @@ std::vector<float> Transfer::distance_to_host() {
   return d;
 }
 
-void Transfer::particles_to_grid(ParticleStore& particles, const TransferEnv& env, TransferRecord& rec) {
+void Transfer::particles_to_grid(ParticleStore& particles, const TransferEnv& env) {
   validate(env);
   const DistanceBlocks db = distance_view();
   WB_REQUIRE(db.D0 == env.D0, "Transfer: the distance field was built for another D0");
@@ -341,7 +355,6 @@ void Transfer::particles_to_grid(ParticleStore& particles, const TransferEnv& en
   ensure_particles(np);
   for (auto& b : c_i64_) b.fill_zero();
   p_moved_.fill_zero();
-  counters_.fill_zero();
   DepositScratch acc{};
   acc.rho = c_i64_[0].data();
   for (int c = 0; c < 3; ++c) acc.c[c] = c_i64_[1 + c].data();
@@ -351,17 +364,15 @@ void Transfer::particles_to_grid(ParticleStore& particles, const TransferEnv& en
   acc.added = c_f32_[0].data();
   c_f32_[0].fill_zero();
   acc.moved = p_moved_.data();
-  acc.counter = counters_.data();
+  acc.counter = sum_field(&TransferSums::to_grid_count);
   acc.keep = env.keep;
   if (np > 0) {
     d_to_grid_mark(device_, particles.view(), env.paint, db, acc, params_, env.dry_threshold);
     d_to_grid_apply(device_, env.paint, acc);
   }
-  int32_t count = 0;
-  counters_.copy_to_host(&count, 1);
-  rec.to_grid_count = count;
-  rec.to_grid_from_particles = reduce_sum(device_, p_moved_.data(), np, ws_);
-  rec.to_grid_into_grid = reduce_sum(device_, acc.added, nc, ws_) * double(params_.cell_mass());
+  reduce_sum_add_into(device_, p_moved_.data(), np, sum_field(&TransferSums::to_grid_from_particles), ws_);
+  // Density units here; collect() turns them into kg.
+  reduce_sum_add_into(device_, acc.added, nc, sum_field(&TransferSums::to_grid_into_grid), ws_);
 }
 
 int64_t Transfer::make_room(ParticleStore& particles, const uint32_t* count, uint32_t* offset, int64_t n,
@@ -395,8 +406,8 @@ void Transfer::emit(const SampleView& samples, BristleLoad& load, ParticleStore&
   d_emit_fill(device_, samples, lv, pv, offset, count, mass_each, swept_each, swept_n, first, n_new, step_index_,
               params_, env.floor_z, env.dt, env.paint, emitted);
   rec.emitted_count = n_new;
-  rec.emitted_from_bristles = reduce_sum(device_, emitted, ns, ws_);
-  rec.emitted_into_particles = reduce_sum(device_, pv.m + first, n_new, ws_);
+  reduce_sum_add_into(device_, emitted, ns, sum_field(&TransferSums::emitted_from_bristles), ws_);
+  reduce_sum_add_into(device_, pv.m + first, n_new, sum_field(&TransferSums::emitted_into_particles), ws_);
 }
 
 void Transfer::grid_to_particles(ParticleStore& particles, const TransferEnv& env, TransferRecord& rec) {
@@ -419,8 +430,9 @@ void Transfer::grid_to_particles(ParticleStore& particles, const TransferEnv& en
   d_grid_clamp(device_, env.paint, demand, removed);
   d_grid_finish(device_, pv, first, n_new, env.paint, demand, params_, env.dry_threshold);
   rec.to_particles_count = n_new;
-  rec.to_particles_from_grid = reduce_sum(device_, removed, nc, ws_) * double(params_.cell_mass());
-  rec.to_particles_into_particles = reduce_sum(device_, pv.m + first, n_new, ws_);
+  // Density units here; collect() turns them into kg.
+  reduce_sum_add_into(device_, removed, nc, sum_field(&TransferSums::to_particles_from_grid), ws_);
+  reduce_sum_add_into(device_, pv.m + first, n_new, sum_field(&TransferSums::to_particles_into_particles), ws_);
 }
 
 }  // namespace wb

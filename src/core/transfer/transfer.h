@@ -73,6 +73,18 @@ struct TransferRecord {
   double grid_change() const { return to_grid_into_grid - to_particles_from_grid; }
 };
 
+/// The part of a TransferRecord the device computes (sums and counts), accumulated on the device
+/// by every stage call and brought to the host in one copy by Transfer::collect.
+struct TransferSums {
+  double absorbed_from_particles, absorbed_into_bristles;
+  double emitted_from_bristles, emitted_into_particles;
+  double to_particles_from_grid, to_particles_into_particles;
+  double to_grid_from_particles, to_grid_into_grid;
+  int32_t absorb_counts[2];  ///< absorbed, bleeding (AbsorbScratch::counters)
+  int32_t to_grid_count;     ///< DepositScratch::counter
+  int32_t unused;
+};
+
 /// Scratch of the absorption pass, per sample (accumulators) and per particle (moved mass).
 struct AbsorbScratch {
   uint32_t* ticket;  ///< particles that asked sample j this step
@@ -115,8 +127,13 @@ class Transfer {
 
   /// One transfer step (§5): every stage below in order, with one compaction of the particle
   /// store. The particles' `nearest` must come from SampleHashGrid::query_nearest on these
-  /// samples this step (the absorption candidate; the distance is re-measured here).
+  /// samples this step (the absorption candidate; the distance is re-measured here). The
+  /// record holds what the host knows (new particles, drops); the device's sums and counts
+  /// join it in collect().
   TransferRecord step(const SampleView& samples, BristleLoad& load, ParticleStore& particles, const TransferEnv& env);
+  /// Adds the sums and counts the device accumulated since the last collect (every stage call's)
+  /// into rec, in one host read, and starts the next accumulation.
+  void collect(TransferRecord& rec);
 
   // --- stages (public for tests and profiling; step() calls them in this order) ---
   /// Eq. 12-13 for every sample: load.potential, load.capacity, load.radius.
@@ -129,12 +146,13 @@ class Transfer {
   /// of bristles.
   void share_contact(const SampleView& samples, BristleLoad& load, const TransferEnv& env);
   /// Eq. 14: particles within R_j of their nearest sample j join it while m_j < M_j (at most
-  /// absorb_limit per sample), else bleed colour. Absorbed particles are flagged dead.
-  void absorb(const SampleView& samples, BristleLoad& load, ParticleStore& particles, TransferRecord& rec);
+  /// absorb_limit per sample), else bleed colour. Absorbed particles are flagged dead. The
+  /// stages that take a record fill its host-known fields; their sums wait for collect().
+  void absorb(const SampleView& samples, BristleLoad& load, ParticleStore& particles);
   /// The coarse distance from every window block to the bristles (decides "within D0").
   void update_distance(const SampleView& samples, const TransferEnv& env);
   /// Eq. 16: live particles slower than slow_speed in blocks farther than D0 go to the grid.
-  void particles_to_grid(ParticleStore& particles, const TransferEnv& env, TransferRecord& rec);
+  void particles_to_grid(ParticleStore& particles, const TransferEnv& env);
   /// §5.1: samples above (1 + epsilon) M_j emit particles in their lower hemisphere, and samples
   /// sliding over a surface leave the swept part of their paint along their path (env.dt).
   void emit(const SampleView& samples, BristleLoad& load, ParticleStore& particles, const TransferEnv& env,
@@ -177,8 +195,12 @@ class Transfer {
   DistanceBlocks blocks_{};
   // Swept-contact passes per window column.
   DeviceBuffer<uint32_t> passes_;
-  // Counters.
-  DeviceBuffer<int32_t> counters_;
+  // The device's part of the record (one TransferSums), zeroed by collect().
+  DeviceBuffer<TransferSums> sums_;
+  template <typename M>
+  M* sum_field(M TransferSums::*field) {
+    return &(sums_.data()->*field);  // address arithmetic on the device pointer, no access
+  }
 };
 
 /// Validates and runs Eq. 12-13 for every sample (the dispatcher behind Transfer::update_capacity).
