@@ -105,11 +105,14 @@ TEST_F(AlgorithmsTest, SumIntoDeviceMemoryIsNotAHostRead) {
   reduce_sum_into(device_, d.data(), 0, out.data() + 1, ws_);
   reduce_sum_add_into(device_, d.data(), n, out.data() + 2, ws_);  // accumulates: twice the sum
   reduce_sum_add_into(device_, d.data(), n, out.data() + 2, ws_);
+  DeviceBuffer<float> top(device_, 1);
+  reduce_max_into(device_, d.data(), n, top.data(), ws_);
   EXPECT_EQ(mem::host_reads(), r0);
   const double direct = reduce_sum(device_, d.data(), n, ws_);
   EXPECT_EQ(mem::host_reads(), r0 + 1);
   const std::vector<double> h = out.to_host();
   EXPECT_EQ(mem::host_reads(), r0 + 2);
+  EXPECT_FLOAT_EQ(top.to_host()[0], *std::max_element(v.begin(), v.end()));
   double expect = 0.0;
   for (float x : v) expect += double(x);
   EXPECT_NEAR(h[0], expect, 1e-9 * double(n));

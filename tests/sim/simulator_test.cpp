@@ -160,8 +160,8 @@ TEST_F(SimulatorTest, StepHostReadsStayBounded) {
   const double mean = double(std::accumulate(reads.begin(), reads.end(), int64_t(0))) / double(reads.size());
   const int64_t most = *std::max_element(reads.begin(), reads.end());
   std::printf("host reads a step: mean %.1f, most %lld\n", mean, static_cast<long long>(most));
-  EXPECT_LE(mean, 20.0);
-  EXPECT_LE(most, 30);
+  EXPECT_LE(mean, 16.0);
+  EXPECT_LE(most, 24);
 }
 
 TEST_F(SimulatorTest, MorePressureSpreadsAWiderMark) {

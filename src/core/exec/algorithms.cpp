@@ -43,6 +43,10 @@ float reduce_max(const Device& d, const float* in, int64_t n, Workspace& ws) {
   mem::count_host_read();
   WB_DISPATCH(d, reduce_max(in, n, ws));
 }
+void reduce_max_into(const Device& d, const float* in, int64_t n, float* out, Workspace& ws) {
+  check_ws(d, ws);
+  WB_DISPATCH(d, reduce_max_into(in, n, out, ws));
+}
 float reduce_min(const Device& d, const float* in, int64_t n, Workspace& ws) {
   check_ws(d, ws);
   mem::count_host_read();

@@ -21,6 +21,8 @@ void reduce_sum_into(const Device& device, const float* in, int64_t n, double* o
 /// *out += the sum, on the device (not a host read): a record the device keeps over a step.
 void reduce_sum_add_into(const Device& device, const float* in, int64_t n, double* out, Workspace& ws);
 float reduce_max(const Device& device, const float* in, int64_t n, Workspace& ws);
+/// The same maximum written to *out, a device pointer (not a host read; -inf for n = 0).
+void reduce_max_into(const Device& device, const float* in, int64_t n, float* out, Workspace& ws);
 float reduce_min(const Device& device, const float* in, int64_t n, Workspace& ws);
 /// Number of NaN or infinite values.
 int64_t count_nonfinite(const Device& device, const float* in, int64_t n, Workspace& ws);
@@ -36,6 +38,7 @@ double reduce_sum(const float* in, int64_t n, Workspace& ws);
 void reduce_sum_into(const float* in, int64_t n, double* out, Workspace& ws);
 void reduce_sum_add_into(const float* in, int64_t n, double* out, Workspace& ws);
 float reduce_max(const float* in, int64_t n, Workspace& ws);
+void reduce_max_into(const float* in, int64_t n, float* out, Workspace& ws);
 float reduce_min(const float* in, int64_t n, Workspace& ws);
 int64_t count_nonfinite(const float* in, int64_t n, Workspace& ws);
 }  // namespace cpu
@@ -47,6 +50,7 @@ double reduce_sum(const float* in, int64_t n, Workspace& ws);
 void reduce_sum_into(const float* in, int64_t n, double* out, Workspace& ws);
 void reduce_sum_add_into(const float* in, int64_t n, double* out, Workspace& ws);
 float reduce_max(const float* in, int64_t n, Workspace& ws);
+void reduce_max_into(const float* in, int64_t n, float* out, Workspace& ws);
 float reduce_min(const float* in, int64_t n, Workspace& ws);
 int64_t count_nonfinite(const float* in, int64_t n, Workspace& ws);
 }  // namespace cuda

@@ -70,6 +70,8 @@ float reduce_max(const float* in, int64_t n, Workspace&) {
   return m;
 }
 
+void reduce_max_into(const float* in, int64_t n, float* out, Workspace& ws) { *out = reduce_max(in, n, ws); }
+
 float reduce_min(const float* in, int64_t n, Workspace&) {
   float m = std::numeric_limits<float>::infinity();
 #pragma omp parallel for reduction(min : m) schedule(static) if (n > 65536)

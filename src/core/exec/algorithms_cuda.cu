@@ -127,6 +127,14 @@ float reduce_max(const float* in, int64_t n, Workspace& ws) {
   return reduce(in, n, MaxOp{}, -::cuda::std::numeric_limits<float>::infinity(), ws);
 }
 
+void reduce_max_into(const float* in, int64_t n, float* out, Workspace& ws) {
+  size_t temp = 0;
+  const float init = -::cuda::std::numeric_limits<float>::infinity();
+  WB_CUDA_CHECK(cub::DeviceReduce::Reduce(nullptr, temp, in, out, n, MaxOp{}, init, wb::cuda_stream()));
+  void* base = ws.get(temp);
+  WB_CUDA_CHECK(cub::DeviceReduce::Reduce(base, temp, in, out, n, MaxOp{}, init, wb::cuda_stream()));
+}
+
 float reduce_min(const float* in, int64_t n, Workspace& ws) {
   return reduce(in, n, MinOp{}, ::cuda::std::numeric_limits<float>::infinity(), ws);
 }

@@ -81,7 +81,11 @@ void ActiveWindow::reload() {
 }
 
 double ActiveWindow::total_mass(Workspace& ws) const {
-  return canvas_->total_density() - gathered_mass_ + paint_.total_density(ws);
+  return total_mass_with(paint_.total_density(ws));
+}
+
+double ActiveWindow::total_mass_with(double window_density) const {
+  return canvas_->total_density() - gathered_mass_ + window_density;
 }
 
 }  // namespace wb

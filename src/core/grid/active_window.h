@@ -45,6 +45,8 @@ class ActiveWindow {
   double gathered_mass() const { return gathered_mass_; }
   /// All paint: canvas + window - the canvas copy of the window region. Unchanged by moves.
   double total_mass(Workspace& ws) const;
+  /// total_mass with the window's density sum already known (read with other sums).
+  double total_mass_with(double window_density) const;
 
  private:
   void shift_faces(int c, int dx, int dy, int dz);

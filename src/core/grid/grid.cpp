@@ -253,6 +253,8 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
     b->set_device(d);
   cg_sums_.set_device(d);
   cg_sums_.resize(4);
+  advect_max_.set_device(d);
+  advect_max_.resize(2);
   paint_tmp_ = PaintWindow(d, dims);
   scratch_.reserve(d, g.cells());
   classify();
@@ -300,8 +302,13 @@ void Grid::advect(float dt) {
   // x y z, then z y x), in sub-steps that keep each axis's outflow Courant number at most
   // advect_courant: no cell gives more than it holds, and no global correction is needed.
   outflow_d(d, v, paint.density.data(), cell_tmp_.data(), face_tmp_.data());
-  const float rate = reduce_max(d, cell_tmp_.data(), g.cells(), ws_);
-  const int top = int(reduce_max(d, face_tmp_.data(), g.cells(), ws_));  // layers holding paint
+  // Both maxima in one copy: the outflow rate and the layers holding paint.
+  reduce_max_into(d, cell_tmp_.data(), g.cells(), advect_max_.data(), ws_);
+  reduce_max_into(d, face_tmp_.data(), g.cells(), advect_max_.data() + 1, ws_);
+  float maxima[2];
+  advect_max_.copy_to_host(maxima, 2);
+  const float rate = maxima[0];
+  const int top = int(maxima[1]);
   const float courant = std::isfinite(rate) ? rate * dt : 0.f;
   const int n = std::clamp(int(std::ceil(courant / params_.advect_courant)), 1, params_.advect_max_substeps);
   stats_.advect_substeps = n;

@@ -146,6 +146,7 @@ class Grid {
   DeviceBuffer<float> cg_nu_, cg_x_, cg_b_, cg_r_, cg_z_, cg_p_, cg_q_, cg_diag_, cg_dot_a_, cg_dot_b_;
   /// The CG's scalars on the device: r.z of the two latest iterations, p.Ap, b.D^-1 b.
   DeviceBuffer<double> cg_sums_;
+  DeviceBuffer<float> advect_max_;  ///< the advection's outflow rate and top layer, read in one copy
   PaintWindow paint_tmp_;
   SolverScratch scratch_;
   Workspace ws_;

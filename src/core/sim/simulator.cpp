@@ -60,6 +60,9 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
     b->resize(size_t(g.nx) * size_t(g.ny));
   }
   nonfinite_counts_.set_device(d);
+  step_sums_ = DeviceBuffer<StepSums>(d, 1);
+  step_sums_.fill_zero();
+  transfer_->set_sums(&step_sums_.data()->transfer);
   for (int c = 0; c < 3; ++c) {
     cells(bristle_v_[c]);
     cells(cell_v_[c]);
@@ -75,6 +78,24 @@ void Simulator::reset_brush(const BrushPose& pose) { brush_->reset(pose); }
 
 PaintCensus Simulator::census() {
   return PaintBooks::census(*load_, particles_, grid_->window().total_mass(ws_), transfer_->params(), ws_);
+}
+
+PaintCensus Simulator::record_census(TransferRecord& rec) {
+  // The census's sums join the transfer's on the device; one copy brings the step's record.
+  StepSums* d = step_sums_.data();
+  reduce_sum_into(device(), load_->m.data(), load_->size(), &d->bristles, ws_);
+  reduce_sum_into(device(), particles_.m.data(), particles_.size(), &d->particles, ws_);
+  const PaintWindow& paint = grid_->window().paint();
+  reduce_sum_into(device(), paint.density.data(), paint.cell_count(), &d->window_density, ws_);
+  StepSums h{};
+  step_sums_.copy_to_host(&h, 1);
+  step_sums_.fill_zero();
+  Transfer::add_sums(h.transfer, double(transfer_->params().cell_mass()), rec);
+  PaintCensus c;
+  c.bristles = h.bristles;
+  c.particles = h.particles;
+  c.grid = grid_->window().total_mass_with(h.window_density) * double(transfer_->params().cell_mass());
+  return c;
 }
 
 void Simulator::load_paint(const PaintLoad& paint) { books_.external(load_->fill(paint)); }
@@ -101,8 +122,7 @@ void Simulator::settle() {
     transfer_->update_distance(none, env);
     transfer_->particles_to_grid(particles_, env);
     particles_.compact(ws_);
-    transfer_->collect(rec);
-    books_.record(rec, census());
+    books_.record(rec, record_census(rec));
   }
   grid_->window().flush();
 }
@@ -224,8 +244,7 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
   clamp_particles_to_canvas();
   {
     WB_PROFILE_SCOPE("books");
-    transfer_->collect(rec);
-    books_.record(rec, census());
+    books_.record(rec, record_census(rec));
   }
   ++counters_.steps;
   counters_.substeps += substeps;

@@ -87,6 +87,8 @@ class Simulator {
   void brush_stage(const BrushPose* poses, int substeps, float dt);
   void particle_stage(float dt);
   void deposit_leaving_particles(Int3 next_origin);
+  /// The step's transfer sums added to rec and the census after it, from one read of step_sums_.
+  PaintCensus record_census(TransferRecord& rec);
   void joint_fields_stage();
   void contain_nonfinite();
   void clamp_particles_to_canvas();
@@ -112,6 +114,12 @@ class Simulator {
   DeviceBuffer<float> raster_mass_, raster_density_, raster_mom_[3], raster_w_[3];
   DeviceBuffer<float> overlay_mass_;
   DeviceBuffer<int64_t> nonfinite_counts_;  ///< per checked array, read back in one copy
+  /// The step's record on the device: the transfer's sums and the census's, read in one copy.
+  struct StepSums {
+    TransferSums transfer;
+    double bristles, particles, window_density;
+  };
+  DeviceBuffer<StepSums> step_sums_;
   DeviceBuffer<float> solid_height_;  ///< dried-paint top per window column (particles' solid, Eq. 8)
   DeviceBuffer<float> wet_top_;       ///< wet-paint surface per window column (free particles land on it)
 };

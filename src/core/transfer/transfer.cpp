@@ -161,6 +161,7 @@ Transfer::Transfer(const Device& device, const TransferParams& params)
   edt_v_.set_device(device);
   sums_ = DeviceBuffer<TransferSums>(device, 1);
   sums_.fill_zero();
+  sums_ptr_ = sums_.data();
 }
 
 void Transfer::ensure_samples(int64_t n) {
@@ -220,10 +221,14 @@ TransferRecord Transfer::step(const SampleView& samples, BristleLoad& load, Part
 }
 
 void Transfer::collect(TransferRecord& rec) {
+  WB_REQUIRE(sums_ptr_ == sums_.data(), "Transfer::collect: the sums go to the caller's record (set_sums)");
   TransferSums s{};
   sums_.copy_to_host(&s, 1);
   sums_.fill_zero();
-  const double cm = double(params_.cell_mass());
+  add_sums(s, double(params_.cell_mass()), rec);
+}
+
+void Transfer::add_sums(const TransferSums& s, double cm, TransferRecord& rec) {
   rec.absorbed_count += s.absorb_counts[0];
   rec.bleeding_count += s.absorb_counts[1];
   rec.absorbed_from_particles += s.absorbed_from_particles;
@@ -291,7 +296,7 @@ void Transfer::absorb(const SampleView& samples, BristleLoad& load, ParticleStor
   for (int c = 0; c < 3; ++c) a.bl_c[c] = s_f32_[8 + c].data();
   a.bl_b = s_f32_[11].data();
   a.moved = p_moved_.data();
-  a.counters = sums_.data()->absorb_counts;  // address only: the counts accumulate in the record
+  a.counters = sums_ptr_->absorb_counts;  // address only: the counts accumulate in the record
   const BristleLoadView lv = load.view();
   if (np > 0 && ns > 0) {
     d_absorb(device_, particles.view(), samples, lv, a, params_);

@@ -134,6 +134,12 @@ class Transfer {
   /// Adds the sums and counts the device accumulated since the last collect (every stage call's)
   /// into rec, in one host read, and starts the next accumulation.
   void collect(TransferRecord& rec);
+  /// Where the stages accumulate their sums: a TransferSums on this device that the caller
+  /// reads with more of its own in one copy (the simulator's step record), then passes to
+  /// add_sums and zeroes; nullptr: the transfer's own, read by collect().
+  void set_sums(TransferSums* device_sums) { sums_ptr_ = device_sums ? device_sums : sums_.data(); }
+  /// rec += s (the device's densities in kg).
+  static void add_sums(const TransferSums& s, double cell_mass, TransferRecord& rec);
 
   // --- stages (public for tests and profiling; step() calls them in this order) ---
   /// Eq. 12-13 for every sample: load.potential, load.capacity, load.radius.
@@ -195,11 +201,12 @@ class Transfer {
   DistanceBlocks blocks_{};
   // Swept-contact passes per window column.
   DeviceBuffer<uint32_t> passes_;
-  // The device's part of the record (one TransferSums), zeroed by collect().
+  // The device's part of the record (one TransferSums), zeroed by collect(); or the caller's.
   DeviceBuffer<TransferSums> sums_;
+  TransferSums* sums_ptr_ = nullptr;
   template <typename M>
   M* sum_field(M TransferSums::*field) {
-    return &(sums_.data()->*field);  // address arithmetic on the device pointer, no access
+    return &(sums_ptr_->*field);  // address arithmetic on the device pointer, no access
   }
 };
 
