@@ -153,6 +153,8 @@ Brush::Brush(const Device& device, const BrushSpec& spec, const BrushPose& pose,
   scratch_b_.resize(size_t(std::max(N, S)));
   nonfinite_.set_device(device);
   nonfinite_.resize(2);
+  count_.set_device(device);
+  count_.resize(1);
   // Reserve the sort's scratch now so that the first step does not allocate.
   ws_.get(size_t(std::max(N, S)) * 2 * sizeof(uint32_t) + 4096);
 
@@ -331,6 +333,14 @@ void Brush::rasterize(Int3 window_origin, Int3 window_dims, float* psi, float* v
 
 int64_t Brush::mark_contacts(int32_t* trace, int trace_w, int trace_h, int ox, int oy, float contact_height,
                              const SolidField& solid) {
+  mark_contacts_into(trace, trace_w, trace_h, ox, oy, contact_height, solid, count_.data());
+  double n = 0;
+  count_.copy_to_host(&n, 1);
+  return int64_t(std::llround(n));
+}
+
+void Brush::mark_contacts_into(int32_t* trace, int trace_w, int trace_h, int ox, int oy, float contact_height,
+                               const SolidField& solid, double* count) {
   WB_PROFILE_SCOPE("brush.contacts");
   WB_REQUIRE(trace && trace_w > 0 && trace_h > 0, "Brush::mark_contacts: empty trace");
   WB_REQUIRE(uint64_t(trace_w) * uint64_t(trace_h) < (uint64_t(1) << 31), "Brush::mark_contacts: trace too large");
@@ -341,7 +351,12 @@ int64_t Brush::mark_contacts(int32_t* trace, int trace_w, int trace_h, int ox, i
                           contact_keys_.data(), contact_vals_.data());
   sort_by_key(device_, contact_keys_.data(), contact_vals_.data(), S, bit_width(sentinel), ws_);
   count_distinct_flags_on(device_, contact_keys_.data(), S, sentinel, scratch_a_.data());
-  return int64_t(std::llround(reduce_sum(device_, scratch_a_.data(), S, ws_)));
+  reduce_sum_into(device_, scratch_a_.data(), S, count, ws_);
+}
+
+void Brush::max_stretch_into(float* out) {
+  brush_stretch_and_z_on(device_, state_view(), rest_view(), scratch_a_.data(), scratch_b_.data());
+  reduce_max_into(device_, scratch_a_.data(), vertex_count(), out, ws_);
 }
 
 BrushStats Brush::stats() {

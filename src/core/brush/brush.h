@@ -88,6 +88,11 @@ class Brush {
   /// into may have grown since the last step.
   int64_t mark_contacts(int32_t* trace, int trace_w, int trace_h, int ox, int oy, float contact_height,
                         const SolidField& solid = {});
+  /// mark_contacts with the count written to *count (a device pointer): no host read.
+  void mark_contacts_into(int32_t* trace, int trace_w, int trace_h, int ox, int oy, float contact_height,
+                          const SolidField& solid, double* count);
+  /// stats().max_stretch written to *out (a device pointer): no host read.
+  void max_stretch_into(float* out);
 
   BrushStats stats();
   /// Device view of the samples; valid until the brush is destroyed (the buffers never move).
@@ -146,6 +151,7 @@ class Brush {
   DeviceBuffer<uint32_t> contact_keys_, contact_vals_;
   DeviceBuffer<float> scratch_a_, scratch_b_;
   DeviceBuffer<int64_t> nonfinite_;  ///< the sub-step's non-finite counts (positions, velocities)
+  DeviceBuffer<double> count_;       ///< mark_contacts' count
 };
 
 }  // namespace wb

@@ -30,6 +30,11 @@ Replay::Replay(Simulator& sim, StrokePlayer& player)
   trace_.set_device(sim.device());
   trace_.resize(size_t(region_.width) * region_.height);
   trace_.fill_zero();
+  const size_t steps = size_t(std::max<int64_t>(player_.step_count(), 1));
+  contacts_.set_device(sim.device());
+  contacts_.resize(steps);
+  stretch_.set_device(sim.device());
+  stretch_.resize(steps);
   sim_.reset_brush(player_.pose_at(player_.t_begin()));
   // A brush that is not refilled at every pen-down carries one load for the whole stroke.
   if (!player_.stroke().paint.reload_on_pen_down) sim_.load_paint(player_.stroke().paint);
@@ -60,13 +65,28 @@ bool Replay::advance() {
   for (int k = 1; k <= step.substeps; ++k) poses_.push_back(player_.pose_at(StrokePlayer::substep_time(step, k)));
   sim_.step(poses_.data(), step.substeps, float(step.dt));
   // A bristle is in contact when a sample is within one cell of the canvas or dried paint.
-  const int64_t touched =
-      sim_.brush().mark_contacts(trace_.data(), region_.width, region_.height, region_.x0, region_.y0, 1.0f,
-                                 sim_.solid_field());
-  contact_cells_max_ = std::max(contact_cells_max_, touched);
-  max_stretch_ = std::max(max_stretch_, sim_.brush().stats().max_stretch);
+  if (recorded_ < int64_t(contacts_.size())) {
+    sim_.brush().mark_contacts_into(trace_.data(), region_.width, region_.height, region_.x0, region_.y0, 1.0f,
+                                    sim_.solid_field(), contacts_.data() + recorded_);
+    sim_.brush().max_stretch_into(stretch_.data() + recorded_);
+    ++recorded_;
+  }
   last_t_ = step.t;
   return true;
+}
+
+int64_t Replay::contact_cells_max() const {
+  if (recorded_ == 0) return 0;
+  std::vector<double> c(static_cast<size_t>(recorded_));
+  contacts_.copy_to_host(c.data(), c.size());
+  return int64_t(std::llround(*std::max_element(c.begin(), c.end())));
+}
+
+float Replay::max_stretch() const {
+  if (recorded_ == 0) return 0.f;
+  std::vector<float> s(static_cast<size_t>(recorded_));
+  stretch_.copy_to_host(s.data(), s.size());
+  return std::max(0.f, *std::max_element(s.begin(), s.end()));
 }
 
 std::vector<uint8_t> Replay::brush_image() const {

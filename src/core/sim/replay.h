@@ -29,10 +29,11 @@ class Replay {
   double sim_time() const { return last_t_ - player_.t_begin(); }
   const CanvasRect& region() const { return region_; }
 
-  /// Most canvas cells the bristles touched in one step.
-  int64_t contact_cells_max() const { return contact_cells_max_; }
-  /// Largest relative segment stretch seen after any step.
-  float max_stretch() const { return max_stretch_; }
+  /// Most canvas cells the bristles touched in one step (kept on the device a step at a time;
+  /// read here).
+  int64_t contact_cells_max() const;
+  /// Largest relative segment stretch seen after any step (likewise).
+  float max_stretch() const;
   /// Every canvas cell of the region that bristles touched so far (row-major, region-sized).
   std::vector<int32_t> contact_trace() const { return trace_.to_host(); }
 
@@ -47,8 +48,10 @@ class Replay {
   StrokePlayer& player_;
   CanvasRect region_;
   DeviceBuffer<int32_t> trace_;
-  int64_t contact_cells_max_ = 0;
-  float max_stretch_ = 0.f;
+  // Per step, on the device (no host read a step): touched cells and the largest stretch.
+  DeviceBuffer<double> contacts_;
+  DeviceBuffer<float> stretch_;
+  int64_t recorded_ = 0;
   double last_t_ = 0.0;
   std::vector<BrushPose> poses_;  ///< sub-step poses of the current step (reserved once)
 };
