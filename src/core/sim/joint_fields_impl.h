@@ -72,7 +72,8 @@ void joint_clamp_to_canvas(ParticleView p, Vec3 lo, Vec3 hi) {
 void joint_kill_nonfinite(ParticleView p) {
   parallel_for(p.count, [=] WB_HD(int64_t k) {
     const bool ok = isfinite3(p.x[k]) && isfinite3(p.v[k]) && isfinite(p.m[k]) && isfinite(p.pigment_r[k]) &&
-                    isfinite(p.pigment_y[k]) && isfinite(p.pigment_b[k]);
+                    isfinite(p.pigment_y[k]) && isfinite(p.pigment_b[k]) && isfinite(p.oil[k]) &&
+                    isfinite(p.dryness[k]);
     if (!ok) p.dead[k] = 1u;
   });
 }

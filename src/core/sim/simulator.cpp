@@ -179,6 +179,7 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
   ProfilerGuard guard(&profiler_);
   WB_PROFILE_SCOPE("sim.step");
   grid_->set_particle_density(nullptr);  // last step's raster is stale
+  count_nonfinite_on_entry();
 
   // --- 1-2. Brush (§4.1) in sub-steps, then its samples ------------------------------------
   const Vec3 footprint_before = footprint_centre(brush_->pose(), config_.brush.length);
@@ -352,39 +353,65 @@ void Simulator::joint_fields_stage() {
   joint_blend_velocity(device(), grid_->view(), win.paint().view(), rv, cell_mass);
 }
 
-void Simulator::contain_nonfinite() {
-  // A non-finite value anywhere in the live state is zeroed (grid) or removed (particles)
-  // before anything renders or scatters it; the event is counted and the books show the loss.
-  // Every array is counted on the device and the counts come back in one copy (one host read).
+std::array<std::pair<float*, int64_t>, Simulator::kCheckedArrays> Simulator::checked_arrays() {
+  // Grid fields, velocities and the brush's load first (zeroed where non-finite), then the
+  // particles' fields (kNonfiniteParticleArrays; a particle with any non-finite field is removed).
   ActiveWindow& win = grid_->window();
   PaintWindow& paint = win.paint();
-  int64_t bad = 0;
-  const std::pair<float*, int64_t> arrays[] = {
+  const int64_t np = particles_.size(), ns = load_->size();
+  return {{
 #define WB_X(name, doc) {paint.name.data(), paint.cell_count()},
       WB_PAINT_FIELDS(WB_X)
 #undef WB_X
       {win.velocity(0).data(), int64_t(win.velocity(0).size())},
       {win.velocity(1).data(), int64_t(win.velocity(1).size())},
       {win.velocity(2).data(), int64_t(win.velocity(2).size())},
-      {reinterpret_cast<float*>(particles_.x.data()), 3 * particles_.size()},
-      {particles_.m.data(), particles_.size()}};
-  constexpr size_t kArrays = std::size(arrays), kParticleArrays = 2;
-  if (nonfinite_counts_.size() < kArrays) nonfinite_counts_.resize(kArrays);
-  for (size_t i = 0; i < kArrays; ++i)
+      {load_->m.data(), ns},
+      {load_->pigment_r.data(), ns},
+      {load_->pigment_y.data(), ns},
+      {load_->pigment_b.data(), ns},
+      {load_->oil.data(), ns},
+      {reinterpret_cast<float*>(particles_.x.data()), 3 * np},
+      {reinterpret_cast<float*>(particles_.v.data()), 3 * np},
+      {particles_.m.data(), np},
+      {particles_.pigment_r.data(), np},
+      {particles_.pigment_y.data(), np},
+      {particles_.pigment_b.data(), np},
+      {particles_.oil.data(), np},
+      {particles_.dryness.data(), np}}};
+}
+
+void Simulator::count_nonfinite_on_entry() {
+  // What the step receives is counted too (a value that went bad between steps, from outside
+  // the step's stages): the step's own clamps may absorb it silently (max(m, 0) of NaN is 0),
+  // so this is where it is seen. Counted on the device; read with the end's counts.
+  const auto arrays = checked_arrays();
+  nonfinite_counts_.resize(2 * arrays.size());
+  for (size_t i = 0; i < arrays.size(); ++i)
+    count_nonfinite_into(device(), arrays[i].first, arrays[i].second, nonfinite_counts_.data() + arrays.size() + i,
+                         ws_);
+}
+
+void Simulator::contain_nonfinite() {
+  // A non-finite value anywhere in the live state is zeroed (grid fields, velocities, the
+  // brush's load: that paint is lost and the books show it) or removed (particles) before
+  // anything renders or scatters it; the event is counted. Every array is counted on the
+  // device and the counts, with those on entry, come back in one copy (one host read).
+  const auto arrays = checked_arrays();
+  const size_t n = arrays.size();
+  for (size_t i = 0; i < n; ++i)
     count_nonfinite_into(device(), arrays[i].first, arrays[i].second, nonfinite_counts_.data() + i, ws_);
-  int64_t counts[kArrays];
-  nonfinite_counts_.copy_to_host(counts, kArrays);
-  for (size_t i = 0; i + kParticleArrays < kArrays; ++i) {
+  std::array<int64_t, 2 * kCheckedArrays>& counts = nonfinite_host_;
+  nonfinite_counts_.copy_to_host(counts.data(), 2 * n);
+  int64_t bad = 0;
+  for (size_t i = 0; i < 2 * n; ++i) bad += counts[i];
+  for (size_t i = 0; i + kNonfiniteParticleArrays < n; ++i)
     if (counts[i]) joint_zero_nonfinite(device(), arrays[i].first, arrays[i].second);
-    bad += counts[i];
-  }
-  {
-    const int64_t k = counts[kArrays - 2] + counts[kArrays - 1];
-    if (k) {
-      joint_kill_nonfinite(device(), particles_.view());
-      particles_.compact(ws_);
-      bad += k;
-    }
+  int64_t particles_bad = 0;
+  for (size_t i = n - kNonfiniteParticleArrays; i < n; ++i) particles_bad += counts[i];
+  if (particles_bad) {
+    joint_kill_nonfinite(device(), particles_.view());
+    particles_.compact(ws_);
   }
   if (bad) ++counters_.nonfinite_events;
 }

@@ -2,7 +2,9 @@
 // stages called by name in the paper's order. The physics lives in the stage headers;
 // this file only sequences them, times them and keeps the books.
 #pragma once
+#include <array>
 #include <memory>
+#include <utility>
 
 #include "core/brush/brush.h"
 #include "core/canvas/tile_store.h"
@@ -91,6 +93,12 @@ class Simulator {
   PaintCensus record_census(TransferRecord& rec);
   void joint_fields_stage();
   void contain_nonfinite();
+  void count_nonfinite_on_entry();
+  /// Every array of the live state the containment checks (device pointer, floats): the paint
+  /// fields, 3 velocities, 5 load fields, then kNonfiniteParticleArrays particle fields.
+  static constexpr size_t kNonfiniteParticleArrays = 8;
+  static constexpr size_t kCheckedArrays = kPaintFieldCount + 3 + 5 + kNonfiniteParticleArrays;
+  std::array<std::pair<float*, int64_t>, kCheckedArrays> checked_arrays();
   void clamp_particles_to_canvas();
   TransferEnv transfer_env();
   /// D0 of §5.2, limited so that the particle zone fits in the window (transfer_env).
@@ -113,7 +121,8 @@ class Simulator {
   DeviceBuffer<float> psi_, bristle_v_[3], cell_v_[3];
   DeviceBuffer<float> raster_mass_, raster_density_, raster_mom_[3], raster_w_[3];
   DeviceBuffer<float> overlay_mass_;
-  DeviceBuffer<int64_t> nonfinite_counts_;  ///< per checked array, read back in one copy
+  DeviceBuffer<int64_t> nonfinite_counts_;  ///< per checked array at the end, then on entry: one copy
+  std::array<int64_t, 2 * kCheckedArrays> nonfinite_host_{};
   /// The step's record on the device: the transfer's sums and the census's, read in one copy.
   struct StepSums {
     TransferSums transfer;
