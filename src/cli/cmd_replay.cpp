@@ -1,6 +1,7 @@
 // `wetbrush replay STROKES`: runs a stroke file (JSON or MyPaint dump) through the
 // simulator headless; writes the rendered painting, optional frames, the brush trace,
 // an OpenRaster painting and a stats JSON (docs/FORMATS.md, "Replay statistics").
+#include <malloc.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -157,16 +158,8 @@ void report_bench(const ReplayArgs& a, const Simulator& sim, const Stroke& strok
   }
 }
 
-int run_replay(const ReplayArgs& a) {
-  const Device device = resolve_device(a.device);
-  Stroke stroke = load_stroke(a.strokes);
-  apply_overrides(a, stroke);
-  for (const std::string& w : stroke.warnings) std::fprintf(stderr, "wetbrush: warning: %s\n", w.c_str());
-  if (!a.frames_dir.empty()) {
-    WB_REQUIRE(a.every > 0, "--every must be at least 1");
-    std::filesystem::create_directories(a.frames_dir);
-  }
-
+/// The simulator's configuration for a stroke and the command's options.
+SimConfig replay_config(const ReplayArgs& a, const Stroke& stroke, const Device& device) {
   SimConfig cfg;
   cfg.device = device;
   cfg.canvas = stroke.canvas;
@@ -194,6 +187,19 @@ int run_replay(const ReplayArgs& a) {
     for (const auto& w : warnings) std::fprintf(stderr, "wetbrush: warning: %s: %s\n", a.params_file.c_str(), w.c_str());
   }
   for (const std::string& s : a.sets) apply_param_assignment(cfg.params, s);
+  return cfg;
+}
+
+int run_replay(const ReplayArgs& a) {
+  const Device device = resolve_device(a.device);
+  Stroke stroke = load_stroke(a.strokes);
+  apply_overrides(a, stroke);
+  for (const std::string& w : stroke.warnings) std::fprintf(stderr, "wetbrush: warning: %s\n", w.c_str());
+  if (!a.frames_dir.empty()) {
+    WB_REQUIRE(a.every > 0, "--every must be at least 1");
+    std::filesystem::create_directories(a.frames_dir);
+  }
+  const SimConfig cfg = replay_config(a, stroke, device);
 
   StrokePlayer player(stroke);
   Simulator sim(cfg, player.pose_at(player.t_begin()));
@@ -322,6 +328,127 @@ int run_replay(const ReplayArgs& a) {
   return nonfinite ? 3 : 0;
 }
 
+/// `wetbrush soak`: the stroke files replayed back to back, each on a fresh simulator, for a
+/// given time (docs/PERFORMANCE.md "Soak"): what a long session must not do is grow its memory,
+/// slow down or let its books drift.
+struct SoakArgs {
+  std::vector<std::string> strokes;
+  double minutes = 60.0;
+  std::string device = "auto";
+  std::string json;
+};
+
+/// Resident memory of this process, bytes (Linux /proc/self/statm).
+double resident_bytes() {
+  std::ifstream f("/proc/self/statm");
+  long long pages_total = 0, pages_resident = 0;
+  f >> pages_total >> pages_resident;
+  return double(pages_resident) * double(sysconf(_SC_PAGESIZE));
+}
+
+int run_soak(const SoakArgs& s) {
+  WB_REQUIRE(std::isfinite(s.minutes) && s.minutes > 0.0 && s.minutes <= 24 * 60, "--minutes must be in (0, 1440]");
+  const Device device = resolve_device(s.device);
+  std::vector<Stroke> strokes;
+  for (const std::string& path : s.strokes) strokes.push_back(load_stroke(path));
+  struct Run {
+    int cycle;
+    size_t stroke;
+    int64_t steps;
+    double step_ms, drift, rss, held;
+    int64_t nonfinite;
+  };
+  std::vector<Run> runs;
+  const bool tty = isatty(STDERR_FILENO);
+  const auto t0 = std::chrono::steady_clock::now();
+  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  for (int cycle = 0; cycle == 0 || elapsed() < s.minutes * 60.0; ++cycle) {
+    for (size_t i = 0; i < strokes.size(); ++i) {
+      ReplayArgs a;
+      a.device = s.device;
+      Run r{cycle, i, 0, 0, 0, 0, 0, 0};
+      {
+        const SimConfig cfg = replay_config(a, strokes[i], device);
+        StrokePlayer player(strokes[i]);
+        Simulator sim(cfg, player.pose_at(player.t_begin()));
+        Replay replay(sim, player);
+        std::vector<double> ms;
+        double last_print = elapsed();
+        for (;;) {
+          const auto ts = std::chrono::steady_clock::now();
+          if (!replay.advance()) break;
+          ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - ts).count());
+          if (tty && elapsed() - last_print > 1.0) {
+            last_print = elapsed();
+            std::fprintf(stderr, "\rcycle %d  %s  step %lld/%lld  %.0f s elapsed   ", cycle, s.strokes[i].c_str(),
+                         static_cast<long long>(replay.steps_done()), static_cast<long long>(replay.step_count()),
+                         elapsed());
+          }
+        }
+        sim.settle();
+        r.steps = int64_t(ms.size());
+        if (!ms.empty()) {
+          std::nth_element(ms.begin(), ms.begin() + ms.size() / 2, ms.end());
+          r.step_ms = ms[ms.size() / 2];
+        }
+        r.drift = std::fabs(sim.books().max_drift());
+        r.nonfinite = sim.counters().nonfinite_events;
+      }
+      // After the simulator is gone: what the process and the backend still hold. The C library
+      // keeps freed memory for reuse (its mmap threshold rises after large frees); returning it
+      // first makes the resident figure what is live, so a leak shows as growth.
+      malloc_trim(0);
+      r.rss = resident_bytes();
+      r.held = double(mem::usage(!device.is_cpu()).in_use);
+      runs.push_back(r);
+      if (tty) std::fprintf(stderr, "\r");
+      std::printf("cycle %d  %-28s %5lld steps  %8.2f ms/step  drift %.1e  resident %7.1f MiB  held %6.1f MiB  %.0f s\n",
+                  cycle, s.strokes[i].c_str(), static_cast<long long>(r.steps), r.step_ms, r.drift, r.rss / 1048576.0,
+                  r.held / 1048576.0, elapsed());
+      std::fflush(stdout);
+    }
+  }
+  // Growth against the end of the first cycle (the first replays warm the allocator and caches).
+  const size_t n = strokes.size();
+  const Run& base = runs[n - 1];
+  const Run& last = runs.back();
+  const double growth = (last.rss - base.rss) / base.rss;
+  double worst_drift = 0, worst_slowdown = 0, max_held = 0;
+  int64_t nonfinite = 0;
+  for (const Run& r : runs) {
+    worst_drift = std::max(worst_drift, r.drift);
+    nonfinite += r.nonfinite;
+    max_held = std::max(max_held, r.held);
+  }
+  const int cycles = last.cycle + 1;
+  if (cycles >= 2)
+    for (size_t i = 0; i < n; ++i) {
+      const Run& first = runs[i];
+      const Run& end = runs[runs.size() - n + i];
+      if (first.step_ms > 0) worst_slowdown = std::max(worst_slowdown, end.step_ms / first.step_ms - 1.0);
+    }
+  std::printf("soak: %d cycles of %zu strokes in %.0f s; resident memory %+.2f %% since the first cycle "
+              "(%.1f -> %.1f MiB); backend memory held between replays at most %.1f MiB; step time of the last cycle "
+              "against the first at most %+.1f %%; books drift at most %.1e; %lld non-finite events\n",
+              cycles, n, elapsed(), 100.0 * growth, base.rss / 1048576.0, last.rss / 1048576.0, max_held / 1048576.0,
+              100.0 * worst_slowdown, worst_drift, static_cast<long long>(nonfinite));
+  if (!s.json.empty()) {
+    nlohmann::json j{{"device", device.to_string()}, {"cycles", cycles}, {"seconds", elapsed()},
+                     {"resident_growth", growth}, {"backend_held_max_bytes", max_held},
+                     {"step_time_slowdown_max", worst_slowdown}, {"drift_max", worst_drift},
+                     {"nonfinite_events", nonfinite}, {"runs", nlohmann::json::array()}};
+    for (const Run& r : runs)
+      j["runs"].push_back({{"cycle", r.cycle}, {"stroke", s.strokes[r.stroke]}, {"steps", r.steps},
+                           {"step_ms_median", r.step_ms}, {"drift", r.drift}, {"resident_bytes", r.rss},
+                           {"backend_held_bytes", r.held}});
+    write_text_file(s.json, j.dump(2) + "\n");
+  }
+  // The bounds of docs/PERFORMANCE.md "Soak": memory flat within 1 %, books closed, finite.
+  const bool ok = (cycles < 2 || growth <= 0.01) && worst_drift <= 1e-4 && nonfinite == 0;
+  if (!ok) std::fprintf(stderr, "wetbrush soak: FAILED (memory growth, books drift or non-finite events)\n");
+  return ok ? 0 : 1;
+}
+
 }  // namespace
 
 void register_replay(CLI::App& app) {
@@ -365,6 +492,17 @@ void register_replay(CLI::App& app) {
   add_device_option(b, bench->device);
   bench->quiet = true;
   set_action(b, [bench]() { return run_replay(*bench); });
+
+  auto soak = std::make_shared<SoakArgs>();
+  CLI::App* k = app.add_subcommand(
+      "soak", "Replay stroke files back to back, each on a fresh simulator, for a while: memory, step time and books");
+  k->add_option("STROKES", soak->strokes, "Stroke files (wetbrush JSON or MyPaint dump)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  k->add_option("--minutes", soak->minutes, "How long to keep going (whole cycles; at least one)")->capture_default_str();
+  k->add_option("--json", soak->json, "Also write every run's figures as JSON");
+  add_device_option(k, soak->device);
+  set_action(k, [soak]() { return run_soak(*soak); });
 }
 
 }  // namespace wb::cli
