@@ -49,7 +49,7 @@ TEST(Cli, EverySubcommandHasHelp) {
   const RunResult top = run_cli("--help");
   EXPECT_EQ(top.exit_code, 0) << top.output;
   // Every command that runs kernels takes --device; `params` only prints the table.
-  for (const char* sub : {"replay", "bench", "devices", "params", "solver-study"}) {
+  for (const char* sub : {"replay", "bench", "soak", "devices", "params", "solver-study"}) {
     const RunResult r = run_cli(std::string(sub) + " --help");
     EXPECT_EQ(r.exit_code, 0) << sub << ": " << r.output;
     if (std::string(sub) != "params")
@@ -125,9 +125,31 @@ TEST(Cli, BenchReportsEveryStageTheStepRateAndMemory) {
   const nlohmann::json& step = j["stages"]["sim.step"];
   EXPECT_EQ(step["calls"].get<int>(), j["steps"].get<int>());
   EXPECT_GE(step["p90_ms"].get<double>(), step["median_ms"].get<double>());
+  // Host reads of device results: every step makes some (the books' record at least).
+  EXPECT_GE(j["host_waits_per_step"].get<double>(), 1.0);
+  EXPECT_GE(step["host_reads_mean"].get<double>(), 1.0);
   for (const auto& [name, st] : j["stages"].items())
     EXPECT_LE(st["median_ms"].get<double>(), step["p90_ms"].get<double>() * 1.01 + 1e-3) << name << " longer than a step";
   EXPECT_NE(run_cli("bench --device cpu " + data("strokes/bad/empty.json")).exit_code, 0);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Cli, SoakReportsMemoryStepTimeAndBooksPerRun) {
+  // One cycle (the shortest soak): a line per run and a JSON of the figures; a fresh simulator
+  // per run leaves no backend memory held after it.
+  const auto dir = temp_dir("soak");
+  const std::string out = (dir / "soak.json").string();
+  const RunResult r = run_cli("soak --device cpu --minutes 0.001 " + data("strokes/good/minimal.json") + " --json " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("soak: 1 cycles"), std::string::npos) << r.output;
+  std::ifstream f(out);
+  const nlohmann::json j = nlohmann::json::parse(f);
+  ASSERT_EQ(j["runs"].size(), 1u);
+  EXPECT_GT(j["runs"][0]["steps"].get<int>(), 0);
+  EXPECT_GT(j["runs"][0]["resident_bytes"].get<double>(), 1e6);
+  EXPECT_EQ(j["backend_held_max_bytes"].get<double>(), 0.0) << "a replay's buffers outlived its simulator";
+  EXPECT_LE(j["drift_max"].get<double>(), 1e-4);
+  EXPECT_NE(run_cli("soak --device cpu --minutes -1 " + data("strokes/good/minimal.json")).exit_code, 0);
   std::filesystem::remove_all(dir);
 }
 
