@@ -65,6 +65,7 @@ std::vector<ScriptPoint> line_points(QPointF a, QPointF b, int n, float pressure
 }  // namespace wb::studio
 
 #include <cmath>
+#include <utility>
 
 #include "studio/main_window.h"
 
@@ -107,6 +108,17 @@ double run_demo_painting(MainWindow& w) {
     w.settle();
   }
   return pen_s;
+}
+
+void paint_loop_stroke(MainWindow& w, int k) {
+  const QSize c = w.view()->canvas_size();
+  const double W = c.width(), H = c.height();
+  const double y = H * (0.2 + 0.15 * (k % 5));
+  QPointF a(W * 0.15, y), b(W * 0.85, y);
+  if (k % 2) std::swap(a, b);
+  w.dip(w.paint_panel()->current_paint());
+  tablet_stroke(w.view(), line_points(a, b, 48, 0.6f, 10.f, 0.f), 20);
+  w.settle();
 }
 
 }  // namespace wb::studio

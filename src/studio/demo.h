@@ -31,4 +31,8 @@ class MainWindow;
 /// varying pressure and tilt (the README screenshot and the frame-rate measurement). Returns
 /// the seconds the pen spent on the canvas.
 double run_demo_painting(MainWindow& w);
+/// Stroke k of an endless scripted session (`--paint-loop`, the autosave and recovery test): a
+/// dip, then a straight stroke of about a second across row k mod 5 of the canvas, alternating in
+/// direction. Returns once the simulation has caught up with it.
+void paint_loop_stroke(MainWindow& w, int k);
 }  // namespace wb::studio

@@ -35,7 +35,13 @@ int main(int argc, char** argv) {
                                "With --demo-screenshot: write the view frame rate and the simulation rate of the "
                                "scripted painting to FILE (JSON).",
                                "file");
-  cli.addOptions({device_opt, preset_opt, data_opt, norecover_opt, demo_opt, stats_opt});
+  QCommandLineOption autosave_opt("autosave-interval", "Seconds between autosaves of a changed painting (default 180).",
+                                  "seconds", "180");
+  QCommandLineOption loop_opt("paint-loop",
+                              "Paint scripted tablet strokes without end, announcing each on standard output when the "
+                              "pen goes down and when it lifts (the autosave and recovery test kills the studio "
+                              "mid-stroke).");
+  cli.addOptions({device_opt, preset_opt, data_opt, norecover_opt, autosave_opt, demo_opt, stats_opt, loop_opt});
   cli.addPositionalArgument("painting", "OpenRaster painting to open (.ora).", "[painting]");
   cli.process(app);
 
@@ -47,8 +53,15 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "wetbrush-studio: %s\n", e.what());
     return 2;
   }
+  bool interval_ok = false;
+  opt.autosave_interval_s = cli.value(autosave_opt).toInt(&interval_ok);
+  if (!interval_ok || opt.autosave_interval_s < 1 || opt.autosave_interval_s > 86400) {
+    std::fprintf(stderr, "wetbrush-studio: --autosave-interval: expected whole seconds from 1 to 86400, got '%s'\n",
+                 qPrintable(cli.value(autosave_opt)));
+    return 2;
+  }
   opt.data_dir = cli.value(data_opt);
-  opt.offer_recovery = !cli.isSet(norecover_opt) && !cli.isSet(demo_opt);
+  opt.offer_recovery = !cli.isSet(norecover_opt) && !cli.isSet(demo_opt) && !cli.isSet(loop_opt);
   if (!cli.positionalArguments().isEmpty()) opt.open_path = cli.positionalArguments().first();
 
   MainWindow w(opt);
@@ -100,6 +113,20 @@ int main(int argc, char** argv) {
       std::printf("wrote %s\n", qPrintable(out));
       w.undo_stack()->setClean();
       QApplication::quit();
+    });
+  }
+  if (cli.isSet(loop_opt)) {
+    QObject::connect(w.view(), &CanvasView::penPress, [](PenInput, double) {
+      std::printf("paint-loop: pen down\n");
+      std::fflush(stdout);
+    });
+    QObject::connect(w.view(), &CanvasView::penRelease, [](PenInput, double) {
+      std::printf("paint-loop: pen up\n");
+      std::fflush(stdout);
+    });
+    // Events are processed within each stroke, so closing the window ends the loop.
+    QTimer::singleShot(500, &w, [&w] {
+      for (int k = 0; w.isVisible(); ++k) paint_loop_stroke(w, k);
     });
   }
   return app.exec();

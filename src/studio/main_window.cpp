@@ -432,13 +432,32 @@ bool MainWindow::write_snapshot(const QString& path, bool wait, bool user_save) 
       done->set_value(e.what());
     }
   });
-  const auto finish = [this, path, user_save](const std::string& err) {
+  // A user save marks the painting saved at once (strokes painted while the file is written
+  // are changes after it), and takes that back if the write fails: the painting stays open
+  // and unsaved, with its previous file name.
+  const QString previous_path = path_;
+  const auto finish = [this, path, user_save, previous_path](const std::string& err) {
     --saves_in_flight_;
     if (!err.empty()) {
-      QMessageBox::warning(this, "Save failed", QString::fromStdString(err));
+      const QString msg = QString::fromStdString(err);
+      std::fprintf(stderr, "wetbrush-studio: %s\n", qPrintable(msg));
+      autosave_due_ = true;
+      if (!user_save) {
+        // An autosave retries on its timer; a dialog would interrupt the stroke being painted.
+        statusBar()->showMessage("Autosave failed: " + msg, 10000);
+        return false;
+      }
+      undo_->resetClean();
+      dirty_ = true;
+      if (path_ == path) path_ = previous_path;
+      update_title();
+      QMessageBox::warning(this, "Save failed",
+                           msg + "\n\nThe painting is still open with its unsaved changes. Save it again, "
+                                 "or to another folder.");
       return false;
     }
     if (user_save) {
+      add_recent(path);
       statusBar()->showMessage("Saved " + path, 4000);
     }
     return true;
@@ -447,7 +466,6 @@ bool MainWindow::write_snapshot(const QString& path, bool wait, bool user_save) 
     path_ = path;
     undo_->setClean();
     dirty_ = false;
-    add_recent(path);
     update_title();
   }
   if (wait) return finish(result.get());
@@ -462,6 +480,11 @@ bool MainWindow::write_snapshot(const QString& path, bool wait, bool user_save) 
   });
   poll->start();
   return true;
+}
+
+void MainWindow::wait_for_saves() {
+  while (saves_in_flight_ > 0)
+    QCoreApplication::processEvents(QEventLoop::WaitForMoreEvents | QEventLoop::ExcludeUserInputEvents);
 }
 
 bool MainWindow::save_to(const QString& path, bool wait) { return write_snapshot(path, wait, true); }
@@ -611,6 +634,8 @@ void MainWindow::rebuild_recent_menu() {
 }
 
 bool MainWindow::maybe_save() {
+  // A save still being written may fail and leave the painting unsaved after all.
+  wait_for_saves();
   if (!modified()) return true;
   const auto b = QMessageBox::question(this, "Unsaved changes", "The painting has unsaved changes. Save them?",
                                        QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel,

@@ -75,6 +75,8 @@ class MainWindow : public QMainWindow {
   void add_recent(const QString& path);
   void rebuild_recent_menu();
   bool maybe_save();
+  /// Returns when every save in flight has succeeded or failed (and said so).
+  void wait_for_saves();
   void autosave();
   void check_recovery();
   bool write_snapshot(const QString& path, bool wait, bool user_save);

@@ -1,9 +1,12 @@
 // Studio tests (Qt Test, run under xvfb-run for Mesa OpenGL): the window opens with an OpenGL
 // canvas; synthesised tablet strokes paint under their path only; pressure widens the stroke;
 // undo / redo restore the exact canvas; save then open gives the same volume; a recorded
-// session replays to the same canvas; closing with unsaved changes asks. Each test function
-// stands alone: CTest runs each in a process of its own (cmake/StudioTests.cmake).
+// session replays to the same canvas; closing with unsaved changes asks; the real studio killed
+// mid-stroke recovers its last autosave; a save that fails (read-only folder, file size limit)
+// keeps the old file and the painting open and unsaved. Each test function stands alone: CTest
+// runs each in a process of its own (cmake/StudioTests.cmake).
 #include <QApplication>
+#include <QDir>
 #include <QElapsedTimer>
 #include <QFile>
 #include <QMessageBox>
@@ -14,12 +17,18 @@
 #include <QTest>
 #include <QTimer>
 
+#include <signal.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <future>
 #include <nlohmann/json.hpp>
 #include <numeric>
 #include <omp.h>
+#include <optional>
 
 #include "core/io/document.h"
 #include "core/io/stroke.h"
@@ -99,12 +108,63 @@ int painted_width(const std::vector<float>& col, int width, int height, int x, i
   return n;
 }
 
+QByteArray read_bytes(const QString& path) {
+  QFile f(path);
+  return f.open(QIODevice::ReadOnly) ? f.readAll() : QByteArray();
+}
+
+/// Temporary files of saves (`.NAME.tmp-PID-XXXXXX`) left in a folder.
+QStringList save_temporaries(const QString& folder) {
+  return QDir(folder).entryList({"*.tmp-*"}, QDir::Files | QDir::Hidden);
+}
+
+/// Answers the window's modal message boxes as they open (a timer polls for them, since they
+/// block the caller), and records each one's title and text.
+class BoxAnswerer {
+ public:
+  struct Box {
+    QString title, text;
+  };
+  explicit BoxAnswerer(std::function<QMessageBox::StandardButton(QMessageBox&)> answer) : answer_(std::move(answer)) {
+    QObject::connect(&timer_, &QTimer::timeout, [this] {
+      auto* box = qobject_cast<QMessageBox*>(QApplication::activeModalWidget());
+      if (!box || !box->isVisible()) return;
+      boxes.push_back({box->windowTitle(), box->text()});
+      if (QAbstractButton* b = box->button(answer_(*box)))
+        b->click();
+      else
+        box->reject();  // an unexpected box: recorded, and closed so that the test goes on
+    });
+    timer_.start(20);
+  }
+  QString titles() const {
+    QStringList t;
+    for (const Box& b : boxes) t << b.title;
+    return t.join(", ");
+  }
+  std::vector<Box> boxes;
+
+ private:
+  std::function<QMessageBox::StandardButton(QMessageBox&)> answer_;
+  QTimer timer_;
+};
+
+/// Gives a folder made read-only by a test its write permission back (QTemporaryDir must
+/// remove it), however the test ends.
+struct WritableAgain {
+  QString folder;
+  ~WritableAgain() { QFile::setPermissions(folder, QFile::ReadOwner | QFile::WriteOwner | QFile::ExeOwner); }
+};
+
+/// Set in the child process of failedSaveAtFileSizeLimitKeepsPainting.
+constexpr const char* kFileSizeChildEnv = "WB_STUDIO_TEST_FILE_SIZE_CHILD";
+
 }  // namespace
 
 class StudioTest : public QObject {
   Q_OBJECT
  private:
-  QTemporaryDir dir_;
+  std::unique_ptr<QTemporaryDir> dir_;  ///< made by initTestCase (listing the functions makes none)
   std::unique_ptr<MainWindow> w_;
   // The tiny preset: the studio's input path, undo, files and recording at a scale where a
   // stroke simulates in seconds on two CPU cores (canvas 160 x 120 x 16, window 32 x 32 x 8,
@@ -120,7 +180,7 @@ class StudioTest : public QObject {
     StudioOptions o;
     o.device = Device::parse("cpu");
     o.preset = preset_;
-    o.data_dir = dir_.path() + "/data";
+    o.data_dir = dir_->path() + "/data";
     o.offer_recovery = false;
     return o;
   }
@@ -138,9 +198,72 @@ class StudioTest : public QObject {
           (long long)st.steps, st.step_ms, (long long)st.particles, c.grid, c.particles, c.bristles);
   }
 
+  /// Paints a stroke on a new canvas and saves it to `path` (the old file of a failed save).
+  void paint_and_save(const QString& path) {
+    grid_only_canvas(false);
+    stroke(40.f, 0.6f);
+    QVERIFY(w_->save_to(path, true));
+    QVERIFY(!w_->modified());
+    // A second stroke, not saved: the painting that a failed save must keep.
+    stroke(80.f, 0.7f, 20.f, 140.f);
+    QVERIFY(w_->modified());
+  }
+
+  /// Saves over `path` while saves fail: each gives a clear error naming the file and `why`,
+  /// leaves the file byte for byte as `old_file` with no temporary file beside it, and keeps
+  /// the painting open, unchanged and marked unsaved. Through both save paths (waiting, as
+  /// closing does; on a worker, as File > Save), and closing while such a save is written
+  /// waits for it and then asks about the unsaved painting.
+  void expect_failed_saves(const QString& path, const QByteArray& old_file, const std::vector<uint8_t>& painting,
+                           const QString& why) {
+    const QString folder = QFileInfo(path).absolutePath();
+    const QString title = QFileInfo(path).fileName() + " *";
+    // Ok to the error; Cancel to "save the changes?", so that the window stays open.
+    BoxAnswerer answer(
+        [](QMessageBox& b) { return b.button(QMessageBox::Cancel) ? QMessageBox::Cancel : QMessageBox::Ok; });
+    const auto kept = [&](const char* how) {
+      QVERIFY2(answer.boxes.size() == 1 && answer.boxes[0].title == "Save failed",
+               qPrintable(QString("%1: one error box, got: %2").arg(how, answer.titles())));
+      const QString msg = answer.boxes[0].text;
+      qInfo("%s: \"%s\"", how, qPrintable(QString(msg).replace('\n', ' ')));
+      QVERIFY2(msg.contains(path) && msg.contains(why), qPrintable("the error names the file and " + why + ": " + msg));
+      QVERIFY2(read_bytes(path) == old_file, "the old file is intact, byte for byte");
+      QVERIFY2(save_temporaries(folder).isEmpty(),
+               qPrintable("temporary files left: " + save_temporaries(folder).join(", ")));
+      QVERIFY2(w_->modified(), "the painting is still marked unsaved");
+      QVERIFY2(w_->windowTitle().startsWith(title), qPrintable("the title marks it unsaved: " + w_->windowTitle()));
+      QCOMPARE(w_->current_path(), path);
+      QVERIFY2(volume_bytes(*w_) == painting, "the painting is open and unchanged");
+      answer.boxes.clear();
+    };
+    QVERIFY2(!w_->save_to(path, true), "a failed save says so");
+    kept("waiting save");
+    if (QTest::currentTestFailed()) return;
+    w_->save_to(path);
+    QTRY_VERIFY_WITH_TIMEOUT(!answer.boxes.empty(), 10000);
+    kept("save on a worker");
+    if (QTest::currentTestFailed()) return;
+    w_->save_to(path);
+    QVERIFY2(!w_->close(), "closing with a failing save in flight keeps the window");
+    QVERIFY2(answer.boxes.size() == 2 && answer.boxes[0].title == "Save failed" &&
+                 answer.boxes[1].title == "Unsaved changes",
+             qPrintable("closing waits for the save's error, then asks; got: " + answer.titles()));
+    QVERIFY(w_->isVisible());
+    QVERIFY(w_->modified());
+  }
+
+  /// Once saves work again, a save holds the painting that was kept open.
+  void expect_save_after_repair(const QString& path, const std::vector<uint8_t>& painting) {
+    QVERIFY(w_->save_to(path, true));
+    QVERIFY(!w_->modified());
+    Painting saved = load_painting(path.toStdString(), Device::parse("cpu"));
+    QVERIFY2(canonical_volume(saved.canvas) == painting, "the next save holds the painting");
+  }
+
  private Q_SLOTS:
   void initTestCase() {
-    QVERIFY(dir_.isValid());
+    dir_ = std::make_unique<QTemporaryDir>();
+    QVERIFY(dir_->isValid());
 
     w_ = std::make_unique<MainWindow>(options());
     w_->show();
@@ -276,7 +399,7 @@ class StudioTest : public QObject {
     stroke(50.f, 0.6f);
     const std::vector<uint8_t> now = volume_bytes(*w_);
     QVERIFY(now.size() > 0);
-    const QString path = dir_.path() + "/painting.ora";
+    const QString path = dir_->path() + "/painting.ora";
     QVERIFY(w_->save_to(path, true));
     QVERIFY(!w_->modified());
     // What the file holds is what the studio had.
@@ -306,23 +429,23 @@ class StudioTest : public QObject {
     tablet_stroke(w_->view(), line_points(QPointF(25, 35), QPointF(125, 55), 24, 0.7f, 15.f, 0.f), 12);
     w_->settle();
     // A save between the strokes must not change what the simulation does next.
-    QVERIFY(w_->save_to(dir_.path() + "/between.ora", true));
+    QVERIFY(w_->save_to(dir_->path() + "/between.ora", true));
     w_->wipe(0.5f);
     tablet_stroke(w_->view(), line_points(QPointF(135, 85), QPointF(40, 75), 24, 0.5f, -10.f, 10.f), 12);
     w_->settle();
     QVERIFY(w_->sim()->recording_from_blank());
-    const QString rec = dir_.path() + "/session.json";
+    const QString rec = dir_->path() + "/session.json";
     QVERIFY(w_->save_recording(rec));
 
     // `wetbrush replay` of the file on the same device. It ends by settling the particles into
     // the canvas; the studio's settled canvas (what it saves) is compared.
-    const QString out = dir_.path() + "/replay.ora";
+    const QString out = dir_->path() + "/replay.ora";
     const int64_t particles_live = w_->sim()->status().particles;
     QProcess cli;
     QProcessEnvironment env = QProcessEnvironment::systemEnvironment();
     env.insert("OMP_NUM_THREADS", "1");
     cli.setProcessEnvironment(env);
-    const QString stats = dir_.path() + "/replay-stats.json";
+    const QString stats = dir_->path() + "/replay-stats.json";
     // The recording names the studio's active window, so the replay needs no --window.
     cli.start(WB_CLI_PATH, {"replay", rec, "--device", "cpu", "--save", out, "--stats", stats, "--quiet"});
     QVERIFY(cli.waitForFinished(120000));
@@ -394,7 +517,7 @@ class StudioTest : public QObject {
     QVERIFY(!closed);
     QVERIFY(w_->isVisible());
     // Saved: closing does not ask.
-    QVERIFY(w_->save_to(dir_.path() + "/closing.ora", true));
+    QVERIFY(w_->save_to(dir_->path() + "/closing.ora", true));
     bool asked_again = false;
     QTimer::singleShot(300, this, [&] {
       if (auto* box = qobject_cast<QMessageBox*>(QApplication::activeModalWidget())) {
@@ -404,6 +527,159 @@ class StudioTest : public QObject {
     });
     QVERIFY(w_->close());
     QVERIFY(!asked_again);
+  }
+
+  /// The real studio paints scripted strokes and autosaves every second; killed with SIGKILL
+  /// while its pen is down, its next start offers the recovery file, and accepting it gives the
+  /// painting of the last autosave, volume for volume.
+  void killedMidStrokeRecoversLastAutosave() {
+    const QString data = dir_->path() + "/killed";
+    const QString recovery = data + "/recovery.ora";
+    QProcess studio;
+    QElapsedTimer clock;
+    clock.start();
+    // The test's own Xvfb display, WB_DEVICE and OMP_WAIT_POLICY are inherited.
+    studio.start(WB_STUDIO_PATH, {"--device", "cpu", "--preset", "tiny", "--data-dir", data, "--autosave-interval",
+                                  "1", "--paint-loop"});
+    QVERIFY2(studio.waitForStarted(10000), qPrintable("wetbrush-studio did not start: " + studio.errorString()));
+    QByteArray out;
+    // Reads the studio's announcements until `done` holds, the studio exits or `ms` pass.
+    const auto wait_for = [&](const std::function<bool()>& done, int ms) {
+      QElapsedTimer t;
+      t.start();
+      while (!done() && studio.state() == QProcess::Running && t.elapsed() < ms) {
+        studio.waitForReadyRead(20);
+        out += studio.readAllStandardOutput();
+      }
+      return done();
+    };
+    const auto state = [&] {
+      return QString("after %1 s: studio %2, stdout:\n%3\nstderr:\n%4")
+          .arg(clock.elapsed() / 1000.0, 0, 'f', 1)
+          .arg(studio.state() == QProcess::Running ? "running" : "exited")
+          .arg(QString::fromUtf8(out), QString::fromUtf8(studio.readAllStandardError()));
+    };
+    QVERIFY2(wait_for([&] { return QFile::exists(recovery); }, 40000),
+             qPrintable("no autosave appeared in the data folder " + state()));
+    const double autosaved_s = clock.elapsed() / 1000.0;
+    const qsizetype downs = out.count("pen down");
+    QVERIFY2(wait_for([&] { return out.count("pen down") > downs; }, 30000),
+             qPrintable("the studio did not start another stroke " + state()));
+    // A quarter of the stroke's second of pen time: the simulation is mid-stroke.
+    wait_for([] { return false; }, 250);
+    QVERIFY2(studio.state() == QProcess::Running, qPrintable("the studio exited by itself " + state()));
+    QVERIFY(::kill(pid_t(studio.processId()), SIGKILL) == 0);
+    QVERIFY(studio.waitForFinished(10000));
+    out += studio.readAllStandardOutput();
+    const double killed_s = clock.elapsed() / 1000.0;
+    QCOMPARE(studio.exitStatus(), QProcess::CrashExit);
+    QVERIFY2(out.lastIndexOf("pen down") > out.lastIndexOf("pen up"),
+             qPrintable("the kill came after the pen lifted " + state()));
+
+    // The last autosave is what the recovery file holds now: a valid painting with the strokes.
+    const QByteArray saved = read_bytes(recovery);
+    QVERIFY2(!saved.isEmpty(), "the recovery file survived the kill");
+    std::optional<Painting> last;
+    try {
+      last = load_painting_bytes(reinterpret_cast<const uint8_t*>(saved.constData()), size_t(saved.size()),
+                                 recovery.toStdString(), Device::parse("cpu"));
+    } catch (const std::exception& e) {
+      QFAIL(qPrintable(QString("the recovery file is not a valid painting: ") + e.what()));
+    }
+    QCOMPARE(last->canvas.dims().width, kW);
+    QCOMPARE(last->canvas.dims().height, kH);
+    const std::vector<float> col = column_density(last->canvas);
+    const double paint = std::accumulate(col.begin(), col.end(), 0.0);
+    const QStringList temporaries = save_temporaries(data);
+    qInfo("studio: first autosave after %.1f s, killed after %.1f s (stroke %lld, pen down); recovery file %lld "
+          "bytes, %.1f cell volumes of paint; temporary files left by the kill: %lld",
+          autosaved_s, killed_s, (long long)out.count("pen down"), (long long)saved.size(), paint,
+          (long long)temporaries.size());
+    QVERIFY2(paint > 5.0, "the autosave holds the painted strokes");
+
+    // The next start: it offers the recovery, and Yes opens the autosaved painting, unsaved.
+    QElapsedTimer recovering;
+    recovering.start();
+    StudioOptions o = options();
+    o.data_dir = data;
+    o.offer_recovery = true;
+    BoxAnswerer answer([](QMessageBox&) { return QMessageBox::Yes; });
+    auto next = std::make_unique<MainWindow>(o);
+    next->show();
+    QTRY_VERIFY2_WITH_TIMEOUT(!answer.boxes.empty(), "the next start offers to recover the painting", 10000);
+    next->settle();
+    QCOMPARE(answer.boxes.front().title, QString("Recover painting"));
+    QVERIFY2(volume_bytes(*next) == canonical_volume(last->canvas),
+             "the recovered painting is the last autosave, volume for volume");
+    QVERIFY2(next->modified() && next->windowTitle().startsWith("Untitled *"),
+             qPrintable("the recovered painting is open as unsaved: " + next->windowTitle()));
+    QVERIFY(next->current_path().isEmpty());
+    qInfo("recovery: offered and opened in %lld ms", (long long)recovering.elapsed());
+  }
+
+  void failedSaveToReadOnlyFolderKeepsPainting() {
+    const QString folder = dir_->path() + "/read-only";
+    const QString path = folder + "/painting.ora";
+    QVERIFY(QDir().mkpath(folder));
+    WritableAgain restore{folder};
+    const auto read_only = [&] {
+      return QFile::setPermissions(folder, QFile::ReadOwner | QFile::ExeOwner | QFile::ReadGroup | QFile::ExeGroup |
+                                               QFile::ReadOther | QFile::ExeOther);
+    };
+    QVERIFY(read_only());
+    if (::access(QFile::encodeName(folder).constData(), W_OK) == 0)
+      QSKIP("a folder with mode 0555 is still writable here (running as root): no read-only folder to save into");
+    QVERIFY(QFile::setPermissions(folder, QFile::ReadOwner | QFile::WriteOwner | QFile::ExeOwner));
+    paint_and_save(path);
+    if (QTest::currentTestFailed()) return;
+    const QByteArray old_file = read_bytes(path);
+    const std::vector<uint8_t> painting = volume_bytes(*w_);
+    QVERIFY(read_only());
+    expect_failed_saves(path, old_file, painting, "Permission denied");
+    if (QTest::currentTestFailed()) return;
+    QVERIFY(QFile::setPermissions(folder, QFile::ReadOwner | QFile::WriteOwner | QFile::ExeOwner));
+    expect_save_after_repair(path, painting);
+  }
+
+  void failedSaveAtFileSizeLimitKeepsPainting() {
+    if (!qEnvironmentVariableIsSet(kFileSizeChildEnv)) {
+      // The limit and the ignored SIGXFSZ hold for the whole process: this test function runs
+      // again in a child (this binary, this function alone), which sets them.
+      QProcess child;
+      QProcessEnvironment env = QProcessEnvironment::systemEnvironment();
+      env.insert(kFileSizeChildEnv, "1");
+      child.setProcessEnvironment(env);
+      child.setProcessChannelMode(QProcess::MergedChannels);
+      child.start(QCoreApplication::applicationFilePath(), {"failedSaveAtFileSizeLimitKeepsPainting"});
+      QVERIFY2(child.waitForFinished(120000), "the child test finished within two minutes");
+      const QString out = QString::fromUtf8(child.readAll());
+      qInfo("child test:\n%s", qPrintable(out));
+      QVERIFY2(child.exitStatus() == QProcess::NormalExit && child.exitCode() == 0,
+               qPrintable(QString("the child test failed (exit %1), its output is above").arg(child.exitCode())));
+      QVERIFY2(out.contains("PASS   : StudioTest::failedSaveAtFileSizeLimitKeepsPainting()"), "the child ran the test");
+      return;
+    }
+    const QString folder = dir_->path() + "/limited";
+    const QString path = folder + "/painting.ora";
+    QVERIFY(QDir().mkpath(folder));
+    paint_and_save(path);
+    if (QTest::currentTestFailed()) return;
+    const QByteArray old_file = read_bytes(path);
+    const std::vector<uint8_t> painting = volume_bytes(*w_);
+    // Below the size of the painting's file: writing it fails with EFBIG, as on a full disk.
+    constexpr rlim_t kLimit = 8 * 1024;
+    qInfo("old file %lld bytes, file size limit %lld bytes", (long long)old_file.size(), (long long)kLimit);
+    QVERIFY2(old_file.size() > qsizetype(2 * kLimit), "the painting's file is well over the limit");
+    rlimit unlimited{};
+    QVERIFY(::getrlimit(RLIMIT_FSIZE, &unlimited) == 0);
+    ::signal(SIGXFSZ, SIG_IGN);  // the write fails instead of killing the process
+    rlimit limited = unlimited;
+    limited.rlim_cur = kLimit;  // the soft limit only, so that it can be raised again
+    QVERIFY(::setrlimit(RLIMIT_FSIZE, &limited) == 0);
+    expect_failed_saves(path, old_file, painting, "File too large");
+    QVERIFY(::setrlimit(RLIMIT_FSIZE, &unlimited) == 0);
+    if (QTest::currentTestFailed()) return;
+    expect_save_after_repair(path, painting);
   }
 
   void cleanupTestCase() {
