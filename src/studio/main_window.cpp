@@ -30,6 +30,7 @@
 #include "core/io/brush_json.h"
 #include "core/io/document.h"
 #include "core/exec/error.h"
+#include "core/io/material_maps.h"
 #include "core/io/png.h"
 #include "studio/sim_paint.h"
 
@@ -551,16 +552,7 @@ bool MainWindow::export_maps(const QString& height_path, const QString& normal_p
   sim_->post([done, hp, np](SimThread& s) {
     try {
       TileStore canvas = settled_canvas_copy(s.sim(), s.sim().device());
-      const FloatImage h = s.renderer().render_height_map(canvas);
-      const double scale = 65535.0 / canvas.dims().depth;
-      std::vector<uint16_t> q(h.data.size());
-      for (size_t i = 0; i < q.size(); ++i) q[i] = uint16_t(std::lround(std::clamp(h.data[i] * scale, 0.0, 65535.0)));
-      write_png_gray16(hp, q.data(), h.width, h.height, {{"wetbrush:height_units_per_cell", std::to_string(scale)}});
-      const FloatImage n = s.renderer().render_normal_map(canvas);
-      std::vector<uint8_t> rgb(n.data.size());
-      for (size_t i = 0; i < rgb.size(); ++i)
-        rgb[i] = uint8_t(std::lround(std::clamp(n.data[i] * 0.5f + 0.5f, 0.f, 1.f) * 255.f));
-      write_png8(np, rgb.data(), n.width, n.height, 3);
+      write_material_maps(s.sim().device(), canvas, MaterialMapPaths{hp, np, ""});
       done->set_value("");
     } catch (const std::exception& e) {
       done->set_value(e.what());

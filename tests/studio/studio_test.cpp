@@ -414,6 +414,31 @@ class StudioTest : public QObject {
     QVERIFY(!w_->modified());
   }
 
+  void exportGivesTheCliFilesByteForByte() {
+    // File > Export and `wetbrush export` of the same painting write the same files: one writer
+    // (core/io/material_maps), the normal map's +Y up the image in both.
+    grid_only_canvas(false);
+    stroke(50.f, 0.6f);
+    const QString path = dir_->path() + "/export.ora";
+    QVERIFY(w_->save_to(path, true));
+    QVERIFY(w_->open_from(path));
+    w_->settle();
+    const QString h = dir_->path() + "/studio-height.png", n = dir_->path() + "/studio-normal.png";
+    QVERIFY(w_->export_maps(h, n));
+    const QString h2 = dir_->path() + "/cli-height.png", n2 = dir_->path() + "/cli-normal.png";
+    QProcess cli;
+    cli.start(WB_CLI_PATH, {"export", path, "--height", h2, "--normal", n2, "--device", "cpu"});
+    QVERIFY(cli.waitForFinished(120000));
+    QVERIFY2(cli.exitStatus() == QProcess::NormalExit && cli.exitCode() == 0, cli.readAllStandardError().constData());
+    const auto bytes = [](const QString& f) {
+      QFile file(f);
+      return file.open(QIODevice::ReadOnly) ? file.readAll() : QByteArray();
+    };
+    QVERIFY(!bytes(h).isEmpty() && !bytes(n).isEmpty());
+    QVERIFY2(bytes(h) == bytes(h2), "height maps differ");
+    QVERIFY2(bytes(n) == bytes(n2), "normal maps differ");
+  }
+
   void recordingReplaysToSameCanvas() {
     // One thread on both sides: the CPU backend's parallel atomic sums make two runs of the same
     // stroke differ (the FLIP step amplifies the rounding), one thread makes a run reproducible.
