@@ -26,10 +26,18 @@ WB_HD WB_INLINE int imax(int a, int b) { return a > b ? a : b; }
 WB_HD WB_INLINE int imin(int a, int b) { return a < b ? a : b; }
 
 /// Integer cell of p for cell size h.
+/// A cell coordinate defined for every float: beyond +-1e9 cells (no canvas is that large) and
+/// for a non-finite value (a point the step's containment is about to remove) it is clamped, as
+/// converting such a float to int is undefined.
+WB_HD WB_INLINE int hash_coord(float v) {
+  if (v > -1e9f && v < 1e9f) return int(floorf(v));
+  return v > 0.f ? 1000000000 : -1000000000;
+}
+
 WB_HD WB_INLINE void hash_cell_of(Vec3 p, float inv_h, int& ix, int& iy, int& iz) {
-  ix = int(floorf(p.x * inv_h));
-  iy = int(floorf(p.y * inv_h));
-  iz = int(floorf(p.z * inv_h));
+  ix = hash_coord(p.x * inv_h);
+  iy = hash_coord(p.y * inv_h);
+  iz = hash_coord(p.z * inv_h);
 }
 
 /// Bucket of cell (ix, iy, iz): the spatial hash of Teschner et al. 2003, masked. Distinct
@@ -56,7 +64,7 @@ WB_HD WB_INLINE int ring_far(int lo, int hi, int c) { return c - lo > hi - c ? c
 /// the lower sample index, so the answer does not depend on the order buckets are visited.
 WB_HD WB_INLINE NearestSample nearest_sample(const HashGridView& g, Vec3 p, float max_range) {
   NearestSample out{-1, max_range};
-  if (g.count == 0) return out;
+  if (g.count == 0 || !isfinite3(p)) return out;  // a non-finite point has no neighbour
   const float inv_h = 1.f / g.h;
   int cx, cy, cz;
   hash_cell_of(p, inv_h, cx, cy, cz);

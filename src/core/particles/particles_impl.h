@@ -12,6 +12,7 @@ void particles_adhesion_step(ParticleView p, SampleView s, SolidView solid, Part
   const int64_t n_samples = s.count();
   parallel_for(p.count, [=] WB_HD(int64_t k) {
     Vec3 x = p.x[k], v = p.v[k];
+    if (!isfinite3(x) || !isfinite3(v)) return;  // left as it is for the step's containment to remove
     const int32_t j = p.nearest[k];
     if (j >= 0 && j < n_samples) {
       const SampleFrame f = load_sample(s, j);
