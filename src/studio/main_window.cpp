@@ -411,6 +411,8 @@ bool MainWindow::write_snapshot(const QString& path, bool wait, bool user_save) 
   const std::string file = path.toStdString();
   const bool from_blank = sim_->recording_from_blank();
   ++saves_in_flight_;
+  const int64_t serial = ++snapshot_serial_;
+  if (!user_save) autosave_serial_ = serial;
   sim_->post([done, file, from_blank](SimThread& s) {
     try {
       // The paint at rest, with what is in flight now; the simulation goes on unchanged.
@@ -437,7 +439,7 @@ bool MainWindow::write_snapshot(const QString& path, bool wait, bool user_save) 
   // are changes after it), and takes that back if the write fails: the painting stays open
   // and unsaved, with its previous file name.
   const QString previous_path = path_;
-  const auto finish = [this, path, user_save, previous_path](const std::string& err) {
+  const auto finish = [this, path, user_save, previous_path, serial](const std::string& err) {
     --saves_in_flight_;
     if (!err.empty()) {
       const QString msg = QString::fromStdString(err);
@@ -460,7 +462,11 @@ bool MainWindow::write_snapshot(const QString& path, bool wait, bool user_save) 
     if (user_save) {
       add_recent(path);
       statusBar()->showMessage("Saved " + path, 4000);
+      saved_serial_ = std::max(saved_serial_, serial);
     }
+    // A recovery file older than a saved painting would offer, after a crash, to go back to
+    // before the save: it goes (an autosave asked for later is newer and stays).
+    if (autosave_serial_ < saved_serial_) QFile::remove(recovery_path());
     return true;
   };
   if (user_save) {

@@ -98,6 +98,10 @@ class MainWindow : public QMainWindow {
   QString path_;
   bool dirty_ = false;           ///< changes not in the undo stack (dry, open, new)
   bool autosave_due_ = false;
+  // Snapshots are taken in the order they are asked for (the simulation thread's queue): the
+  // serial of each, of the latest autosave asked for and of the latest user save that succeeded
+  // decide whether the recovery file is older than the saved painting (then it goes).
+  int64_t snapshot_serial_ = 0, autosave_serial_ = 0, saved_serial_ = 0;
   int64_t frames_at_ = 0;
   double frames_t_ = 0.0;
   double view_fps_ = 0.0;

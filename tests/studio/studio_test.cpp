@@ -642,6 +642,23 @@ class StudioTest : public QObject {
     qInfo("recovery: offered and opened in %lld ms", (long long)recovering.elapsed());
   }
 
+  void savingRemovesAnOlderRecoveryFile() {
+    // After a save, a crash must not offer to go back to the autosave from before it: that
+    // recovery file goes with the save; the next change is autosaved again.
+    StudioOptions o = options();
+    o.autosave_interval_s = 1;
+    w_ = std::make_unique<MainWindow>(o);
+    w_->show();
+    QVERIFY(QTest::qWaitForWindowExposed(w_.get()));
+    stroke(50.f, 0.6f);
+    const QString recovery = w_->recovery_path();
+    QTRY_VERIFY2_WITH_TIMEOUT(QFile::exists(recovery), "the changed painting is autosaved", 15000);
+    QVERIFY(w_->save_to(dir_->path() + "/saved.ora", true));
+    QVERIFY2(!QFile::exists(recovery), "the recovery file older than the save is gone");
+    stroke(80.f, 0.6f);
+    QTRY_VERIFY2_WITH_TIMEOUT(QFile::exists(recovery), "a change after the save is autosaved again", 15000);
+  }
+
   void failedSaveToReadOnlyFolderKeepsPainting() {
     const QString folder = dir_->path() + "/read-only";
     const QString path = folder + "/painting.ora";
