@@ -36,14 +36,23 @@ T fetch_result(void* slot) {
   return host;
 }
 
+// The reduction into device memory at `out`, or, for out == nullptr, into the workspace's first
+// 256-byte slot (CUB's scratch follows it); returns where the result is. CUB writes init for n == 0.
 template <typename InputIt, typename T, typename Op>
-T reduce(InputIt in, int64_t n, Op op, T init, Workspace& ws) {
+T* reduce_to(InputIt in, int64_t n, Op op, T init, T* out, Workspace& ws) {
   size_t temp = 0;
   WB_CUDA_CHECK(cub::DeviceReduce::Reduce(nullptr, temp, in, static_cast<T*>(nullptr), n, op, init, wb::cuda_stream()));
-  auto* base = static_cast<unsigned char*>(ws.get(256 + temp));
-  T* out = reinterpret_cast<T*>(base);
-  WB_CUDA_CHECK(cub::DeviceReduce::Reduce(base + 256, temp, in, out, n, op, init, wb::cuda_stream()));
-  return fetch_result<T>(out);
+  const size_t skip = out ? 0 : 256;
+  auto* base = static_cast<unsigned char*>(ws.get(skip + temp));
+  if (!out) out = reinterpret_cast<T*>(base);
+  WB_CUDA_CHECK(cub::DeviceReduce::Reduce(base + skip, temp, in, out, n, op, init, wb::cuda_stream()));
+  return out;
+}
+
+// The reduction's value on the host: into the workspace's first slot, then one copy.
+template <typename InputIt, typename T, typename Op>
+T reduce(InputIt in, int64_t n, Op op, T init, Workspace& ws) {
+  return fetch_result<T>(reduce_to(in, n, op, init, static_cast<T*>(nullptr), ws));
 }
 
 }  // namespace
@@ -87,12 +96,7 @@ double reduce_sum(const float* in, int64_t n, Workspace& ws) {
 }
 
 void reduce_sum_into(const float* in, int64_t n, double* out, Workspace& ws) {
-  // CUB writes the sum of an empty range as the initial value, so n == 0 gives 0 too.
-  auto it = thrust::make_transform_iterator(in, ToDouble{});
-  size_t temp = 0;
-  WB_CUDA_CHECK(cub::DeviceReduce::Reduce(nullptr, temp, it, out, n, ::cuda::std::plus<double>{}, 0.0, wb::cuda_stream()));
-  void* base = ws.get(temp);
-  WB_CUDA_CHECK(cub::DeviceReduce::Reduce(base, temp, it, out, n, ::cuda::std::plus<double>{}, 0.0, wb::cuda_stream()));
+  reduce_to(thrust::make_transform_iterator(in, ToDouble{}), n, ::cuda::std::plus<double>{}, 0.0, out, ws);
 }
 
 namespace {
@@ -101,26 +105,16 @@ __global__ void add_to(double* out, const double* v) { *out += *v; }
 
 void reduce_sum_add_into(const float* in, int64_t n, double* out, Workspace& ws) {
   // The sum into the workspace's first slot, then one thread adds it (stream order, no wait).
-  auto it = thrust::make_transform_iterator(in, ToDouble{});
-  size_t temp = 0;
-  WB_CUDA_CHECK(cub::DeviceReduce::Reduce(nullptr, temp, it, static_cast<double*>(nullptr), n,
-                                          ::cuda::std::plus<double>{}, 0.0, wb::cuda_stream()));
-  auto* base = static_cast<unsigned char*>(ws.get(256 + temp));
-  auto* sum = reinterpret_cast<double*>(base);
-  WB_CUDA_CHECK(cub::DeviceReduce::Reduce(base + 256, temp, it, sum, n, ::cuda::std::plus<double>{}, 0.0,
-                                          wb::cuda_stream()));
+  const double* sum = reduce_to(thrust::make_transform_iterator(in, ToDouble{}), n, ::cuda::std::plus<double>{}, 0.0,
+                                static_cast<double*>(nullptr), ws);
   add_to<<<1, 1, 0, wb::cuda_stream()>>>(out, sum);
   WB_CUDA_CHECK(cudaGetLastError());
 }
 
 void count_nonfinite_into(const float* in, int64_t n, int64_t* out, Workspace& ws) {
   static_assert(sizeof(int64_t) == sizeof(long long), "count type");
-  auto it = thrust::make_transform_iterator(in, NonFinite{});
-  auto* dst = reinterpret_cast<long long*>(out);
-  size_t temp = 0;
-  WB_CUDA_CHECK(cub::DeviceReduce::Reduce(nullptr, temp, it, dst, n, ::cuda::std::plus<long long>{}, 0LL, wb::cuda_stream()));
-  void* base = ws.get(temp);
-  WB_CUDA_CHECK(cub::DeviceReduce::Reduce(base, temp, it, dst, n, ::cuda::std::plus<long long>{}, 0LL, wb::cuda_stream()));
+  reduce_to(thrust::make_transform_iterator(in, NonFinite{}), n, ::cuda::std::plus<long long>{}, 0LL,
+            reinterpret_cast<long long*>(out), ws);
 }
 
 float reduce_max(const float* in, int64_t n, Workspace& ws) {
@@ -128,11 +122,7 @@ float reduce_max(const float* in, int64_t n, Workspace& ws) {
 }
 
 void reduce_max_into(const float* in, int64_t n, float* out, Workspace& ws) {
-  size_t temp = 0;
-  const float init = -::cuda::std::numeric_limits<float>::infinity();
-  WB_CUDA_CHECK(cub::DeviceReduce::Reduce(nullptr, temp, in, out, n, MaxOp{}, init, wb::cuda_stream()));
-  void* base = ws.get(temp);
-  WB_CUDA_CHECK(cub::DeviceReduce::Reduce(base, temp, in, out, n, MaxOp{}, init, wb::cuda_stream()));
+  reduce_to(in, n, MaxOp{}, -::cuda::std::numeric_limits<float>::infinity(), out, ws);
 }
 
 float reduce_min(const float* in, int64_t n, Workspace& ws) {

@@ -1,8 +1,9 @@
 // Sample hash grid (paper §6, Green 2010): built from the bristle samples every step,
 // queried from the particles for the nearest sample and the distance to it, within the
 // range its user needs (d_B of Eq. 10 within D1; Eq. 14's absorber within the load sphere).
-// "Within D0" of §5.2 is the coarse distance field of the transfer stage, not this query. Three launches to build: bucket keys, radix sort,
-// bucket ranges; one to gather the sorted positions.
+// "Within D0" of §5.2 is the coarse distance field of the transfer stage, not this query.
+// Three launches to build: bucket keys, radix sort, bucket ranges; one to gather the sorted
+// positions.
 #pragma once
 #include <cstdint>
 

@@ -25,7 +25,6 @@ struct HashGridView {
 WB_HD WB_INLINE int imax(int a, int b) { return a > b ? a : b; }
 WB_HD WB_INLINE int imin(int a, int b) { return a < b ? a : b; }
 
-/// Integer cell of p for cell size h.
 /// A cell coordinate defined for every float: beyond +-1e9 cells (no canvas is that large) and
 /// for a non-finite value (a point the step's containment is about to remove) it is clamped, as
 /// converting such a float to int is undefined.
@@ -34,6 +33,7 @@ WB_HD WB_INLINE int hash_coord(float v) {
   return v > 0.f ? 1000000000 : -1000000000;
 }
 
+/// Integer cell of p for cell size h.
 WB_HD WB_INLINE void hash_cell_of(Vec3 p, float inv_h, int& ix, int& iy, int& iz) {
   ix = hash_coord(p.x * inv_h);
   iy = hash_coord(p.y * inv_h);

@@ -65,12 +65,14 @@ bool Replay::advance() {
   for (int k = 1; k <= step.substeps; ++k) poses_.push_back(player_.pose_at(StrokePlayer::substep_time(step, k)));
   sim_.step(poses_.data(), step.substeps, float(step.dt));
   // A bristle is in contact when a sample is within one cell of the canvas or dried paint.
-  if (recorded_ < int64_t(contacts_.size())) {
-    sim_.brush().mark_contacts_into(trace_.data(), region_.width, region_.height, region_.x0, region_.y0, 1.0f,
-                                    sim_.solid_field(), contacts_.data() + recorded_);
-    sim_.brush().max_stretch_into(stretch_.data() + recorded_);
-    ++recorded_;
+  if (recorded_ == int64_t(contacts_.size())) {  // sized for the player's step count: not reached
+    contacts_.grow_keep(size_t(recorded_) + 1);
+    stretch_.grow_keep(size_t(recorded_) + 1);
   }
+  sim_.brush().mark_contacts_into(trace_.data(), region_.width, region_.height, region_.x0, region_.y0, 1.0f,
+                                  sim_.solid_field(), contacts_.data() + recorded_);
+  sim_.brush().max_stretch_into(stretch_.data() + recorded_);
+  ++recorded_;
   last_t_ = step.t;
   return true;
 }

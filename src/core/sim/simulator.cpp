@@ -60,6 +60,7 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
     b->resize(size_t(g.nx) * size_t(g.ny));
   }
   nonfinite_counts_.set_device(d);
+  nonfinite_counts_.resize(2 * kCheckedArrays);
   step_sums_ = DeviceBuffer<StepSums>(d, 1);
   step_sums_.fill_zero();
   transfer_->set_sums(&step_sums_.data()->transfer);
@@ -386,7 +387,6 @@ void Simulator::count_nonfinite_on_entry() {
   // the step's stages): the step's own clamps may absorb it silently (max(m, 0) of NaN is 0),
   // so this is where it is seen. Counted on the device; read with the end's counts.
   const auto arrays = checked_arrays();
-  nonfinite_counts_.resize(2 * arrays.size());
   for (size_t i = 0; i < arrays.size(); ++i)
     count_nonfinite_into(device(), arrays[i].first, arrays[i].second, nonfinite_counts_.data() + arrays.size() + i,
                          ws_);
@@ -401,7 +401,7 @@ void Simulator::contain_nonfinite() {
   const size_t n = arrays.size();
   for (size_t i = 0; i < n; ++i)
     count_nonfinite_into(device(), arrays[i].first, arrays[i].second, nonfinite_counts_.data() + i, ws_);
-  std::array<int64_t, 2 * kCheckedArrays>& counts = nonfinite_host_;
+  std::array<int64_t, 2 * kCheckedArrays> counts;
   nonfinite_counts_.copy_to_host(counts.data(), 2 * n);
   int64_t bad = 0;
   for (size_t i = 0; i < 2 * n; ++i) bad += counts[i];

@@ -122,7 +122,6 @@ class Simulator {
   DeviceBuffer<float> raster_mass_, raster_density_, raster_mom_[3], raster_w_[3];
   DeviceBuffer<float> overlay_mass_;
   DeviceBuffer<int64_t> nonfinite_counts_;  ///< per checked array at the end, then on entry: one copy
-  std::array<int64_t, 2 * kCheckedArrays> nonfinite_host_{};
   /// The step's record on the device: the transfer's sums and the census's, read in one copy.
   struct StepSums {
     TransferSums transfer;
