@@ -16,11 +16,11 @@ inline Device test_device() {
 class BackendTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    device_ = test_device();
     device_.activate();
     ws_ = Workspace(device_);
   }
-  Device device_;
+  // Set at construction, so that a derived fixture's members built from it live on it too.
+  Device device_ = test_device();
   Workspace ws_;
 };
 

@@ -25,10 +25,13 @@ namespace wb::test {
 
 namespace fs = std::filesystem;
 
-class SaveKillTest : public BackendTest {
+// The saves run in forked child processes, and a child cannot use its parent's CUDA context:
+// these tests are about files, so they hold their paintings on the CPU backend whatever
+// WB_DEVICE names (the document tests read and write paintings on every backend).
+class SaveKillTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    BackendTest::SetUp();
+    device_ = Device(DeviceType::CPU);
     dir_ = fs::temp_directory_path() / ("wetbrush_kill_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
@@ -75,14 +78,23 @@ class SaveKillTest : public BackendTest {
       if (e.path().filename().string().find(".tmp-") != std::string::npos) t.push_back(e.path());
     return t;
   }
-  // Runs `fn` in a child process; returns its exit status (waitpid's).
+  // Runs `fn` in a child process; returns its exit status (waitpid's). The child never returns
+  // into the test runner, whatever `fn` throws.
   static int in_child(const std::function<int()>& fn) {
     const pid_t pid = ::fork();
-    if (pid == 0) ::_exit(fn());
+    if (pid == 0) ::_exit(child_exit_code(fn));
     int status = 0;
     ::waitpid(pid, &status, 0);
     return status;
   }
+  static int child_exit_code(const std::function<int()>& fn) {
+    try {
+      return fn();
+    } catch (...) {
+      return 3;
+    }
+  }
+  Device device_;
   fs::path dir_;
   std::string path_;
 };
@@ -124,10 +136,10 @@ TEST_F(SaveKillTest, KilledSavesLeaveThePreviousPaintingOrTheNewOne) {
     const double at = save_s * 1.2 * (k + jitter(rng)) / 100.0;
     const pid_t pid = ::fork();
     ASSERT_GE(pid, 0);
-    if (pid == 0) {
+    if (pid == 0) ::_exit(child_exit_code([&] {
       save_painting(path_, new_canvas, new_img, {{"version", "new"}});
-      ::_exit(0);
-    }
+      return 0;
+    }));
     std::this_thread::sleep_for(std::chrono::duration<double>(at));
     ::kill(pid, SIGKILL);
     int status = 0;
@@ -163,14 +175,14 @@ TEST_F(SaveKillTest, KilledSavesLeaveThePreviousPaintingOrTheNewOne) {
   for (const char* stage : {"partial-write", "before-rename"}) {
     const pid_t pid = ::fork();
     ASSERT_GE(pid, 0);
-    if (pid == 0) {
+    if (pid == 0) ::_exit(child_exit_code([&] {
       SaveOptions o;
       o.fault_hook = [&](const std::string& at) {
         if (at == stage) ::raise(SIGKILL);
       };
       save_painting(path_, new_canvas, new_img, {{"version", "new"}}, o);
-      ::_exit(0);
-    }
+      return 0;
+    }));
     int status = 0;
     ::waitpid(pid, &status, 0);
     ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << stage;

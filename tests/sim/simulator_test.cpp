@@ -249,5 +249,46 @@ TEST_F(SimulatorTest, StrokeOffTheCanvasEdgeKeepsPaintOnAndAboveTheCanvas) {
   EXPECT_GT(footprint_of(sim, device_).columns, 0);
 }
 
+TEST_F(SimulatorTest, SameStrokeOnCpuAndThisBackend) {
+  // The CUDA backend paints what the CPU backend paints. Sums and atomics run in another order,
+  // so the two drift apart by rounding: the books close on each, and the canvas's paint and its
+  // column heights agree within tolerances that such rounding stays far under.
+  if (device_.is_cpu()) GTEST_SKIP() << "run with WB_DEVICE=cuda to compare the CUDA backend with the CPU";
+  struct Result {
+    double loaded = 0, on_canvas = 0, drift = 0;
+    Footprint f;
+  };
+  auto paint = [&](const Device& d) {
+    SimConfig c = small_config();
+    c.device = d;
+    Simulator sim(c, pose_at(c.brush, 100, 128, 0.f, false));
+    sim.load_paint(red());
+    Result r;
+    r.loaded = sim.census().total();
+    for (int i = 0; i < 4; ++i) sim.step(pose_at(c.brush, 100.f, 128.f, 0.2f * float(i)), 1.f / 60.f);
+    for (int i = 0; i < 24; ++i) sim.step(pose_at(c.brush, 100.f + 2.f * float(i), 128.f, 0.6f), 1.f / 60.f);
+    for (int i = 0; i < 4; ++i) sim.step(pose_at(c.brush, 148.f, 128.f, 0.f, false), 1.f / 60.f);
+    sim.settle();
+    EXPECT_EQ(sim.counters().nonfinite_events, 0) << d.to_string();
+    r.on_canvas = sim.canvas().total_density();
+    r.drift = std::abs(sim.books().max_drift());
+    r.f = footprint_of(sim, d);
+    return r;
+  };
+  const Result g = paint(device_), h = paint(Device(DeviceType::CPU));
+  EXPECT_LT(g.drift, 1e-4);
+  EXPECT_LT(h.drift, 1e-4);
+  EXPECT_NEAR(g.loaded, h.loaded, 1e-5 * h.loaded);
+  ASSERT_GT(h.on_canvas, 0.0);
+  EXPECT_NEAR(g.on_canvas, h.on_canvas, 0.01 * h.on_canvas) << "paint left on the canvas";
+  double l1 = 0;
+  for (size_t i = 0; i < h.f.column.size(); ++i) l1 += std::abs(double(g.f.column[i]) - double(h.f.column[i]));
+  std::printf("[          ] canvas paint: %s %.4f, cpu %.4f cells; column L1 %.4f of %.4f; %lld vs %lld columns\n",
+              device_.to_string().c_str(), g.on_canvas, h.on_canvas, l1, h.f.mass, (long long)g.f.columns,
+              (long long)h.f.columns);
+  EXPECT_LT(l1, 0.08 * h.f.mass) << "column heights differ between the backends";
+  EXPECT_NEAR(double(g.f.columns), double(h.f.columns), 0.05 * double(h.f.columns));
+}
+
 }  // namespace
 }  // namespace wb::test
