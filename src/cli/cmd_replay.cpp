@@ -318,8 +318,19 @@ int run_replay(const ReplayArgs& a) {
         {"render", render_ms},
         {"step_median", prof.median_ms("sim.step")}};
     j["nonfinite_events"] = nonfinite;
+    j["zone_cut_steps"] = sim.counters().zone_cut_steps;
     j["warnings"] = stroke.warnings;
     write_text_file(a.stats, j.dump(2) + "\n");
+  }
+  if (sim.counters().zone_cut_steps > 0) {
+    const Int3 w = sim.config().window;
+    const int need = int(std::ceil(-sim.counters().zone_room_min)) * 2;
+    std::fprintf(stderr,
+                 "wetbrush: warning: on %lld of %lld steps the brush and its particle zone did not fit the %dx%d "
+                 "window (bands across the stroke at the window's snap may follow); a window about %dx%d holds them "
+                 "(simulation.window or --window)\n",
+                 static_cast<long long>(sim.counters().zone_cut_steps), static_cast<long long>(sim.counters().steps),
+                 w.x, w.y, w.x + need, w.y + need);
   }
   if (!a.quiet)
     std::printf("replayed %lld steps (%.2f s of stroke) on %s in %.0f ms; paint drift %.3g%%%s\n",

@@ -21,5 +21,8 @@ void joint_clamp_to_canvas(const Device& d, ParticleView p, Vec3 lo, Vec3 hi) {
   WB_DISPATCH(d, joint_clamp_to_canvas(p, lo, hi));
 }
 void joint_kill_nonfinite(const Device& d, ParticleView p) { WB_DISPATCH(d, joint_kill_nonfinite(p)); }
+void joint_sample_extent(const Device& d, const Vec3* x, int64_t n, float z_top, float* out) {
+  WB_DISPATCH(d, joint_sample_extent(x, n, z_top, out));
+}
 
 }  // namespace wb

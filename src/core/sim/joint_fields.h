@@ -27,6 +27,9 @@ void joint_zero_nonfinite(const Device& d, float* v, int64_t n);
 void joint_clamp_to_canvas(const Device& d, ParticleView p, Vec3 lo, Vec3 hi);
 /// Flags particles with any non-finite state as dead.
 void joint_kill_nonfinite(const Device& d, ParticleView p);
+/// Per sample below height z_top: x, -x, y and -y into out[0..n), [n..2n), [2n..3n), [3n..4n)
+/// (-inf above z_top); their maxima are the horizontal box of the samples that reach the window.
+void joint_sample_extent(const Device& d, const Vec3* x, int64_t n, float z_top, float* out);
 
 #define WB_JOINT_BACKEND_DECLS                                                                          \
   void joint_scale(const float* in, float* out, int64_t n, float scale);                               \
@@ -34,7 +37,8 @@ void joint_kill_nonfinite(const Device& d, ParticleView p);
   void joint_cell_velocity(GridView g, float* vx, float* vy, float* vz);                                \
   void joint_zero_nonfinite(float* v, int64_t n);                                                       \
   void joint_kill_nonfinite(ParticleView p);                                                            \
-  void joint_clamp_to_canvas(ParticleView p, Vec3 lo, Vec3 hi);
+  void joint_clamp_to_canvas(ParticleView p, Vec3 lo, Vec3 hi);                                      \
+  void joint_sample_extent(const Vec3* x, int64_t n, float z_top, float* out);
 namespace cpu {
 WB_JOINT_BACKEND_DECLS
 }

@@ -9,6 +9,18 @@ void joint_scale(const float* in, float* out, int64_t n, float scale) {
   parallel_for(n, [=] WB_HD(int64_t i) { out[i] = in[i] * scale; });
 }
 
+void joint_sample_extent(const Vec3* x, int64_t n, float z_top, float* out) {
+  parallel_for(n, [=] WB_HD(int64_t i) {
+    const Vec3 p = x[i];
+    const bool in = p.z < z_top;
+    const float none = -INFINITY;
+    out[i] = in ? p.x : none;
+    out[n + i] = in ? -p.x : none;
+    out[2 * n + i] = in ? p.y : none;
+    out[3 * n + i] = in ? -p.y : none;
+  });
+}
+
 void joint_blend_velocity(GridView g, PaintWindowView paint, ParticleRasterView raster, float cell_mass) {
   const GridDims d = g.d;
   for (int c = 0; c < 3; ++c) {

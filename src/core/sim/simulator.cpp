@@ -38,13 +38,15 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
   d.activate();
   canvas_ = std::make_unique<TileStore>(d, config_.canvas);
   brush_ = std::make_unique<Brush>(d, config_.brush, initial_pose, config_.params.brush_solver);
-  const Vec3 centre = footprint_centre(initial_pose, config_.brush.length);
   grid_ = std::make_unique<Grid>(*canvas_, config_.params.grid, config_.window, Int3{});
-  grid_->recentre_on(centre);
   particles_ = ParticleStore(d, config_.params.particles.max_particles);
   hash_ = SampleHashGrid(d);
   load_ = std::make_unique<BristleLoad>(d, brush_->sample_count(), config_.params.transfer);
   transfer_ = std::make_unique<Transfer>(d, config_.params.transfer);
+  for (auto* b : {&extent_scratch_, &extent_}) b->set_device(d);
+  extent_.resize(4);
+  box_ = samples_box();
+  grid_->move_window(place_window(box_, box_));
   const GridDims g = grid_->dims();
   auto cells = [&](DeviceBuffer<float>& b) {
     b.set_device(d);
@@ -75,7 +77,10 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
   books_.open(census());
 }
 
-void Simulator::reset_brush(const BrushPose& pose) { brush_->reset(pose); }
+void Simulator::reset_brush(const BrushPose& pose) {
+  brush_->reset(pose);
+  box_ = samples_box();  // the next step's window holds where the brush is now, not the path to it
+}
 
 PaintCensus Simulator::census() {
   return PaintBooks::census(*load_, particles_, grid_->window().total_mass(ws_), transfer_->params(), ws_);
@@ -128,13 +133,48 @@ void Simulator::settle() {
   grid_->window().flush();
 }
 
-float Simulator::effective_D0() const {
-  // The particle zone must end inside the window's kept box with room for the return margin:
-  // if D0 reached past it, no particle would ever be "beyond D0" and slow paint would stay
-  // particles for the whole stroke, drift, and be caught in the rim (docs/TRANSFER.md).
+std::array<float, 4> Simulator::samples_box() {
+  const SampleView s = brush_->samples();
+  const int64_t n = s.count();
+  if (n == 0) return {};
+  if (extent_scratch_.size() < size_t(4 * n)) extent_scratch_.resize(size_t(4 * n));
+  const float z_top = float(grid_->window().origin().z + grid_->window().dims().z);
+  joint_sample_extent(device(), s.x, n, z_top, extent_scratch_.data());
+  for (int c = 0; c < 4; ++c) reduce_max_into(device(), extent_scratch_.data() + c * n, n, extent_.data() + c, ws_);
+  float m[4];
+  extent_.copy_to_host(m, 4);
+  if (!(m[0] >= -m[1] && m[2] >= -m[3])) {  // no sample below the window's top: the tips' point
+    const Vec3 tip = footprint_centre(brush_->pose(), config_.brush.length);
+    return {tip.x, tip.x, tip.y, tip.y};
+  }
+  return {-m[1], m[0], -m[3], m[2]};
+}
+
+Int3 Simulator::place_window(const std::array<float, 4>& before, const std::array<float, 4>& after) {
+  // The window holds the samples' box over the step (the swept contact lays paint from where
+  // each sample was to where it is), centred on it. The particle zone must end inside the kept
+  // box: a zone cut by it returns its particles in a strip at every move of the window, a band
+  // across the stroke at the snap's period, instead of by Eq. 16 behind the brush
+  // (docs/TRANSFER.md "The particle zone"). The zone reaches D0 + return_margin from the samples,
+  // plus the distance blocks' error, and the window's centre is off the box's by up to half a
+  // snap. D0 keeps a floor, the absorption's reach through the block distance: without
+  // particles around the bristles the brush could pick up no paint (Eq. 14, 15). A brush too
+  // large for its window at that floor needs a larger window (`simulation.window`).
+  const float x0 = std::min(before[0], after[0]), x1 = std::max(before[1], after[1]);
+  const float y0 = std::min(before[2], after[2]), y1 = std::max(before[3], after[3]);
   const Int3 n = grid_->window().dims();
-  const float room = 0.5f * float(std::min(n.x, n.y) - 2 * kKeepRim) - config_.params.transfer.return_margin;
-  return std::clamp(room, 0.f, config_.params.particles.D0);
+  const TransferParams& tp = config_.params.transfer;
+  const float block_error = float(tp.distance_block) * std::sqrt(3.f);
+  const float room = 0.5f * std::min(float(n.x) - (x1 - x0), float(n.y) - (y1 - y0)) - float(kKeepRim) -
+                     tp.return_margin - block_error - 0.5f * float(config_.params.grid.window_snap);
+  const float D0 = config_.params.particles.D0;
+  const float floor_D0 = std::min(D0, transfer_->params().absorb_range() + block_error);
+  zone_D0_ = std::clamp(room, floor_D0, D0);
+  if (config_.particles) {
+    counters_.zone_cut_steps += room < floor_D0;
+    counters_.zone_room_min = std::min(counters_.zone_room_min, room - floor_D0);
+  }
+  return grid_->window().origin_for(Vec3(0.5f * (x0 + x1), 0.5f * (y0 + y1), 0.f), config_.params.grid.window_snap);
 }
 
 TransferEnv Simulator::transfer_env() {
@@ -183,18 +223,14 @@ void Simulator::step(const BrushPose* poses, int substeps, float dt) {
   count_nonfinite_on_entry();
 
   // --- 1-2. Brush (§4.1) in sub-steps, then its samples ------------------------------------
-  const Vec3 footprint_before = footprint_centre(brush_->pose(), config_.brush.length);
+  const std::array<float, 4> box_before = box_;
   brush_stage(poses, substeps, dt);
 
   // --- 3. Window: follow the brush; rasterise the bristles into it (boundary of §4.2) -----
   {
     WB_PROFILE_SCOPE("window");
-    // Centred on the middle of the step's path: the paint the bristles sweep over the step
-    // (swept contact, laid from where each sample was to where it is) lies inside the window
-    // for a path up to the window less the footprint and its rims (docs/TRANSFER.md).
-    const Vec3 footprint_after = footprint_centre(brush_->pose(), config_.brush.length);
-    const Int3 next = grid_->window().origin_for(0.5f * (footprint_before + footprint_after),
-                                                 config_.params.grid.window_snap);
+    box_ = samples_box();
+    const Int3 next = place_window(box_before, box_);
     if (particles_.size() > 0) deposit_leaving_particles(next);
     grid_->move_window(next);
     brush_->rasterize(grid_->window().origin(), grid_->window().dims(), psi_.data(), bristle_v_[0].data(),

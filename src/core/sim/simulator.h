@@ -38,6 +38,11 @@ struct SimCounters {
   int64_t substeps = 0;
   int64_t nonfinite_events = 0;  ///< steps whose state went non-finite and were contained
   int64_t particles_max = 0;
+  /// Steps whose particle zone, at D0's floor, did not fit the window's kept box around the
+  /// samples (the brush is too large for its window: Simulator::place_window).
+  int64_t zone_cut_steps = 0;
+  /// The least room seen for D0 around the samples, cells (negative: the zone was cut).
+  float zone_room_min = 1e30f;
 };
 
 class Simulator {
@@ -101,8 +106,14 @@ class Simulator {
   std::array<std::pair<float*, int64_t>, kCheckedArrays> checked_arrays();
   void clamp_particles_to_canvas();
   TransferEnv transfer_env();
-  /// D0 of §5.2, limited so that the particle zone fits in the window (transfer_env).
-  float effective_D0() const;
+  /// D0 of §5.2 for this step, limited so that the particle zone fits in the window's kept box
+  /// around the samples (transfer_env; set by place_window).
+  float effective_D0() const { return zone_D0_; }
+  /// Horizontal box of the samples below the window's top: x_lo, x_hi, y_lo, y_hi (one read).
+  std::array<float, 4> samples_box();
+  /// Window origin for the samples' box over the step (the union of `before` and `after`), and
+  /// the D0 that keeps the particle zone inside its kept box.
+  Int3 place_window(const std::array<float, 4>& before, const std::array<float, 4>& after);
 
   SimConfig config_;
   Profiler profiler_;
@@ -130,6 +141,9 @@ class Simulator {
   DeviceBuffer<StepSums> step_sums_;
   DeviceBuffer<float> solid_height_;  ///< dried-paint top per window column (particles' solid, Eq. 8)
   DeviceBuffer<float> wet_top_;       ///< wet-paint surface per window column (free particles land on it)
+  DeviceBuffer<float> extent_scratch_, extent_;  ///< the samples' box (samples_box)
+  std::array<float, 4> box_{};                   ///< the samples' box at the end of the last step
+  float zone_D0_ = 0.f;
 };
 
 }  // namespace wb
