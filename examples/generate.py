@@ -52,7 +52,12 @@ def line(a, b):
     return lambda u: (a[0] + (b[0] - a[0]) * u, a[1] + (b[1] - a[1]) * u)
 
 
-def write(name, comment, brush, paint, samples, events=(), canvas=None):
+def write(name, comment, brush, paint, samples, events=(), canvas=None, window=None):
+    """`window`: the active window, for a brush that with its particle zone does not fit the
+    default 128 x 128 x 32 (a flat brush: docs/TRANSFER.md "The particle zone")."""
+    simulation = {"max_move_per_substep": 2, "max_substeps": 64, "lead_in": 0.25, "lead_out": 0.25}
+    if window:
+        simulation["window"] = list(window)
     doc = {
         "format": "wetbrush-stroke",
         "version": 1,
@@ -60,7 +65,7 @@ def write(name, comment, brush, paint, samples, events=(), canvas=None):
         "canvas": canvas or {"width": 1024, "height": 1024, "depth": 64, "paper_rgb": [0.96, 0.94, 0.89]},
         "brush": brush,
         "paint": paint,
-        "simulation": {"max_move_per_substep": 2, "max_substeps": 64, "lead_in": 0.25, "lead_out": 0.25},
+        "simulation": simulation,
         "samples": samples,
         "events": list(events),
     }
@@ -115,7 +120,7 @@ def scumble():
           "Scumbling (paper Fig. 3b): two dark strokes with a flat brush, the canvas dried, then a light, "
           "lightly loaded flat brush dragged quickly at low pressure across them.",
           {"shape": "flat"}, {"ryb": [0.55, 0.35, 0.75], "oil": 0.3, "load": 1.0, "reload_on_pen_down": False},
-          s, events)
+          s, events, window=(192, 192, 32))
 
 
 def stiff_and_oily():
@@ -137,7 +142,7 @@ def stiff_and_oily():
           "Stiff and oily paint side by side: a flat brush lays a short stroke of stiff paint (oil 0.1) at y 490 "
           "and one of oily paint (oil 0.8) at y 535, then rests above them for 1 s.",
           {"shape": "flat"}, {"ryb": [0.85, 0.3, 0.05], "oil": 0.1, "load": 1.0, "reload_on_pen_down": False},
-          s, events)
+          s, events, window=(192, 192, 32))
 
 
 if __name__ == "__main__":

@@ -32,15 +32,18 @@ for w in $what; do
         -o "$out/press-and-drag-grid-only.png" --save "$out/press-and-drag-grid-only.ora" \
         --stats "$out/press-and-drag-grid-only.json" > "$out/press-and-drag-grid-only.log" 2>&1
       echo "replay press-and-drag --grid-only (cuda): exit $?"
-      # Close-ups under a raking light (ridges and bristle streaks).
-      for ex in press-and-drag press-and-drag-grid-only cross-wet scumble; do
+      # Every painting: a 2:1 close-up under a raking light, centred on the painted region the
+      # replay reports, and an oblique view of the whole canvas under the same light.
+      for st in "$out"/*.json; do
+        ex="$(basename "${st%.json}")"
         [ -f "$out/$ex.ora" ] || continue
-        c=512,512; sz=720x400
-        [ "$ex" = cross-wet ] && c=520,515 && sz=720x720
-        [ "$ex" = scumble ] && c=520,505
-        "$bin/wetbrush" render "$out/$ex.ora" --device cuda --center "$c" --size "$sz" --zoom 2 \
+        c="$(python3 -c "import json,sys; r=json.load(open(sys.argv[1]))['region']; print('%d,%d' % (r['x0'] + r['width'] // 2, r['y0'] + r['height'] // 2))" "$st")"
+        "$bin/wetbrush" render "$out/$ex.ora" --device cuda --center "$c" --size 720x400 --zoom 2 \
           --light -0.8,0.35,0.5 -o "$out/$ex-detail.png" > /dev/null 2>&1
-        echo "render $ex detail: exit $?"
+        echo "render $ex detail at $c: exit $?"
+        "$bin/wetbrush" render "$out/$ex.ora" --device cuda --camera oblique --elevation 30 \
+          --light -0.8,0.35,0.5 -o "$out/$ex-oblique.png" > /dev/null 2>&1
+        echo "render $ex oblique: exit $?"
       done ;;
   esac
 done
