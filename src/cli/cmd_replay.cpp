@@ -483,7 +483,7 @@ void register_replay(CLI::App& app) {
   sub->add_option("--load", args->load, "How full the brush is loaded, fraction of capacity [0, 1]");
   sub->add_flag("--no-reload", args->no_reload, "Load the brush once, not at every pen-down (it runs dry)");
   sub->add_flag("--grid-only", args->grid_only, "No particles: paint lives on the grid only (paper Fig. 7a/c)");
-  sub->add_option("--window", args->window, "Active window size X,Y,Z in cells (default 128,128,32)")->delimiter(',');
+  sub->add_option("--window", args->window, "Active window size X,Y,Z in cells (default 160,160,32)")->delimiter(',');
   sub->add_option("--set", args->sets, "Set a parameter, id=value (see `wetbrush params`); repeatable");
   sub->add_option("--params", args->params_file, "Read parameters from a JSON file (`wetbrush params --json`)");
   sub->add_flag("-q,--quiet", args->quiet, "No progress or summary output");

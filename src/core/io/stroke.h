@@ -60,7 +60,7 @@ struct Stroke {
   double lead_in = 0.25;              ///< seconds the brush descends from the air to the first sample
   double lead_out = 0.25;             ///< seconds it rises after the last sample
   /// Active window X, Y, Z cells the stroke needs (a brush that splays wider than the default
-  /// 128 x 128 x 32); unset: the replayer's default. `replay --window` overrides it.
+  /// 160 x 160 x 32); unset: the replayer's default. `replay --window` overrides it.
   std::optional<std::array<int, 3>> window;
 
   std::string source;                 ///< file it was read from (for messages)

@@ -25,7 +25,10 @@ namespace wb {
 struct SimConfig {
   Device device{};
   CanvasDims canvas{};
-  Int3 window{128, 128, 32};  ///< active window, cells (§4.2: 128 x 128 x 32)
+  /// Active window, cells. The paper's is 128 x 128 x 32 (§4.2); 160 holds the default round and
+  /// flat brushes pressed and dragged with their particle zone (Simulator::place_window), which
+  /// 128 cuts on most steps of the examples (docs/TRANSFER.md "The particle zone").
+  Int3 window{160, 160, 32};
   BrushSpec brush{};
   SimParams params{};
   /// false: grid-only paint (no particles, no bristle-particle transfer), the paper's Fig. 7a/c.
