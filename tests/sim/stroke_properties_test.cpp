@@ -32,7 +32,48 @@ struct Stroke {
   std::optional<BrushSpec> brush;  ///< none: the scene's small round brush
   bool particles = true;   ///< false: grid-only paint (Fig. 7a/c)
   float dt = kDt;          ///< simulation step, s
+  int window_xy = 0;       ///< active window X and Y, cells (0: the scene's)
+  SimCounters* counters = nullptr;  ///< receives the simulator's counters after the stroke
 };
+
+/// Power of the spectrum of v[i0, i0 + n) at bin k, after removing its least-squares quadratic
+/// trend (the load running down).
+double detrended_power(const std::vector<double>& v, int i0, int n, int k) {
+  double S[5] = {0, 0, 0, 0, 0}, B[3] = {0, 0, 0};
+  for (int i = 0; i < n; ++i) {
+    const double t = 2.0 * (i + 0.5) / n - 1.0, y = v[size_t(i0 + i)];
+    for (int q = 0; q < 5; ++q) S[q] += std::pow(t, q);
+    for (int q = 0; q < 3; ++q) B[q] += y * std::pow(t, q);
+  }
+  const double M[3][3] = {{S[0], S[1], S[2]}, {S[1], S[2], S[3]}, {S[2], S[3], S[4]}};
+  auto det3 = [](const double A[3][3]) {
+    return A[0][0] * (A[1][1] * A[2][2] - A[1][2] * A[2][1]) - A[0][1] * (A[1][0] * A[2][2] - A[1][2] * A[2][0]) +
+           A[0][2] * (A[1][0] * A[2][1] - A[1][1] * A[2][0]);
+  };
+  double c[3];
+  for (int q = 0; q < 3; ++q) {  // Cramer's rule
+    double A[3][3];
+    for (int r = 0; r < 3; ++r)
+      for (int j = 0; j < 3; ++j) A[r][j] = j == q ? B[r] : M[r][j];
+    c[q] = det3(A) / det3(M);
+  }
+  double re = 0, im = 0;
+  for (int i = 0; i < n; ++i) {
+    const double t = 2.0 * (i + 0.5) / n - 1.0;
+    const double r = v[size_t(i0 + i)] - (c[0] + c[1] * t + c[2] * t * t);
+    re += r * std::cos(2 * M_PI * k * i / n), im -= r * std::sin(2 * M_PI * k * i / n);
+  }
+  return re * re + im * im;
+}
+
+/// Power at bin k over the mean of bins k +- 2..5 (a peak stands out of its neighbours).
+double peak_ratio(const std::vector<double>& v, int i0, int n, int k) {
+  double neighbours = 0;
+  int count = 0;
+  for (int j = k - 5; j <= k + 5; ++j)
+    if (std::abs(j - k) >= 2) neighbours += detrended_power(v, i0, n, j), ++count;
+  return detrended_power(v, i0, n, k) / (neighbours / count);
+}
 
 class StrokePropertiesTest : public SimulatorTest {
  protected:
@@ -50,6 +91,7 @@ class StrokePropertiesTest : public SimulatorTest {
   /// Column paint (cells) per canvas column after `st`; `sim_out` receives the canvas if set.
   std::vector<float> paint_stroke(const Stroke& st) {
     SimConfig c = small_config(CanvasDims{kW, kH, 16});
+    if (st.window_xy > 0) c.window = Int3{st.window_xy, st.window_xy, c.window.z};
     if (st.brush) c.brush = *st.brush;
     c.particles = st.particles;
     auto pose = [&](float x, float p, bool down = true) {
@@ -80,6 +122,7 @@ class StrokePropertiesTest : public SimulatorTest {
                   dt, t.emitted, (long long)t.emitted_count, t.absorbed, (long long)t.absorbed_count, t.to_grid, t.to_particles,
                   sim.census().bristles);
     }
+    if (st.counters) *st.counters = sim.counters();
     sim.settle();
     if (std::getenv("WB_STROKE_BOOKS")) {
       const PaintCensus cs = sim.census();
@@ -209,45 +252,40 @@ TEST_F(StrokePropertiesTest, ConstantSpeedLeavesNoStepPattern) {
   st.speed = 300.f;
   const std::vector<double> v = per_length(paint_stroke(st));
   const int n = kBody1 - kBody0;
-  // Least-squares quadratic trend on t in [-1, 1] (normal equations of 1, t, t^2).
-  double S[5] = {0, 0, 0, 0, 0}, B[3] = {0, 0, 0};
-  for (int i = 0; i < n; ++i) {
-    const double t = 2.0 * (i + 0.5) / n - 1.0, y = v[size_t(kBody0 + i)];
-    for (int k = 0; k < 5; ++k) S[k] += std::pow(t, k);
-    for (int k = 0; k < 3; ++k) B[k] += y * std::pow(t, k);
-  }
-  const double M[3][3] = {{S[0], S[1], S[2]}, {S[1], S[2], S[3]}, {S[2], S[3], S[4]}};
-  const double det = M[0][0] * (M[1][1] * M[2][2] - M[1][2] * M[2][1]) -
-                     M[0][1] * (M[1][0] * M[2][2] - M[1][2] * M[2][0]) + M[0][2] * (M[1][0] * M[2][1] - M[1][1] * M[2][0]);
-  double c[3];
-  for (int k = 0; k < 3; ++k) {  // Cramer's rule
-    double A[3][3];
-    for (int r = 0; r < 3; ++r)
-      for (int q = 0; q < 3; ++q) A[r][q] = q == k ? B[r] : M[r][q];
-    c[k] = (A[0][0] * (A[1][1] * A[2][2] - A[1][2] * A[2][1]) - A[0][1] * (A[1][0] * A[2][2] - A[1][2] * A[2][0]) +
-            A[0][2] * (A[1][0] * A[2][1] - A[1][1] * A[2][0])) / det;
-  }
-  std::vector<double> r(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) {
-    const double t = 2.0 * (i + 0.5) / n - 1.0;
-    r[size_t(i)] = v[size_t(kBody0 + i)] - (c[0] + c[1] * t + c[2] * t * t);
-  }
-  auto power = [&](int k) {
-    double re = 0, im = 0;
-    for (int i = 0; i < n; ++i) re += r[size_t(i)] * std::cos(2 * M_PI * k * i / n), im -= r[size_t(i)] * std::sin(2 * M_PI * k * i / n);
-    return re * re + im * im;
-  };
   const int step_bin = int(std::lround(n / (st.speed * kDt)));
-  double neighbours = 0;
-  int count = 0;
-  for (int k = step_bin - 5; k <= step_bin + 5; ++k)
-    if (k != step_bin && std::abs(k - step_bin) >= 2) neighbours += power(k), ++count;
-  neighbours /= count;
-  std::printf("spectrum of the paint per unit length: step bin %d power %.3g, neighbours' mean %.3g (ratio %.2f)\n",
-              step_bin, power(step_bin), neighbours, power(step_bin) / neighbours);
+  const double ratio = peak_ratio(v, kBody0, n, step_bin);
+  std::printf("spectrum of the paint per unit length: step bin %d, power over its neighbours' mean %.2f\n", step_bin,
+              ratio);
   // One bead a step (every sample's swept particle at the middle of its path) gave ratios of
   // 6.5 to 25; stratified along the path, 1.9 to 3.5 over runs.
-  EXPECT_LT(power(step_bin), 4.0 * neighbours) << "a peak at the step period";
+  EXPECT_LT(ratio, 4.0) << "a peak at the step period";
+}
+
+TEST_F(StrokePropertiesTest, WindowMovesReturnNoParticlesWhereTheParticleZoneFits) {
+  // The window follows the brush in moves of window_snap cells. Where the particle zone reached
+  // past the window's kept box, each move returned the strip of particles it left to the grid at
+  // once, not by Eq. 16 behind the brush: on a flat brush in stiff paint, a band across the
+  // stroke every 8 cells (docs/TRANSFER.md "The particle zone"). In a window that holds the brush
+  // and its zone, the zone is never cut and moves return (almost) no particles; in the scene's
+  // 48-cell window it is cut, and the moves return particles by the thousand.
+  Stroke st;
+  st.speed = 300.f;
+  SimCounters fit, cut;
+  st.counters = &fit;
+  st.window_xy = 128;
+  const std::vector<double> v = per_length(paint_stroke(st));
+  st.counters = &cut;
+  st.window_xy = 0;
+  paint_stroke(st);
+  std::printf("particles returned at window moves: %lld in a 128-cell window (zone cut on %lld of %lld steps), "
+              "%lld in the 48-cell window (cut on %lld)\n",
+              (long long)fit.returned_at_moves, (long long)fit.zone_cut_steps, (long long)fit.steps,
+              (long long)cut.returned_at_moves, (long long)cut.zone_cut_steps);
+  EXPECT_EQ(fit.zone_cut_steps, 0) << "the 128-cell window holds the small brush and its zone";
+  EXPECT_GT(cut.zone_cut_steps, 0);
+  EXPECT_LT(double(fit.returned_at_moves), 0.03 * double(std::max<int64_t>(cut.returned_at_moves, 1)));
+  const int n = kBody1 - kBody0, snap = small_config().params.grid.window_snap;
+  EXPECT_LT(peak_ratio(v, kBody0, n, n / snap), 4.0) << "a peak at the window snap's period";
 }
 
 TEST_F(StrokePropertiesTest, OneLoadRunsOutAlongALongStroke) {

@@ -301,9 +301,11 @@ void Simulator::deposit_leaving_particles(Int3 next) {
   env.keep = KeepBox::of(Int3{std::max(cur.x, next.x) - cur.x + m, std::max(cur.y, next.y) - cur.y + m, 0},
                          Int3{std::min(cur.x, next.x) + n.x - cur.x - m, std::min(cur.y, next.y) + n.y - cur.y - m,
                               n.z - kKeepRimTop});
-  transfer_->update_distance(brush_->samples(), env);
+  env.only_leaving = true;
   transfer_->particles_to_grid(particles_, env);
+  const int64_t before = particles_.size();
   particles_.compact(ws_);
+  counters_.returned_at_moves += before - particles_.size();
 }
 
 SolidField Simulator::solid_field() {

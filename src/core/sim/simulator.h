@@ -46,6 +46,9 @@ struct SimCounters {
   int64_t zone_cut_steps = 0;
   /// The least room seen for D0 around the samples, cells (negative: the zone was cut).
   float zone_room_min = 1e30f;
+  /// Particles returned to the grid because the window moved off them (deposit_leaving_particles):
+  /// where the zone fits, only the slow ones beyond it that the step's own pass would return.
+  int64_t returned_at_moves = 0;
 };
 
 class Simulator {

@@ -353,8 +353,8 @@ std::vector<float> Transfer::distance_to_host() {
 
 void Transfer::particles_to_grid(ParticleStore& particles, const TransferEnv& env) {
   validate(env);
-  const DistanceBlocks db = distance_view();
-  WB_REQUIRE(db.D0 == env.D0, "Transfer: the distance field was built for another D0");
+  const DistanceBlocks db = env.only_leaving ? DistanceBlocks{} : distance_view();
+  WB_REQUIRE(env.only_leaving || db.D0 == env.D0, "Transfer: the distance field was built for another D0");
   const int64_t np = particles.size(), nc = env.paint.size();
   ensure_cells(nc);
   ensure_particles(np);
@@ -371,6 +371,7 @@ void Transfer::particles_to_grid(ParticleStore& particles, const TransferEnv& en
   acc.moved = p_moved_.data();
   acc.counter = sum_field(&TransferSums::to_grid_count);
   acc.keep = env.keep;
+  acc.only_leaving = env.only_leaving;
   if (np > 0) {
     d_to_grid_mark(device_, particles.view(), env.paint, db, acc, params_, env.dry_threshold);
     d_to_grid_apply(device_, env.paint, acc);

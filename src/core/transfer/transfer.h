@@ -37,6 +37,9 @@ struct TransferEnv {
   /// Window box the particles may stay in (off: the whole window); the simulator sets it every
   /// step and, before the window moves, to the part that stays (docs/TRANSFER.md).
   KeepBox keep{};
+  /// Eq. 16 for the particles outside `keep` only (the window is about to move off them); the
+  /// others wait for the step's own pass, and no distance field is read.
+  bool only_leaving = false;
 };
 
 /// What one step's transfers moved, kg, each measured on both sides (source / destination),
@@ -114,6 +117,7 @@ struct DepositScratch {
   float* moved;    ///< per particle: mass sent to the grid
   int32_t* counter;
   KeepBox keep;             ///< particles outside it are deposited regardless (TransferEnv::keep)
+  bool only_leaving;        ///< TransferEnv::only_leaving
 };
 
 class Transfer {

@@ -287,7 +287,7 @@ void transfer_to_grid_mark(ParticleView p, PaintWindowView pw, DistanceBlocks db
     }
     // Leaving the window's next box: back to the grid now, or it would be outside every field.
     const bool leaving = !acc.keep.contains(q);
-    if (!leaving && (!(length2(p.v[k]) < slow2) || db.near(q, margin))) return;
+    if (!leaving && (acc.only_leaving || !(length2(p.v[k]) < slow2) || db.near(q, margin))) return;
     const Vec3 ck(p.pigment_r[k], p.pigment_y[k], p.pigment_b[k]);
     const float bk = pigment_brightness(ck), oil = p.oil[k], dry = p.dryness[k];
     const float a = mk * inv_cm;  // density units
