@@ -103,14 +103,14 @@ def scumble():
     t = s[-1]["t"]
     events = [{"type": "dry", "t": round(t + 0.05, 4)},
               {"type": "clean", "t": round(t + 0.06, 4)},
-              {"type": "dip", "t": round(t + 0.07, 4), "ryb": [0.02, 0.35, 0.05], "oil": 0.2, "load": 1.0}]
+              {"type": "dip", "t": round(t + 0.07, 4), "ryb": [0.02, 0.35, 0.05], "oil": 0.2, "load": 0.4}]
     t = round(t + 0.2, 4)
     s += hover(s[-1]["t"], (380, 540), (400, 430), 0.2)
     t = round(s[-1]["t"] + DT, 4)
     # Scumbling: quick zig-zag passes at light pressure, the handle low.
     pts = [(400, 430), (640, 470), (420, 500), (640, 540), (420, 580)]
     for a, b in zip(pts, pts[1:]):
-        seg = stroke(t, line(a, b), 0.8, 0.5, tilt=(30 if b[0] > a[0] else -30, 0), twist=90,
+        seg = stroke(t, line(a, b), 0.8, 0.15, tilt=(30 if b[0] > a[0] else -30, 0), twist=90,
                      press_time=0.08, lift_time=0.08)
         s += seg
         t = round(s[-1]["t"] + 0.05, 4)

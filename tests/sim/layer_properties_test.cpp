@@ -314,6 +314,55 @@ TEST_F(LayerPropertiesTest, CleanBrushPloughsAWetLayer) {
   EXPECT_GT(right, 1.03 * kLayer) << "paint pushed up beside the track";
 }
 
+TEST_F(LayerPropertiesTest, LightBrushScumblesTheTopsOfADriedRidgedLayer) {
+  // A dried blue layer with ridges across the stroke: 3 cells high and 4 wide, valleys of 1 cell
+  // and 4 wide (period 8 along x). A lightly loaded white brush dragged lightly along x at 60 mm/s:
+  // the brush rests on the ridges (the pen's pressure presses it into the surface it meets), so
+  // the new paint per column is larger on the ridge tops than in the valleys.
+  constexpr int kW = 192, kH = 64;
+  constexpr float kX0 = 24.f, kX1 = 152.f;
+  SimConfig c = layer_config(CanvasDims{kW, kH, kDepth});
+  Simulator sim(c, pose_at(c.brush, kX0, kY, 0.f, false));
+  auto ridge = [](int x) { return (x & 7) < 4; };
+  write_layer(sim, [&](int x, int, int z) {
+    PaintCell p;
+    if (z < (ridge(x) ? 3 : 1)) {
+      p.density = 1.f, p.pigment_r = 0.1f, p.pigment_y = 0.15f, p.pigment_b = 0.85f, p.oil = 0.3f;
+      p.dryness = 1.f;
+    }
+    return p;
+  });
+  PaintLoad white;
+  white.ryb[0] = white.ryb[1] = white.ryb[2] = 0.f;
+  white.load = env_or("WB_LAYER_LOAD", 0.3f);
+  sim.load_paint(white);
+  Books books;
+  books.open(sim);
+  drag(sim, kX0, kX1, 300.f, env_or("WB_LAYER_PRESSURE", 0.1f));
+  EXPECT_LT(books.max_drift(sim), 1e-4);
+  EXPECT_EQ(sim.counters().nonfinite_events, 0);
+  // New paint: the cells that are not dried (the layer's cells all are).
+  const auto f = canvas_fields(sim);
+  const size_t dryness = 5;  // PaintWindow fields: density, r, y, b, oil, dryness
+  double tops = 0, valleys = 0;
+  int n_tops = 0, n_valleys = 0;
+  for (int y = int(kY) - 4; y <= int(kY) + 4; ++y)
+    for (int x = int(kX0) + 24; x < int(kX1) - 16; ++x) {
+      double fresh = 0;
+      for (int z = 0; z < kDepth; ++z) {
+        const size_t id = (size_t(z) * kH + y) * kW + x;
+        if (f[dryness][id] < c.params.grid.dry_threshold) fresh += f[0][id];
+      }
+      (ridge(x) ? tops : valleys) += fresh;
+      (ridge(x) ? n_tops : n_valleys) += 1;
+    }
+  tops /= n_tops, valleys /= n_valleys;
+  std::printf("new paint per column: ridge tops %.4f, valleys %.4f cells (ratio %.2f)\n", tops, valleys,
+              tops / std::max(valleys, 1e-12));
+  EXPECT_GT(tops + valleys, 0.0) << "the brush left no paint";
+  EXPECT_GT(tops, 1.2 * valleys) << "a scumble catches the paint on the tops of the dried layer";
+}
+
 }  // namespace
 // --- support ------------------------------------------------------------------------------------
 

@@ -43,10 +43,6 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
   hash_ = SampleHashGrid(d);
   load_ = std::make_unique<BristleLoad>(d, brush_->sample_count(), config_.params.transfer);
   transfer_ = std::make_unique<Transfer>(d, config_.params.transfer);
-  for (auto* b : {&extent_scratch_, &extent_}) b->set_device(d);
-  extent_.resize(4);
-  box_ = samples_box();
-  grid_->move_window(place_window(box_, box_));
   const GridDims g = grid_->dims();
   auto cells = [&](DeviceBuffer<float>& b) {
     b.set_device(d);
@@ -61,6 +57,10 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
     b->set_device(d);
     b->resize(size_t(g.nx) * size_t(g.ny));
   }
+  for (auto* b : {&extent_scratch_, &extent_}) b->set_device(d);
+  extent_.resize(5);
+  box_ = samples_box();
+  grid_->move_window(place_window(box_, box_));
   nonfinite_counts_.set_device(d);
   nonfinite_counts_.resize(2 * kCheckedArrays);
   step_sums_ = DeviceBuffer<StepSums>(d, 1);
@@ -78,7 +78,9 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
 }
 
 void Simulator::reset_brush(const BrushPose& pose) {
-  brush_->reset(pose);
+  BrushPose p = pose;
+  p.position.z += ground_;
+  brush_->reset(p);
   box_ = samples_box();  // the next step's window holds where the brush is now, not the path to it
 }
 
@@ -137,12 +139,25 @@ std::array<float, 4> Simulator::samples_box() {
   const SampleView s = brush_->samples();
   const int64_t n = s.count();
   if (n == 0) return {};
-  if (extent_scratch_.size() < size_t(4 * n)) extent_scratch_.resize(size_t(4 * n));
-  const float z_top = float(grid_->window().origin().z + grid_->window().dims().z);
+  ActiveWindow& win = grid_->window();
+  const Int3 o = win.origin(), wn = win.dims();
+  const int64_t columns = int64_t(wn.x) * wn.y;
+  if (extent_scratch_.size() < size_t(std::max(4 * n, columns))) extent_scratch_.resize(size_t(std::max(4 * n, columns)));
+  const float z_top = float(o.z + wn.z);
   joint_sample_extent(device(), s.x, n, z_top, extent_scratch_.data());
   for (int c = 0; c < 4; ++c) reduce_max_into(device(), extent_scratch_.data() + c * n, n, extent_.data() + c, ws_);
-  float m[4];
-  extent_.copy_to_host(m, 4);
+  // The ground for the next step: the dried paint's top under the footprint (the disc of the
+  // brush's half width around where its tips meet the canvas), in the same copy.
+  const ParticleParams& pp = config_.params.particles;
+  particles_solid_height(device(), win.paint().view(), nullptr, config_.params.grid.dry_threshold,
+                         config_.params.grid.liquid_threshold, pp.floor_z, solid_height_.data());
+  const Vec3 tip = footprint_centre(brush_->pose(), config_.brush.length);
+  joint_ground_under(device(), solid_height_.data(), wn.x, wn.y, o.x, o.y, tip.x, tip.y,
+                     0.5f * std::max(config_.brush.width, config_.brush.thickness), pp.floor_z, extent_scratch_.data());
+  reduce_max_into(device(), extent_scratch_.data(), columns, extent_.data() + 4, ws_);
+  float m[5];
+  extent_.copy_to_host(m, 5);
+  ground_ = std::isfinite(m[4]) ? std::max(m[4], 0.f) : 0.f;
   if (!(m[0] >= -m[1] && m[2] >= -m[3])) {  // no sample below the window's top: the tips' point
     const Vec3 tip = footprint_centre(brush_->pose(), config_.brush.length);
     return {tip.x, tip.x, tip.y, tip.y};
@@ -215,8 +230,13 @@ ParticleOverlay Simulator::particle_overlay() {
   return o;
 }
 
-void Simulator::step(const BrushPose* poses, int substeps, float dt) {
+void Simulator::step(const BrushPose* pen_poses, int substeps, float dt) {
   WB_REQUIRE(substeps >= 1 && dt > 0.f && std::isfinite(dt), "Simulator::step: bad sub-step count or dt");
+  // The pen's poses measure the brush from the bare canvas (pose_from_pen); the brush meets the
+  // dried paint under it first, so they are raised by its top (docs/TRANSFER.md "Scumble").
+  lifted_.assign(pen_poses, pen_poses + substeps);
+  for (BrushPose& p : lifted_) p.position.z += ground_;
+  const BrushPose* poses = lifted_.data();
   ProfilerGuard guard(&profiler_);
   WB_PROFILE_SCOPE("sim.step");
   grid_->set_particle_density(nullptr);  // last step's raster is stale

@@ -147,8 +147,12 @@ class Simulator {
   DeviceBuffer<StepSums> step_sums_;
   DeviceBuffer<float> solid_height_;  ///< dried-paint top per window column (particles' solid, Eq. 8)
   DeviceBuffer<float> wet_top_;       ///< wet-paint surface per window column (free particles land on it)
-  DeviceBuffer<float> extent_scratch_, extent_;  ///< the samples' box (samples_box)
+  DeviceBuffer<float> extent_scratch_, extent_;  ///< the samples' box and the ground (samples_box)
   std::array<float, 4> box_{};                   ///< the samples' box at the end of the last step
+  /// Top of the dried paint under the brush's footprint at the end of the last step, cells: the
+  /// pen's pressure presses the brush into the surface it meets, not below the bare canvas.
+  float ground_ = 0.f;
+  std::vector<BrushPose> lifted_;                ///< this step's poses raised by ground_
   float zone_D0_ = 0.f;
 };
 
