@@ -32,6 +32,12 @@ for w in $what; do
         -o "$out/press-and-drag-grid-only.png" --save "$out/press-and-drag-grid-only.ora" \
         --stats "$out/press-and-drag-grid-only.json" > "$out/press-and-drag-grid-only.log" 2>&1
       echo "replay press-and-drag --grid-only (cuda): exit $?"
+      # The paper's load model: no flow along the bristles.
+      timeout 300 "$bin/wetbrush" replay "$here/examples/press-and-drag.json" --device cuda -q \
+        --set transfer.wick_rate=0 --set transfer.wick_slide=0 -o "$out/press-and-drag-no-wicking.png" \
+        --save "$out/press-and-drag-no-wicking.ora" --stats "$out/press-and-drag-no-wicking.json" \
+        > "$out/press-and-drag-no-wicking.log" 2>&1
+      echo "replay press-and-drag without wicking (cuda): exit $?"
       # Every painting: a 2:1 close-up under a raking light, centred on the painted region the
       # replay reports, and an oblique view of the whole canvas under the same light.
       for st in "$out"/*.json; do
