@@ -77,10 +77,12 @@ double peak_ratio(const std::vector<double>& v, int i0, int n, int k) {
 
 class StrokePropertiesTest : public SimulatorTest {
  protected:
-  /// A small flat (a fifth of the default flat's 12 mm): 60 bristles, 6 mm long, 3.2 mm wide.
+  /// A small flat (a fifth of the default flat's 12 mm): 60 bristles of 0.25 cells, 6 mm long,
+  /// 3.2 mm wide.
   static BrushSpec small_flat() {
     BrushSpec b = default_brush(BrushShape::Flat);
     b.bristles = 60;
+    b.bristle_radius = 0.25f;
     b.length = 30.f;
     b.width = 16.f;
     b.thickness = 4.f;
@@ -309,6 +311,85 @@ TEST_F(StrokePropertiesTest, OneLoadRunsOutAlongALongStroke) {
   EXPECT_LT(last, 0.6 * first) << "the load runs down";
   EXPECT_LT(end_cover, 0.9) << "the end breaks into dry-brush coverage";
   EXPECT_GT(last, 0.0) << "but still paints";
+}
+
+TEST_F(StrokePropertiesTest, FlatPulledBroadsideLeavesBristleStreaks) {
+  // The default flat brush full of thick paint (oil 0.1) pulled 100 mm (500 cells) broadside at
+  // 60 mm/s at half pressure, in a window that holds it with its particle zone. In the stroke's
+  // body the paint's thickness varies across the stroke (the bristles' tracks) far more than
+  // along it, in distinct ridges (docs/TRANSFER.md "Bristle streaks").
+  constexpr int W = 640, H = 128;
+  constexpr float y0 = 64.f, xa = 70.f, xb = 570.f, speed = 300.f, pressure = 0.5f;
+  SimConfig c = small_config(CanvasDims{W, H, 32});
+  c.brush = default_brush(BrushShape::Flat);
+  c.window = Int3{160, 160, 32};
+  c.params.particles = ParticleParams{};  // the scene's small-brush D0 and D1 are not this brush's
+  auto pose = [&](float x, float p, bool down = true) {
+    PenSample s;
+    s.x = x, s.y = y0, s.pressure = p, s.tilt_x = 20.f, s.twist = 90.f, s.down = down;
+    return pose_from_pen(s, c.brush);
+  };
+  Simulator sim(c, pose(xa, 0.f, false));
+  PaintLoad paint = red();
+  paint.oil = 0.1f;
+  sim.load_paint(paint);
+  for (int i = 1; i <= 8; ++i) sim.step(pose(xa, pressure * float(i) / 8.f), kDt);
+  const int substeps = int(std::ceil(speed * kDt / 2.f));
+  std::vector<BrushPose> poses(static_cast<size_t>(substeps));
+  for (float x = xa; x < xb; x += speed * kDt) {
+    for (int k = 0; k < substeps; ++k)
+      poses[size_t(k)] = pose(std::min(xb, x + speed * kDt * float(k + 1) / float(substeps)), pressure);
+    sim.step(poses.data(), substeps, kDt);
+  }
+  for (int i = 0; i < 8; ++i) sim.step(pose(xb, 0.f, false), kDt);
+  sim.settle();
+  EXPECT_LT(std::abs(sim.books().max_drift()), 1e-4);
+  EXPECT_EQ(sim.counters().nonfinite_events, 0);
+  EXPECT_EQ(sim.counters().zone_cut_steps, 0);
+  PaintWindow w(device_, Int3{W, H, 32});
+  sim.canvas().gather(w);
+  const auto f = w.to_host();
+  std::vector<double> h(size_t(W) * H, 0.0);  // the paint's thickness per column, cells
+  for (int z = 0; z < 32; ++z)
+    for (size_t id = 0; id < h.size(); ++id) h[id] += f[0][size_t(z) * h.size() + id];
+  // The body: the middle 60 % of the stroke, the rows whose mean thickness is over 30 % of the
+  // thickest row's.
+  const int x0 = int(xa + 0.2f * (xb - xa)), x1 = int(xa + 0.8f * (xb - xa));
+  std::vector<double> across(H, 0.0);
+  for (int y = 0; y < H; ++y)
+    for (int x = x0; x < x1; ++x) across[size_t(y)] += h[size_t(y) * W + x] / double(x1 - x0);
+  const double peak = *std::max_element(across.begin(), across.end());
+  int ya = H, yb = -1;
+  for (int y = 0; y < H; ++y)
+    if (across[size_t(y)] > 0.3 * peak) ya = std::min(ya, y), yb = std::max(yb, y);
+  ASSERT_LT(ya, yb) << "no stroke body";
+  double d_across = 0, d_along = 0;
+  int n = 0;
+  for (int y = ya; y < yb; ++y)
+    for (int x = x0; x < x1; ++x, ++n) {
+      const double v = h[size_t(y) * W + x];
+      d_along += std::abs(h[size_t(y) * W + x + 1] - v);
+      d_across += std::abs(h[size_t(y + 1) * W + x] - v);
+    }
+  d_across /= n, d_along /= n;
+  // Ridges: maxima of the along-averaged profile standing 0.05 cells over the lower of their
+  // neighbourhoods' minima (4 rows each side).
+  int ridges = 0;
+  for (int y = ya + 1; y < yb; ++y) {
+    const double v = across[size_t(y)];
+    if (!(v > across[size_t(y - 1)] && v >= across[size_t(y + 1)])) continue;
+    double lo_l = v, lo_r = v;
+    for (int k = 1; k <= 4; ++k) {
+      lo_l = std::min(lo_l, across[size_t(std::max(ya, y - k))]);
+      lo_r = std::min(lo_r, across[size_t(std::min(yb, y + k))]);
+    }
+    ridges += v - std::max(lo_l, lo_r) >= 0.05;
+  }
+  std::printf("flat broadside, 100 mm at 60 mm/s: body rows %d-%d, mean |dh/dacross| %.3f, |dh/dalong| %.3f "
+              "(ratio %.2f), %d ridges across, mean thickness %.2f cells\n",
+              ya, yb, d_across, d_along, d_across / d_along, ridges, peak);
+  EXPECT_GE(d_across, 2.0 * d_along) << "bristle streaks: the paint varies across the stroke";
+  EXPECT_GE(ridges, 4) << "distinct ridges across the stroke";
 }
 
 TEST_F(StrokePropertiesTest, EveryShapeEdgeOnOrBroadsideLeavesAContinuousMark) {

@@ -46,7 +46,13 @@ BrushSpec default_brush(BrushShape shape) {
       b.stiffness = 0.7f;
       break;
     case BrushShape::Flat:  // 12 mm x 2.4 mm ferrule, square tip
-      b.bristles = 300;
+      // Each simulated bristle is a wet clump of hairs (the paper's brushes have 40-600): 120
+      // clumps of 0.34 cells, spaced about 2.5 cells as the round's bristles are, so the 0.2 mm
+      // grid resolves their tracks as streaks; 300 bristles 1.5 cells apart left none
+      // (docs/TRANSFER.md "Bristle streaks"). Their load capacity is the 300 bristles' (M_max
+      // scales with the radius cubed: Simulator).
+      b.bristles = 120;
+      b.bristle_radius = 0.34f;
       b.length = 90.f;
       b.width = 60.f;
       b.thickness = 12.f;

@@ -110,7 +110,7 @@ std::vector<ParamInfo> build_table() {
       // Rendering (§6).
       // Liquid transfer (§5) and wicking.
       WB_PARAM(transfer.mu, "Capacity compression mu", "", "Eq. 12", 0, 1, "How much bristle crowding cuts a sample's capacity"),
-      WB_PARAM(transfer.M_max, "Sample capacity M_max", "kg", "Eq. 12", 1e-12, 1e-5, "Most paint one bristle sample holds"),
+      WB_PARAM(transfer.M_max, "Sample capacity M_max", "kg", "Eq. 12", 1e-12, 1e-5, "Most paint one bristle sample holds, for a bristle of 0.25 cells (scaled by the radius cubed)"),
       WB_PARAM(transfer.epsilon, "Emission epsilon", "", "§5.1", 0, 10, "A sample emits above (1 + epsilon) M_j"),
       WB_PARAM(transfer.absorb_limit, "Absorb limit", "", "§5.1", 0, 1024, "Particles one sample absorbs per step"),
       WB_PARAM(transfer.emit_limit, "Emit limit", "", "§5.1", 0, 64, "Particles one sample emits per step"),

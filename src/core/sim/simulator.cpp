@@ -34,6 +34,13 @@ MacView mac_view(const float* u, const float* v, const float* w, const ActiveWin
 
 Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
     : config_(config), profiler_(config.device), ws_(config.device) {
+  // A sample's capacity is a sphere of three bristle radii (Eq. 12's M_max): the parameters give
+  // it for a bristle of kCapacityRadius; this brush's bristles hold in proportion to their volume.
+  {
+    const float s = std::pow(config_.brush.bristle_radius / TransferParams::kCapacityRadius, 3.f);
+    config_.params.transfer.M_max *= s;
+    config_.params.transfer.M_min *= s;
+  }
   const Device& d = config_.device;
   d.activate();
   canvas_ = std::make_unique<TileStore>(d, config_.canvas);

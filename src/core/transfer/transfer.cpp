@@ -85,7 +85,9 @@ void validate(const TransferParams& p) {
   WB_REQUIRE(in(p.rho0, 1.f, 1e5f), "TransferParams: rho0 must lie in [1, 1e5] kg/m^3");
   WB_REQUIRE(in(p.cell_size, 1e-6f, 1.f), "TransferParams: cell_size must lie in [1e-6, 1] m");
   WB_REQUIRE(in(p.mu, 0.f, 1.f), "TransferParams: mu must lie in [0, 1] (Eq. 12)");
-  WB_REQUIRE(in(p.M_max, 1e-20f, 1e-5f), "TransferParams: M_max must lie in (0, 1e-5] kg (Eq. 12)");
+  // The parameter is at most 1e-5 kg for a 0.25-cell bristle; a brush of thicker bristles scales
+  // it by the radius cubed (Simulator), up to 8000x for the thickest (5 cells).
+  WB_REQUIRE(in(p.M_max, 1e-20f, 1e-1f), "TransferParams: M_max must lie in (0, 0.1] kg (Eq. 12)");
   WB_REQUIRE(in(p.M_min, 0.f, p.M_max), "TransferParams: M_min must lie in [0, M_max] (Eq. 12)");
   WB_REQUIRE(in(p.epsilon, 0.f, 10.f), "TransferParams: epsilon must lie in [0, 10]");
   WB_REQUIRE(in(p.surface_density, 1e-6f, 1.f), "TransferParams: surface_density must lie in (0, 1]");

@@ -22,6 +22,9 @@ struct TransferParams {
   /// a sphere of three bristle radii (0.25 cells each, BrushSpec::bristle_radius) around each
   /// sample; 128 samples x 200 bristles then hold 0.36 ml. Range (0, 1e-5]. Eq. 12.
   float M_max = 1.4137167e-8f;
+  /// The bristle radius, cells, that M_max and M_min are given for: a brush of thicker bristles
+  /// (clumps) holds (r / kCapacityRadius)^3 times more per sample (the simulator scales them).
+  static constexpr float kCapacityRadius = 0.25f;
   /// Smallest capacity of one sample, kg. Default M_max / 4; with mu = 0.5 and psi <= 1 it only
   /// bites for mu > 0.75. Range [0, M_max]. Eq. 12.
   float M_min = 3.5342917e-9f;
