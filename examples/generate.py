@@ -145,7 +145,19 @@ def stiff_and_oily():
           s, events, window=(192, 192, 32))
 
 
+def flat_streaks():
+    # Bristle streaks (docs/TRANSFER.md): the default flat full of thick paint pulled 100 mm
+    # broadside (its width across the stroke) at 60 mm/s, half pressure, the handle leaning 20
+    # degrees toward the travel.
+    s = stroke(0.0, line((260, 512), (760, 512)), 1.6, 0.5, tilt=(20, 0), twist=90)
+    write("flat-streaks.json",
+          "Bristle streaks: the default flat brush full of thick paint (oil 0.1) pulled 100 mm broadside.",
+          {"shape": "flat"}, {"ryb": [0.85, 0.3, 0.05], "oil": 0.1, "load": 1.0, "reload_on_pen_down": False},
+          s, window=(192, 192, 32))
+
+
 if __name__ == "__main__":
+    flat_streaks()
     cross_wet()
     scumble()
     stiff_and_oily()
