@@ -154,7 +154,7 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
     try {
       validate_brush(b, "brush");
     } catch (const std::exception& e) {
-      statusBar()->showMessage(QString::fromStdString(e.what()), 5000);
+      statusBar()->showMessage(QString::fromStdString(user_message(e)), 5000);
       return;
     }
     view_->set_cursor_radius(b.width * 0.5f);
@@ -428,11 +428,11 @@ bool MainWindow::write_snapshot(const QString& path, bool wait, bool user_save) 
           save_painting(file, *copy, *image, meta);
           done->set_value("");
         } catch (const std::exception& e) {
-          done->set_value(e.what());
+          done->set_value(user_message(e));
         }
       });
     } catch (const std::exception& e) {
-      done->set_value(e.what());
+      done->set_value(user_message(e));
     }
   });
   // A user save marks the painting saved at once (strokes painted while the file is written
@@ -517,7 +517,7 @@ bool MainWindow::open_from(const QString& path) {
       *dims = c.canvas;
       done->set_value("");
     } catch (const std::exception& e) {
-      done->set_value(e.what());
+      done->set_value(user_message(e));
     }
   });
   const std::string err = done->get_future().get();
@@ -544,7 +544,7 @@ bool MainWindow::export_png(const QString& path) {
       write_png8(file, img.rgba.data(), img.width, img.height, 4);
       done->set_value("");
     } catch (const std::exception& e) {
-      done->set_value(e.what());
+      done->set_value(user_message(e));
     }
   });
   const std::string err = done->get_future().get();
@@ -561,7 +561,7 @@ bool MainWindow::export_maps(const QString& height_path, const QString& normal_p
       write_material_maps(s.sim().device(), canvas, MaterialMapPaths{hp, np, ""});
       done->set_value("");
     } catch (const std::exception& e) {
-      done->set_value(e.what());
+      done->set_value(user_message(e));
     }
   });
   const std::string err = done->get_future().get();
@@ -580,7 +580,7 @@ bool MainWindow::save_recording(const QString& path) {
                                8000);
     return true;
   } catch (const std::exception& e) {
-    QMessageBox::warning(this, "Save recording failed", QString::fromStdString(e.what()));
+    QMessageBox::warning(this, "Save recording failed", QString::fromStdString(user_message(e)));
     return false;
   }
 }

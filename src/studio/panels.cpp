@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/color/ryb.h"
+#include "core/exec/error.h"
 #include "core/io/brush_json.h"
 
 namespace wb::studio {
@@ -97,7 +98,7 @@ BrushPanel::BrushPanel(QWidget* parent) : QWidget(parent) {
       set_brush(b);
       emit_changed();
     } catch (const std::exception& e) {
-      QMessageBox::warning(this, "Brush preset", QString::fromStdString(e.what()));
+      QMessageBox::warning(this, "Brush preset", QString::fromStdString(user_message(e)));
     }
   });
   connect(save, &QPushButton::clicked, this, [this] {

@@ -451,7 +451,7 @@ void SimThread::run() {
       try {
         fn(*this);
       } catch (const std::exception& e) {
-        Q_EMIT failed(QString::fromStdString(e.what()));
+        Q_EMIT failed(QString::fromStdString(user_message(e)));
       }
     }
     // A few steps, then look at the inputs again: commands (undo, save) never wait long.
@@ -476,9 +476,9 @@ void SimThread::run() {
       failed_ = true;
       {
         std::lock_guard lk(status_mu_);
-        status_.error = e.what();
+        status_.error = user_message(e);
       }
-      Q_EMIT failed(QString::fromStdString(e.what()));
+      Q_EMIT failed(QString::fromStdString(user_message(e)));
     }
     const bool pending = !failed_ && step_available();
     if (!pending) {
@@ -487,7 +487,7 @@ void SimThread::run() {
         try {
           finish_stroke();
         } catch (const std::exception& e) {
-          Q_EMIT failed(QString::fromStdString(e.what()));
+          Q_EMIT failed(QString::fromStdString(user_message(e)));
         }
       }
       render(true);

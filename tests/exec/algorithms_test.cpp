@@ -156,4 +156,16 @@ TEST(DeviceTest, ParseAndPrint) {
   EXPECT_GE(list_devices().size(), 1u);
 }
 
+TEST(ErrorTest, MessageForTheUserHasNoSourceLocation) {
+  try {
+    WB_THROW("the file is not a painting");
+  } catch (const Error& e) {
+    EXPECT_EQ(e.message(), "the file is not a painting");
+    EXPECT_EQ(user_message(e), "the file is not a painting");
+    EXPECT_NE(std::string(e.what()).find(".cpp:"), std::string::npos) << "logs keep where it was raised";
+    return;
+  }
+  FAIL() << "WB_THROW did not throw";
+}
+
 }  // namespace wb::test

@@ -8,7 +8,7 @@ namespace wb {
 
 void throw_error(const char* file, int line, const std::string& message) {
   const char* base = std::strrchr(file, '/');
-  throw Error(message + " [" + (base ? base + 1 : file) + ":" + std::to_string(line) + "]");
+  throw Error(message, std::string(base ? base + 1 : file) + ":" + std::to_string(line));
 }
 
 namespace detail {

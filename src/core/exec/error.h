@@ -7,8 +7,20 @@ namespace wb {
 
 class Error : public std::runtime_error {
  public:
-  explicit Error(const std::string& what) : std::runtime_error(what) {}
+  explicit Error(const std::string& message, const std::string& where = {})
+      : std::runtime_error(where.empty() ? message : message + " [" + where + "]"), message_(message) {}
+  /// The message for the user, without the source location that what() appends for logs.
+  const std::string& message() const { return message_; }
+
+ private:
+  std::string message_;
 };
+
+/// What to show a user for any exception: an Error's message, else what().
+inline std::string user_message(const std::exception& e) {
+  const auto* w = dynamic_cast<const Error*>(&e);
+  return w ? w->message() : e.what();
+}
 
 [[noreturn]] void throw_error(const char* file, int line, const std::string& message);
 
