@@ -63,7 +63,7 @@ QualityPreset QualityPreset::tiny() {
   p.canvas_height = 120;
   p.canvas_depth = 16;
   p.ao_rays = 4;
-  p.window_xy = 48;  // particles within 8 cells of the bristles (Simulator::effective_D0)
+  p.window_xy = 48;  // particles within D0's floor, about 8.6 cells, of the bristles (Simulator::place_window)
   p.window_z = 8;
   return p;
 }
