@@ -282,8 +282,6 @@ bool Grid::move_window(Int3 new_origin) {
   return moved;
 }
 
-bool Grid::recentre_on(Vec3 brush) { return move_window(window_.origin_for(brush, params_.window_snap)); }
-
 void Grid::classify() {
   WB_PROFILE_SCOPE("grid.classify");
   classify_d(device(), view(), window_.paint().view(), bristles_, particle_density_, window_.canvas().dims(), params_.liquid_threshold,

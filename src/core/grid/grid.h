@@ -79,8 +79,6 @@ class Grid {
   // --- stages (call in this order; step() does) ---
   /// Window to `new_origin` (scatter, shift velocity, gather). Returns whether it moved.
   bool move_window(Int3 new_origin);
-  /// Window centred on the brush (canvas cells), origin snapped to params().window_snap.
-  bool recentre_on(Vec3 brush_canvas_cells);
   /// Cell classes and open face fractions from paint, dryness and bristles.
   void classify();
   /// Semi-Lagrangian advection (RK2 backtrace, trilinear) of the paint fields and the velocity.

@@ -20,7 +20,7 @@ KeepBox nowhere() { return KeepBox::of(Int3{}, Int3{}); }
 }  // namespace
 namespace {
 
-/// Where the bristles meet the canvas: the rest tip under the handle (window centre).
+/// Where the bristles meet the canvas: the rest tip under the handle (the ground's disc).
 Vec3 footprint_centre(const BrushPose& pose, float length) {
   return pose.position + pose.rotation * Vec3(0.f, 0.f, -length);
 }
