@@ -165,10 +165,7 @@ std::array<float, 4> Simulator::samples_box() {
   float m[5];
   extent_.copy_to_host(m, 5);
   ground_ = std::isfinite(m[4]) ? std::max(m[4], 0.f) : 0.f;
-  if (!(m[0] >= -m[1] && m[2] >= -m[3])) {  // no sample below the window's top: the tips' point
-    const Vec3 tip = footprint_centre(brush_->pose(), config_.brush.length);
-    return {tip.x, tip.x, tip.y, tip.y};
-  }
+  if (!(m[0] >= -m[1] && m[2] >= -m[3])) return {tip.x, tip.x, tip.y, tip.y};  // none below the top: the tips' point
   return {-m[1], m[0], -m[3], m[2]};
 }
 

@@ -115,7 +115,8 @@ class Simulator {
   /// D0 of §5.2 for this step, limited so that the particle zone fits in the window's kept box
   /// around the samples (transfer_env; set by place_window).
   float effective_D0() const { return zone_D0_; }
-  /// Horizontal box of the samples below the window's top: x_lo, x_hi, y_lo, y_hi (one read).
+  /// Horizontal box of the samples below the window's top: x_lo, x_hi, y_lo, y_hi; also sets
+  /// ground_ for the next step. One read for both.
   std::array<float, 4> samples_box();
   /// Window origin for the samples' box over the step (the union of `before` and `after`), and
   /// the D0 that keeps the particle zone inside its kept box.
