@@ -50,7 +50,7 @@ BrushSpec default_brush(BrushShape shape) {
       // clumps of 0.34 cells, spaced about 2.5 cells as the round's bristles are, so the 0.2 mm
       // grid resolves their tracks as streaks; 300 bristles 1.5 cells apart left none
       // (docs/TRANSFER.md "Bristle streaks"). Their load capacity is the 300 bristles' (M_max
-      // scales with the radius cubed: Simulator).
+      // scales with the radius cubed: TransferParams::for_bristle_radius).
       b.bristles = 120;
       b.bristle_radius = 0.34f;
       b.length = 90.f;

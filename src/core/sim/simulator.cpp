@@ -34,13 +34,6 @@ MacView mac_view(const float* u, const float* v, const float* w, const ActiveWin
 
 Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
     : config_(config), profiler_(config.device), ws_(config.device) {
-  // A sample's capacity is a sphere of three bristle radii (Eq. 12's M_max): the parameters give
-  // it for a bristle of kCapacityRadius; this brush's bristles hold in proportion to their volume.
-  {
-    const float s = std::pow(config_.brush.bristle_radius / TransferParams::kCapacityRadius, 3.f);
-    config_.params.transfer.M_max *= s;
-    config_.params.transfer.M_min *= s;
-  }
   const Device& d = config_.device;
   d.activate();
   canvas_ = std::make_unique<TileStore>(d, config_.canvas);
@@ -48,8 +41,10 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
   grid_ = std::make_unique<Grid>(*canvas_, config_.params.grid, config_.window, Int3{});
   particles_ = ParticleStore(d, config_.params.particles.max_particles);
   hash_ = SampleHashGrid(d);
-  load_ = std::make_unique<BristleLoad>(d, brush_->sample_count(), config_.params.transfer);
-  transfer_ = std::make_unique<Transfer>(d, config_.params.transfer);
+  // This brush's bristles hold in proportion to their volume (Eq. 12's M_max).
+  const TransferParams tp = config_.params.transfer.for_bristle_radius(config_.brush.bristle_radius);
+  load_ = std::make_unique<BristleLoad>(d, brush_->sample_count(), tp);
+  transfer_ = std::make_unique<Transfer>(d, tp);
   const GridDims g = grid_->dims();
   auto cells = [&](DeviceBuffer<float>& b) {
     b.set_device(d);

@@ -14,6 +14,14 @@
 
 namespace wb {
 
+TransferParams TransferParams::for_bristle_radius(float r) const {
+  TransferParams p = *this;
+  const float s = std::pow(r / kCapacityRadius, 3.f);
+  p.M_max *= s;
+  p.M_min *= s;
+  return p;
+}
+
 float TransferParams::absorb_range() const {
   // M'_j = max((1 - mu psi) M_max, M_min) (Eq. 12) is at most max(M_max, M_min).
   return load_radius(std::max(M_max, M_min), cell_mass());
@@ -86,7 +94,7 @@ void validate(const TransferParams& p) {
   WB_REQUIRE(in(p.cell_size, 1e-6f, 1.f), "TransferParams: cell_size must lie in [1e-6, 1] m");
   WB_REQUIRE(in(p.mu, 0.f, 1.f), "TransferParams: mu must lie in [0, 1] (Eq. 12)");
   // The parameter is at most 1e-5 kg for a 0.25-cell bristle; a brush of thicker bristles scales
-  // it by the radius cubed (Simulator), up to 8000x for the thickest (5 cells).
+  // it by the radius cubed (for_bristle_radius), up to 8000x for the thickest (5 cells).
   WB_REQUIRE(in(p.M_max, 1e-20f, 1e-1f), "TransferParams: M_max must lie in (0, 0.1] kg (Eq. 12)");
   WB_REQUIRE(in(p.M_min, 0.f, p.M_max), "TransferParams: M_min must lie in [0, M_max] (Eq. 12)");
   WB_REQUIRE(in(p.epsilon, 0.f, 10.f), "TransferParams: epsilon must lie in [0, 10]");

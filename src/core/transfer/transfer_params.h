@@ -23,7 +23,7 @@ struct TransferParams {
   /// sample; 128 samples x 200 bristles then hold 0.36 ml. Range (0, 1e-5]. Eq. 12.
   float M_max = 1.4137167e-8f;
   /// The bristle radius, cells, that M_max and M_min are given for: a brush of thicker bristles
-  /// (clumps) holds (r / kCapacityRadius)^3 times more per sample (the simulator scales them).
+  /// (clumps) holds (r / kCapacityRadius)^3 times more per sample (for_bristle_radius).
   static constexpr float kCapacityRadius = 0.25f;
   /// Smallest capacity of one sample, kg. Default M_max / 4; with mu = 0.5 and psi <= 1 it only
   /// bites for mu > 0.75. Range [0, M_max]. Eq. 12.
@@ -105,12 +105,9 @@ struct TransferParams {
   /// Largest load sphere of a sample (R_j of §5.1 at the largest capacity), cells: a particle
   /// farther than this from every sample is absorbed by none (Eq. 14).
   float absorb_range() const;
-  /// M_max for a brush: rho0 times the sphere of `radii` bristle radii (cells) around a sample.
-  static float capacity_for(float bristle_radius_cells, float radii = 3.f, float rho0 = 1000.f,
-                            float cell_size = 2e-4f) {
-    const float r = radii * bristle_radius_cells * cell_size;
-    return rho0 * 4.f / 3.f * 3.14159265f * r * r * r;
-  }
+  /// These parameters for a brush whose bristles have radius r, cells: a sample's capacity is a
+  /// sphere of three bristle radii, so M_max and M_min scale by (r / kCapacityRadius)^3.
+  TransferParams for_bristle_radius(float r) const;
 };
 
 }  // namespace wb
