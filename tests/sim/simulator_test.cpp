@@ -160,8 +160,10 @@ TEST_F(SimulatorTest, StepHostReadsStayBounded) {
   const double mean = double(std::accumulate(reads.begin(), reads.end(), int64_t(0))) / double(reads.size());
   const int64_t most = *std::max_element(reads.begin(), reads.end());
   std::printf("host reads a step: mean %.1f, most %lld\n", mean, static_cast<long long>(most));
-  EXPECT_LE(mean, 16.0);
-  EXPECT_LE(most, 24);
+  // The viscous solve reads its residual every 8 iterations: at the lift, where Eq. 9 lifts the
+  // paint the tips hold, it takes up to its 300 iterations (13 reads + 300 / 8).
+  EXPECT_LE(mean, 18.0);
+  EXPECT_LE(most, 13 + 300 / 8);
 }
 
 TEST_F(SimulatorTest, MorePressureSpreadsAWiderMark) {

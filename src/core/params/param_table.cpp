@@ -103,6 +103,8 @@ std::vector<ParamInfo> build_table() {
                "Paint within this distance of the bristles is simulated as particles"),
       WB_PARAM(particles.delta, "Friction range delta", "1/cells", "Eq. 8", 0.01, 1,
                "Friction vanishes beyond 1/delta from a solid surface"),
+      WB_PARAM(particles.friction_rate, "Friction rate k", "1/s", "Eq. 8", 0, 1e6,
+               "How fast paint touching the canvas stops: its velocity decays as exp(-k w t)"),
       WB_PARAM(particles.gamma, "PIC weight gamma", "", "Eq. 11", 0, 1,
                "Weight of the projected grid velocity in the particle velocity update"),
       WB_PARAM(particles.hash_cell, "Hash cell", "cells", "§6", 0.5, 100, "Cell size of the sample hash grid"),

@@ -8,6 +8,7 @@
 #include "core/brush/bristle_fields.h"
 #include "core/exec/hd.h"
 #include "core/math/vec.h"
+#include "core/particles/particle_params.h"
 
 namespace wb {
 
@@ -54,10 +55,21 @@ WB_HD WB_INLINE float friction_weight(float d, float delta) {
   return s * s;
 }
 
-/// Eq. 8: f = -max(1 - delta d, 0)^2 v, read as the velocity change of one step (so the
-/// acceleration is f / dt): at the surface the particle stops (no slip), beyond 1/delta it slips.
-WB_HD WB_INLINE Vec3 friction_accel(Vec3 v, float d, float delta, float dt) {
-  return v * (-friction_weight(d, delta) / dt);
+/// Eq. 8 over a step. The paper's f = -w v is a drag; read as a rate, dv/dt = -k w v with k the
+/// friction rate at the surface (1/s), so the same paint slows the same whatever the step: exact
+/// over the step, v ends at v e^{-k w dt} and moves on average (1 - e^{-k w dt}) / (k w dt) of v dt.
+/// Reading it as "the velocity change of one step" (v (1 - w) a step) damped paint twice as much
+/// in half the time at half the step, and missed a velocity gained within the step (a bristle's
+/// jolt), which then carried paint lying on the canvas by (1 - beta_L) dV dt: half as far at
+/// half the step (docs/PARTICLES.md "Friction as a rate").
+struct FrictionDecay {
+  float mean = 1.f;  ///< mean velocity over the step / starting velocity
+  float end = 1.f;   ///< velocity at the end of the step / starting velocity
+};
+WB_HD WB_INLINE FrictionDecay friction_decay(float d, float delta, float rate, float dt) {
+  const float x = rate * friction_weight(d, delta) * dt;
+  if (x < 1e-6f) return FrictionDecay{};
+  return FrictionDecay{-expm1f(-x) / x, expf(-x)};
 }
 
 /// Eq. 10 weight of the local-frame result: max(1 - d_B / D1, 0).
@@ -132,34 +144,34 @@ WB_HD WB_INLINE Vec3 local_frame_step(Vec3 p, Vec3 v, Vec3 a_k, const SampleFram
   return s.x + to_canvas(s.t, s.n, s.b, pl);
 }
 
-/// One particle's two-step update (§4.3): external acceleration a_k = g + friction (Eq. 8);
-/// p' from the nearest sample's frame (Eq. 9, only when d_B < D1), p'' in the canvas frame;
-/// blend (Eq. 10); keep it above the solid; velocity corrected from the positions,
-/// v = (p_new - p) / dt. `sample` may be null when no sample is near.
+/// One particle's two-step update (§4.3): external acceleration a_k = g; p' from the nearest
+/// sample's frame (Eq. 9, only when d_B < D1), p'' in the canvas frame; blend (Eq. 10); the
+/// friction of Eq. 8 slows the step's motion relative to the canvas, a velocity the bristle gave
+/// within the step included; keep it above the solid. `sample` may be null when no sample is near.
 /// One gravity for grid and particles: a particle inside the wet paint is part of it, and the grid
 /// gives that paint its weight and its support (§4.2 gravity with the hydrostatic part, resisted
 /// by the yield stress), which FLIP hands to the particle (Eq. 11); so g enters a_k only above
 /// the paint. There a free particle falls onto the wet surface and rests on it, as on the solid;
 /// a bristle holding it (Eq. 10 weight > 0) can still press it into the wet paint.
 WB_HD WB_INLINE void adhesion_update(Vec3& p, Vec3& v, const SampleFrame* sample, float d_B, const SolidView& solid,
-                                     Vec3 gravity, float delta, float beta_L, float D1, float dt) {
+                                     const ParticleParams& prm, float dt) {
   const float d = solid_distance(solid, p);
   const bool in_paint = p.z < paint_surface_z(solid, p);
-  const Vec3 a_k = (in_paint ? Vec3(0.f, 0.f, 0.f) : gravity) + friction_accel(v, d, delta, dt);
+  const Vec3 a_k = in_paint ? Vec3(0.f, 0.f, 0.f) : prm.gravity;
   const Vec3 p_canvas = canvas_frame_step(p, v, a_k, dt);
+  const float w = adhesion_weight(d_B, prm.D1);
+  const bool held = sample && w > 0.f;
   Vec3 p_new = p_canvas;
-  // Paint the canvas holds (Eq. 8's weight) does not also follow a bristle: without this a
-  // particle lying under a bristle tip takes (1 - beta_L) of the tip's motion when the brush
-  // lifts or lands (the handle moves ~25 cells in one step), keeps that velocity once it is
-  // past D1, and lands up to 3 brush radii away (docs/PARTICLES.md "The canvas holds").
-  const float w = adhesion_weight(d_B, D1) * (1.f - friction_weight(d, delta));
-  if (sample && w > 0.f) p_new = p_canvas + (local_frame_step(p, v, a_k, *sample, beta_L, dt) - p_canvas) * w;
+  if (held) p_new = p_canvas + (local_frame_step(p, v, a_k, *sample, prm.beta_L, dt) - p_canvas) * w;
+  // Friction slows the whole step's motion relative to the canvas: what the particle carried into
+  // the step, gravity's pull and what a bristle gave it within the step.
+  const FrictionDecay f = friction_decay(d, prm.delta, prm.friction_rate, dt);
+  p_new = p + (p_new - p) * f.mean;
   // The particle cannot enter the solid (the projection only sees the solid on the grid), and
   // a free one coming down from above lands on the wet paint's surface.
-  const bool free_fall = !in_paint && !(sample && w > 0.f);
-  const float zs = free_fall ? paint_surface_z(solid, p_new) : solid_surface_z(solid, p_new);
+  const float zs = !in_paint && !held ? paint_surface_z(solid, p_new) : solid_surface_z(solid, p_new);
   if (p_new.z < zs) p_new.z = zs;
-  v = (p_new - p) / dt;
+  v = (p_new - p) * (f.end / (f.mean * dt));
   p = p_new;
 }
 

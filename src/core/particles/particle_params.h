@@ -18,6 +18,11 @@ struct ParticleParams {
   float D0 = 50.f;
   /// Friction range delta: friction vanishes beyond 1/delta. Default 0.1 / cell (1/0.2 cm), range [0.01, 1]. Table 1, Eq. 8.
   float delta = 0.1f;
+  /// Friction rate at the surface k, 1/s: Eq. 8's drag read as dv/dt = -k w v. Default 600, range
+  /// [0, 1e6]: the viscous relaxation rate mu / (rho0 L^2) of a layer as deep as the friction range
+  /// L = 1/delta = 2 mm, with the stiff paint's apparent viscosity under a brisk stroke (K gamma^(n-1)
+  /// = 30 Pa s^0.5 at gamma = 160/s: 2.4 Pa s) and rho0 = 1000 kg/m^3 (docs/PARTICLES.md).
+  float friction_rate = 600.f;
   /// PIC weight of the velocity update (FLIP weight 1 - gamma). Default 0.8, range [0, 1]. Table 1, Eq. 11.
   float gamma = 0.8f;
   /// Gravity, cells/s^2, canvas frame (z up). Default 9.81 m/s^2 = 49050 cells/s^2 down, range |g| in [0, 49050]. Eq. 9.

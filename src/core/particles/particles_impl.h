@@ -7,8 +7,6 @@
 namespace wb::WB_BACKEND_NS {
 
 void particles_adhesion_step(ParticleView p, SampleView s, SolidView solid, ParticleParams prm, float dt) {
-  const Vec3 g = prm.gravity;
-  const float delta = prm.delta, beta_L = prm.beta_L, D1 = prm.D1;
   const int64_t n_samples = s.count();
   parallel_for(p.count, [=] WB_HD(int64_t k) {
     Vec3 x = p.x[k], v = p.v[k];
@@ -16,9 +14,9 @@ void particles_adhesion_step(ParticleView p, SampleView s, SolidView solid, Part
     const int32_t j = p.nearest[k];
     if (j >= 0 && j < n_samples) {
       const SampleFrame f = load_sample(s, j);
-      adhesion_update(x, v, &f, p.d_B[k], solid, g, delta, beta_L, D1, dt);
+      adhesion_update(x, v, &f, p.d_B[k], solid, prm, dt);
     } else {
-      adhesion_update(x, v, nullptr, p.d_B[k], solid, g, delta, beta_L, D1, dt);
+      adhesion_update(x, v, nullptr, p.d_B[k], solid, prm, dt);
     }
     p.x[k] = x;
     p.v[k] = v;
