@@ -19,14 +19,14 @@ void classify_d(const Device& d, GridView g, PaintWindowView pw, BristleField br
                 float lt, float dt) {
   WB_DISPATCH(d, grid_classify(g, pw, br, pd, cd.width, cd.height, cd.depth, lt, dt));
 }
-void outflow_d(const Device& d, GridView g, const float* rho, float* out, float* top) {
-  WB_DISPATCH(d, grid_paint_outflow(g, rho, out, top));
+void outflow_d(const Device& d, GridView g, const float* rho, const float* pd, float* out, float* top, float* jt) {
+  WB_DISPATCH(d, grid_paint_outflow(g, rho, pd, out, top, jt));
 }
 void advect_axis_d(const Device& d, GridView g, PaintWindowView s, PaintWindowView t, int axis, float dt, int layers) {
   WB_DISPATCH(d, grid_advect_paint_axis(g, s, t, axis, dt, layers));
 }
-void advect_vel_d(const Device& d, GridView g, const float* u, const float* v, const float* w, float dt) {
-  WB_DISPATCH(d, grid_advect_velocity(g, u, v, w, dt));
+void advect_vel_d(const Device& d, GridView g, const float* u, const float* v, const float* w, float dt, int layers) {
+  WB_DISPATCH(d, grid_advect_velocity(g, u, v, w, dt, layers));
 }
 void gravity_d(const Device& d, GridView g, float* ph, float g_dt) { WB_DISPATCH(d, grid_gravity(g, ph, g_dt)); }
 void mu_d(const Device& d, GridView g, const float* oil, HerschelBulkley s, HerschelBulkley o, float m, float* mu) {
@@ -254,7 +254,7 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   cg_sums_.set_device(d);
   cg_sums_.resize(4);
   advect_max_.set_device(d);
-  advect_max_.resize(2);
+  advect_max_.resize(3);
   paint_tmp_ = PaintWindow(d, dims);
   scratch_.reserve(d, g.cells());
   classify();
@@ -299,14 +299,16 @@ void Grid::advect(float dt) {
   // Paint: flux form on the faces of the last step's velocity, one axis at a time (Strang order
   // x y z, then z y x), in sub-steps that keep each axis's outflow Courant number at most
   // advect_courant: no cell gives more than it holds, and no global correction is needed.
-  outflow_d(d, v, paint.density.data(), cell_tmp_.data(), face_tmp_.data());
-  // Both maxima in one copy: the outflow rate and the layers holding paint.
+  outflow_d(d, v, paint.density.data(), particle_density_, cell_tmp_.data(), face_tmp_.data(), rhs_.data());
+  // The maxima in one copy: the outflow rate, the layers holding paint and those holding paint
+  // or particles.
   reduce_max_into(d, cell_tmp_.data(), g.cells(), advect_max_.data(), ws_);
   reduce_max_into(d, face_tmp_.data(), g.cells(), advect_max_.data() + 1, ws_);
-  float maxima[2];
-  advect_max_.copy_to_host(maxima, 2);
+  reduce_max_into(d, rhs_.data(), g.cells(), advect_max_.data() + 2, ws_);
+  float maxima[3];
+  advect_max_.copy_to_host(maxima, 3);
   const float rate = maxima[0];
-  const int top = int(maxima[1]);
+  const int top = int(maxima[1]), joint_top = int(maxima[2]);
   const float courant = std::isfinite(rate) ? rate * dt : 0.f;
   const int n = std::clamp(int(std::ceil(courant / params_.advect_courant)), 1, params_.advect_max_substeps);
   stats_.advect_substeps = n;
@@ -332,11 +334,15 @@ void Grid::advect(float dt) {
       WB_PAINT_FIELDS(WB_X)
 #undef WB_X
     }
-  // Velocity: backtrace every open face through a copy of the field.
+  // Velocity: backtrace every open face through a copy of the field, up to the layers that can
+  // hold liquid in this step (paint or particles, the paint moved up by at most n cells) and the
+  // stencils that reach them. Above, no face is fluid before the projection's extrapolation
+  // writes it again, and nothing in the step reads it where there is no paint (docs/GRID.md).
   for (int c = 0; c < 3; ++c)
     mem::copy_on_device(d, vel_tmp_[c].data(), v.vel[c], size_t(g.faces(c)) * sizeof(float));
   v = view();
-  advect_vel_d(d, v, vel_tmp_[0].data(), vel_tmp_[1].data(), vel_tmp_[2].data(), dt);
+  advect_vel_d(d, v, vel_tmp_[0].data(), vel_tmp_[1].data(), vel_tmp_[2].data(), dt,
+               std::min(g.nz, joint_top + n + 2));
 }
 
 void Grid::rheology() {

@@ -144,7 +144,7 @@ class Grid {
   DeviceBuffer<float> cg_nu_, cg_x_, cg_b_, cg_r_, cg_z_, cg_p_, cg_q_, cg_diag_, cg_dot_a_, cg_dot_b_;
   /// The CG's scalars on the device: r.z of the two latest iterations, p.Ap, b.D^-1 b.
   DeviceBuffer<double> cg_sums_;
-  DeviceBuffer<float> advect_max_;  ///< the advection's outflow rate and top layer, read in one copy
+  DeviceBuffer<float> advect_max_;  ///< the advection's outflow rate and top layers (paint, joint), one copy
   PaintWindow paint_tmp_;
   SolverScratch scratch_;
   Workspace ws_;
@@ -154,10 +154,10 @@ class Grid {
 #define WB_GRID_BACKEND_DECLS                                                                                        \
   void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float* particle_density, int canvas_w, int canvas_h, int canvas_d,     \
                      float liquid_threshold, float dry_threshold);                                                   \
-  void grid_paint_outflow(GridView g, const float* rho, float* out, float* top);                                     \
+  void grid_paint_outflow(GridView g, const float* rho, const float* pd, float* out, float* top, float* jt);                                     \
   void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt,             \
                               int layers);                                                                           \
-  void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt);                  \
+  void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt, int layers);                  \
   void grid_gravity(GridView g, float* ph, float g_dt);                                                              \
   void grid_effective_viscosity(GridView g, const float* oil, HerschelBulkley stiff, HerschelBulkley oily, float m,  \
                                 float* mu);                                                                          \

@@ -60,13 +60,21 @@ void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float*
   });
 }
 
-void grid_paint_outflow(GridView g, const float* rho, float* out, float* top) {
+/// Density below which paint in a cell is a trace for the advection's layer bound, cells.
+constexpr float kTraceDensity = 1e-6f;
+
+void grid_paint_outflow(GridView g, const float* rho, const float* particle_density, float* out, float* top,
+                        float* joint_top) {
   const GridDims d = g.d;
   parallel_for(d.cells(), [=] WB_HD(int64_t c) {
     int i, j, k;
     d.decompose_cell(c, i, j, k);
     out[c] = cell_outflow_rate(g, rho, i, j, k);
-    top[c] = rho[c] != 0.f ? float(k + 1) : 0.f;
+    // Traces (a millionth of a cell, carried up by a lifting bristle a fraction of a cell a
+    // sub-step) do not count: above the top they stay where they are for the step.
+    const bool paint = rho[c] > kTraceDensity;
+    top[c] = paint ? float(k + 1) : 0.f;
+    joint_top[c] = paint || (particle_density && particle_density[c] > kTraceDensity) ? float(k + 1) : 0.f;
   });
 }
 
@@ -110,12 +118,15 @@ void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst
   });
 }
 
-void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt) {
+void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt, int layers) {
   const GridDims d = g.d;
-  parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
-    int c, i, j, k;
-    int64_t f;
-    detail::split_face(d, t, c, f);
+  // The faces of the cells below `layers` (x fastest, z last: a prefix of each component's array).
+  const int64_t nu = int64_t(d.nx + 1) * d.ny * layers, nv = int64_t(d.nx) * (d.ny + 1) * layers;
+  const int64_t nw = int64_t(d.nx) * d.ny * (layers < d.nz ? layers + 1 : d.nz + 1);
+  parallel_for(nu + nv + nw, [=] WB_HD(int64_t t) {
+    const int c = t < nu ? 0 : (t < nu + nv ? 1 : 2);
+    const int64_t f = c == 0 ? t : (c == 1 ? t - nu : t - nu - nv);
+    int i, j, k;
     if (g.theta[c][f] <= 0.f) {
       g.vel[c][f] = g.solid_vel[c][f];
       return;

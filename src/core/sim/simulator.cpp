@@ -200,6 +200,8 @@ TransferEnv Simulator::transfer_env() {
   env.floor_z = config_.params.particles.floor_z;
   env.dry_threshold = config_.params.grid.dry_threshold;
   env.D0 = config_.particles ? effective_D0() : 0.f;
+  const Int3 o = win.origin();
+  if (o.x == wet_top_origin_.x && o.y == wet_top_origin_.y && o.z == wet_top_origin_.z) env.surface = wet_top_.data();
   // Particles live inside the window less a rim of kKeepRim cells (beyond the reach of Eq. 16's
   // kernel): one that enters the rim goes to the grid, and rim paint is never sampled into
   // particles, so nothing cycles between the two there (docs/TRANSFER.md).
@@ -371,6 +373,7 @@ void Simulator::particle_stage(float dt) {
               1.f / transfer_->params().cell_mass());
   particles_solid_height(device(), win.paint().view(), raster_density_.data(), config_.params.grid.dry_threshold,
                          config_.params.grid.liquid_threshold, prm.floor_z, solid_height_.data(), wet_top_.data());
+  wet_top_origin_ = win.origin();
   SolidView solid;
   solid.floor_z = prm.floor_z;
   solid.height = solid_height_.data();

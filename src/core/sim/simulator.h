@@ -148,6 +148,7 @@ class Simulator {
   DeviceBuffer<StepSums> step_sums_;
   DeviceBuffer<float> solid_height_;  ///< dried-paint top per window column (particles' solid, Eq. 8)
   DeviceBuffer<float> wet_top_;       ///< wet-paint surface per window column (free particles land on it)
+  Int3 wet_top_origin_{0, 0, -1};     ///< window origin wet_top_ was made at (z -1: never)
   DeviceBuffer<float> extent_scratch_, extent_;  ///< the samples' box and the ground (samples_box)
   std::array<float, 4> box_{};                   ///< the samples' box at the end of the last step
   /// Top of the dried paint under the brush's footprint at the end of the last step, cells: the

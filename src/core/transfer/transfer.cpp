@@ -382,6 +382,7 @@ void Transfer::particles_to_grid(ParticleStore& particles, const TransferEnv& en
   acc.counter = sum_field(&TransferSums::to_grid_count);
   acc.keep = env.keep;
   acc.only_leaving = env.only_leaving;
+  acc.surface = env.surface;
   if (np > 0) {
     d_to_grid_mark(device_, particles.view(), env.paint, db, acc, params_, env.dry_threshold);
     d_to_grid_apply(device_, env.paint, acc);

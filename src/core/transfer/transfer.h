@@ -40,6 +40,10 @@ struct TransferEnv {
   /// Eq. 16 for the particles outside `keep` only (the window is about to move off them); the
   /// others wait for the step's own pass, and no distance field is read.
   bool only_leaving = false;
+  /// Top of the paint per window column (canvas z; at or above the solid's; null: unknown). A
+  /// particle Eq. 16 returns above it lands on it: the grid has no gravity for paint in air
+  /// cells, so paint returned in flight would hang there (docs/TRANSFER.md "Returning in flight").
+  const float* surface = nullptr;
 };
 
 /// What one step's transfers moved, kg, each measured on both sides (source / destination),
@@ -118,6 +122,7 @@ struct DepositScratch {
   int32_t* counter;
   KeepBox keep;             ///< particles outside it are deposited regardless (TransferEnv::keep)
   bool only_leaving;        ///< TransferEnv::only_leaving
+  const float* surface;     ///< TransferEnv::surface
 };
 
 class Transfer {
