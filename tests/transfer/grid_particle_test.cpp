@@ -219,6 +219,54 @@ TEST_F(GridParticleTest, SlowFarParticlesReturnAndMixColour) {
     }
 }
 
+TEST_F(GridParticleTest, ParticlesReturnedInFlightLandOnThePaintBelow) {
+  // A wet layer 2 cells deep; particles high above it leave the keep box (the window is about to
+  // move off them). Given the paint's surface, they land on it; without it (a Transfer used on
+  // its own) they go to the grid where they are, as air-cell paint that nothing moves.
+  for (bool with_surface : {true, false}) {
+    PaintWindow w = make_window({16, 16, 16}, {0, 0, 0}, [](int, int, int k) { return k < 2 ? 1.f : 0.f; },
+                                Vec3(0.f, 1.f, 0.f), 0.2f, 0.f);
+    TransferParams prm;
+    prm.kernel_h = 0.5f;
+    const double cm = prm.cell_mass();
+    std::vector<Vec3> xs;
+    for (int i = 2; i < 6; ++i) xs.push_back(Vec3(float(i) + 0.5f, 8.5f, 12.5f));
+    ParticleStore p(device_);
+    p.append(particles_at(xs, float(0.5 * cm), Vec3(0.f, 0.f, 1.f), 0.8f, Vec3(0.f, 0.f, -300.f)));
+    HostSamples none;
+    none.resize(0, 0);
+    DeviceSamples s(device_);
+    s.upload(none);
+    Transfer t(device_, prm);
+    TransferEnv env = env_for(w, 10.f);
+    env.keep = KeepBox::of(Int3{8, 0, 0}, Int3{16, 16, 16});  // x < 8 is leaving
+    env.only_leaving = true;
+    DeviceBuffer<float> surface;
+    surface.set_device(device_);
+    surface.resize(16 * 16);
+    const std::vector<float> top(16 * 16, 2.f);
+    surface.copy_from_host(top.data(), top.size());
+    if (with_surface) env.surface = surface.data();
+    TransferRecord rec;
+    t.particles_to_grid(p, env);
+    t.collect(rec);
+    EXPECT_EQ(rec.to_grid_count, int64_t(xs.size()));
+    const WindowFields after = w.to_host();
+    double high = 0, landed = 0;
+    for (int k = 0; k < 16; ++k)
+      for (int i = 2; i < 6; ++i) {
+        const double added = after[0][(size_t(k) * 16 + 8) * 16 + i] - (k < 2 ? 1.0 : 0.0);
+        (k >= 4 ? high : landed) += added;
+      }
+    if (with_surface) {
+      EXPECT_NEAR(landed, 2.0, 1e-5) << "four half cells on the layer's top";
+      EXPECT_EQ(high, 0.0);
+    } else {
+      EXPECT_NEAR(high, 2.0, 1e-5) << "without the surface: where they were";
+    }
+  }
+}
+
 TEST_F(GridParticleTest, ParticlesNearTheBristlesStay) {
   PaintWindow w = make_window({32, 32, 8}, {0, 0, 0}, [](int, int, int) { return 0.f; }, Vec3());
   HostSamples h = vertical_brush(1, 8, 0.8f, 16.f, 16.f, 2.f, 1.f);

@@ -90,4 +90,13 @@ void particles_init_scratch(const Device& d, const ParticleView& p, int64_t firs
   WB_DISPATCH(d, particles_init_scratch(p, first, n));
 }
 
+void particles_ground_surface(const Device& d, const PaintWindowView& pw, const float* particle_density,
+                              float dry_threshold, float liquid_threshold, float floor_z, float* surface) {
+  WB_REQUIRE(pw.density && pw.dryness && surface, "particles_ground_surface: missing fields");
+  WB_REQUIRE(std::isfinite(dry_threshold) && dry_threshold > 0.f && std::isfinite(liquid_threshold) &&
+                 liquid_threshold > 0.f && std::isfinite(floor_z),
+             "particles_ground_surface: bad threshold or floor");
+  WB_DISPATCH(d, particles_ground_surface(pw, particle_density, dry_threshold, liquid_threshold, floor_z, surface));
+}
+
 }  // namespace wb

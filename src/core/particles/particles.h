@@ -52,6 +52,11 @@ void particles_compact_field(const Device& d, const uint32_t* src, uint32_t* dst
 void particles_solid_height(const Device& d, const PaintWindowView& pw, const float* particle_density,
                             float dry_threshold, float liquid_threshold, float floor_z, float* height,
                             float* wet_top = nullptr);
+/// The ground a particle in flight lands on, per window column (absolute canvas z): the solid's
+/// top (as `height` above), raised through the liquid cells (joint test) stacked on it up to the
+/// first that is not. Paint held up in the air above a gap is not ground.
+void particles_ground_surface(const Device& d, const PaintWindowView& pw, const float* particle_density,
+                              float dry_threshold, float liquid_threshold, float floor_z, float* surface);
 /// Scratch of particles [first, first + n): nearest = -1, d_B = 0, key = 0, dead = 0.
 void particles_init_scratch(const Device& d, const ParticleView& p, int64_t first, int64_t n);
 
@@ -68,6 +73,8 @@ void particles_init_scratch(const Device& d, const ParticleView& p, int64_t firs
   void particles_compact_field(const uint32_t* src, uint32_t* dst, const uint32_t* dead, const uint32_t* pos,       \
                                int64_t n);                                                                         \
   void particles_init_scratch(ParticleView p, int64_t first, int64_t n);                                         \
+  void particles_ground_surface(PaintWindowView pw, const float* particle_density, float dry_threshold,          \
+                                float liquid_threshold, float floor_z, float* surface);                          \
   void particles_solid_height(PaintWindowView pw, const float* particle_density, float dry_threshold,            \
                               float liquid_threshold, float floor_z, float* height, float* wet_top);
 

@@ -6,6 +6,9 @@
 
 namespace wb::WB_BACKEND_NS {
 
+WB_HD WB_INLINE int imin_p(int a, int b) { return a < b ? a : b; }
+WB_HD WB_INLINE int imax_p(int a, int b) { return a > b ? a : b; }
+
 void particles_adhesion_step(ParticleView p, SampleView s, SolidView solid, ParticleParams prm, float dt) {
   const int64_t n_samples = s.count();
   parallel_for(p.count, [=] WB_HD(int64_t k) {
@@ -95,6 +98,32 @@ void particles_solid_height(PaintWindowView pw, const float* particle_density, f
     }
     height[c] = top;
     if (wet_top) wet_top[c] = maxf(top, wet);
+  });
+}
+
+void particles_ground_surface(PaintWindowView pw, const float* particle_density, float dry_threshold,
+                              float liquid_threshold, float floor_z, float* surface) {
+  parallel_for(int64_t(pw.nx) * pw.ny, [=] WB_HD(int64_t c) {
+    const int64_t layer = int64_t(pw.nx) * pw.ny;
+    float top = floor_z;
+    int k0 = imin_p(imax_p(int(floorf(floor_z)) - pw.oz, 0), pw.nz);
+    for (int k = pw.nz - 1; k >= k0; --k) {
+      const int64_t id = int64_t(k) * layer + c;
+      if (pw.density[id] > 0.f && pw.dryness[id] >= dry_threshold) {  // the grid's solid test
+        top = maxf(top, float(pw.oz + k) + minf(pw.density[id], 1.f));
+        k0 = k + 1;
+        break;
+      }
+    }
+    // Up from the solid through liquid cells (the joint test) to the first that is not, counting
+    // its partial fill: paint held up in the air by the bristles, above a gap, is not ground.
+    for (int k = k0; k < pw.nz; ++k) {
+      const int64_t id = int64_t(k) * layer + c;
+      const float joint = pw.density[id] + (particle_density ? particle_density[id] : 0.f);
+      top = maxf(top, float(pw.oz + k) + minf(joint, 1.f));  // the first air cell: its partial fill
+      if (joint < liquid_threshold) break;
+    }
+    surface[c] = top;
   });
 }
 

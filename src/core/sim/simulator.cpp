@@ -55,7 +55,7 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
   cells(raster_mass_);
   cells(raster_density_);
   cells(overlay_mass_);
-  for (auto* b : {&solid_height_, &wet_top_}) {
+  for (auto* b : {&solid_height_, &wet_top_, &surface_}) {
     b->set_device(d);
     b->resize(size_t(g.nx) * size_t(g.ny));
   }
@@ -191,6 +191,19 @@ Int3 Simulator::place_window(const std::array<float, 4>& before, const std::arra
   return grid_->window().origin_for(Vec3(0.5f * (x0 + x1), 0.5f * (y0 + y1), 0.f), config_.params.grid.window_snap);
 }
 
+const float* Simulator::paint_surface() {
+  // The particles' raster of this step or the last, where the window has not moved since: near
+  // the bristles the paint is mostly particles (§5.2), and its grid part alone reads as air.
+  ActiveWindow& win = grid_->window();
+  const Int3 o = win.origin();
+  const bool raster = raster_step_ >= counters_.steps - 1 && o.x == raster_origin_.x && o.y == raster_origin_.y &&
+                      o.z == raster_origin_.z;
+  particles_ground_surface(device(), win.paint().view(), raster ? raster_density_.data() : nullptr,
+                           config_.params.grid.dry_threshold, config_.params.grid.liquid_threshold,
+                           config_.params.particles.floor_z, surface_.data());
+  return surface_.data();
+}
+
 TransferEnv Simulator::transfer_env() {
   ActiveWindow& win = grid_->window();
   TransferEnv env;
@@ -200,8 +213,7 @@ TransferEnv Simulator::transfer_env() {
   env.floor_z = config_.params.particles.floor_z;
   env.dry_threshold = config_.params.grid.dry_threshold;
   env.D0 = config_.particles ? effective_D0() : 0.f;
-  const Int3 o = win.origin();
-  if (o.x == wet_top_origin_.x && o.y == wet_top_origin_.y && o.z == wet_top_origin_.z) env.surface = wet_top_.data();
+  env.surface = paint_surface();
   // Particles live inside the window less a rim of kKeepRim cells (beyond the reach of Eq. 16's
   // kernel): one that enters the rim goes to the grid, and rim paint is never sampled into
   // particles, so nothing cycles between the two there (docs/TRANSFER.md).
@@ -373,7 +385,6 @@ void Simulator::particle_stage(float dt) {
               1.f / transfer_->params().cell_mass());
   particles_solid_height(device(), win.paint().view(), raster_density_.data(), config_.params.grid.dry_threshold,
                          config_.params.grid.liquid_threshold, prm.floor_z, solid_height_.data(), wet_top_.data());
-  wet_top_origin_ = win.origin();
   SolidView solid;
   solid.floor_z = prm.floor_z;
   solid.height = solid_height_.data();
@@ -411,6 +422,7 @@ void Simulator::joint_fields_stage() {
   const float cell_mass = transfer_->params().cell_mass();
   joint_scale(device(), raster_mass_.data(), raster_density_.data(), int64_t(raster_mass_.size()), 1.f / cell_mass);
   grid_->set_particle_density(raster_density_.data());
+  raster_step_ = counters_.steps, raster_origin_ = o;
   joint_blend_velocity(device(), grid_->view(), win.paint().view(), rv, cell_mass);
 }
 

@@ -112,6 +112,8 @@ class Simulator {
   std::array<std::pair<float*, int64_t>, kCheckedArrays> checked_arrays();
   void clamp_particles_to_canvas();
   TransferEnv transfer_env();
+  /// The ground per column of the window as it is now (TransferEnv::surface).
+  const float* paint_surface();
   /// D0 of §5.2 for this step, limited so that the particle zone fits in the window's kept box
   /// around the samples (transfer_env; set by place_window).
   float effective_D0() const { return zone_D0_; }
@@ -148,7 +150,9 @@ class Simulator {
   DeviceBuffer<StepSums> step_sums_;
   DeviceBuffer<float> solid_height_;  ///< dried-paint top per window column (particles' solid, Eq. 8)
   DeviceBuffer<float> wet_top_;       ///< wet-paint surface per window column (free particles land on it)
-  Int3 wet_top_origin_{0, 0, -1};     ///< window origin wet_top_ was made at (z -1: never)
+  DeviceBuffer<float> surface_;       ///< the ground per window column (paint_surface)
+  int64_t raster_step_ = -2;          ///< step (counters_.steps) raster_density_ was last made in
+  Int3 raster_origin_{};              ///< and the window origin it was made at
   DeviceBuffer<float> extent_scratch_, extent_;  ///< the samples' box and the ground (samples_box)
   std::array<float, 4> box_{};                   ///< the samples' box at the end of the last step
   /// Top of the dried paint under the brush's footprint at the end of the last step, cells: the

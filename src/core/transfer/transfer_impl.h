@@ -288,10 +288,11 @@ void transfer_to_grid_mark(ParticleView p, PaintWindowView pw, DistanceBlocks db
     // Leaving the window's next box: back to the grid now, or it would be outside every field.
     const bool leaving = !acc.keep.contains(q);
     if (!leaving && (acc.only_leaving || !(length2(p.v[k]) < slow2) || db.near(q, margin))) return;
-    // In flight above the paint (leaving the window, or thrown out of it): it lands first.
+    // In flight above the paint (leaving the window, or thrown out of it): it lands first, its
+    // centre half a cell over the surface (a particle is about a cell across).
     if (acc.surface) {
       const int i = imin_t(imax_t(int(q.x), 0), pw.nx - 1), j = imin_t(imax_t(int(q.y), 0), pw.ny - 1);
-      q.z = minf(q.z, maxf(acc.surface[int64_t(j) * pw.nx + i] - float(pw.oz), 0.f));
+      q.z = minf(q.z, maxf(acc.surface[int64_t(j) * pw.nx + i] - float(pw.oz), 0.f) + 0.5f);
     }
     const Vec3 ck(p.pigment_r[k], p.pigment_y[k], p.pigment_b[k]);
     const float bk = pigment_brightness(ck), oil = p.oil[k], dry = p.dryness[k];
