@@ -15,6 +15,7 @@
 
 #include "cli/commands.h"
 #include "core/exec/memory.h"
+#include "core/io/atomic_file.h"
 #include "core/io/document.h"
 #include "core/io/png.h"
 #include "core/io/stroke.h"
@@ -55,13 +56,6 @@ double median_of_differences(const std::vector<double>& a, const std::vector<dou
   if (d.empty()) return 0.0;
   std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
   return d[d.size() / 2];
-}
-
-void write_text_file(const std::string& path, const std::string& text) {
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  if (!f) WB_THROW("cannot write '" + path + "'");
-  f << text;
-  if (!f.flush()) WB_THROW("failed writing '" + path + "'");
 }
 
 /// Applies the command-line overrides of the stroke's brush and paint (MyPaint dumps carry neither).
@@ -154,7 +148,7 @@ void report_bench(const ReplayArgs& a, const Simulator& sim, const Stroke& strok
                        {"residual_max", res_max}}},
                      {"advection_substeps", {{"median", pct(solve.substeps, 0.5)}, {"max", pct(solve.substeps, 1.0)}}},
                      {"stages", stages}};
-    write_text_file(a.bench_json, j.dump(2) + "\n");
+    write_file_atomic(a.bench_json, j.dump(2) + "\n");
   }
 }
 
@@ -320,7 +314,7 @@ int run_replay(const ReplayArgs& a) {
     j["nonfinite_events"] = nonfinite;
     j["zone_cut_steps"] = sim.counters().zone_cut_steps;
     j["warnings"] = stroke.warnings;
-    write_text_file(a.stats, j.dump(2) + "\n");
+    write_file_atomic(a.stats, j.dump(2) + "\n");
   }
   if (sim.counters().zone_cut_steps > 0) {
     const Int3 w = sim.config().window;
@@ -452,7 +446,7 @@ int run_soak(const SoakArgs& s) {
       j["runs"].push_back({{"cycle", r.cycle}, {"stroke", s.strokes[r.stroke]}, {"steps", r.steps},
                            {"step_ms_median", r.step_ms}, {"drift", r.drift}, {"resident_bytes", r.rss},
                            {"backend_held_bytes", r.held}});
-    write_text_file(s.json, j.dump(2) + "\n");
+    write_file_atomic(s.json, j.dump(2) + "\n");
   }
   // The bounds of docs/PERFORMANCE.md "Soak": memory flat within 1 %, books closed, finite.
   const bool ok = (cycles < 2 || growth <= 0.01) && worst_drift <= 1e-4 && nonfinite == 0;

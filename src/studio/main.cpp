@@ -1,14 +1,18 @@
 // wetbrush studio: the desktop painting application (Qt 6 Widgets, OpenGL canvas view).
 #include <QApplication>
+#include <QBuffer>
 #include <QCommandLineParser>
 #include <QElapsedTimer>
-#include <QFile>
 #include <QSurfaceFormat>
 #include <QTimer>
 
 #include <cstdio>
 
+#include <nlohmann/json.hpp>
+
 #include "core/exec/device.h"
+#include "core/exec/error.h"
+#include "core/io/atomic_file.h"
 #include "studio/demo.h"
 #include "studio/main_window.h"
 
@@ -87,29 +91,26 @@ int main(int argc, char** argv) {
                   "preset %s\n",
                   secs, pen_s, (long long)frames, frames / secs, (long long)steps, steps / secs, sim_s / secs,
                   st.step_ms, (long long)st.particles, st.device.c_str(), opt.preset.name.c_str());
-      if (!stats.isEmpty()) {
-        QFile f(stats);
-        if (f.open(QIODevice::WriteOnly | QIODevice::Truncate)) {
-          const QString j =
-              QString("{\n  \"preset\": \"%1\",\n  \"device\": \"%2\",\n  \"wall_s\": %3,\n  \"pen_s\": %4,\n"
-                      "  \"view_frames\": %5,\n  \"view_fps\": %6,\n  \"steps\": %7,\n  \"steps_per_s\": %8,\n"
-                      "  \"simulated_s\": %9,\n  \"real_time_factor\": %10,\n  \"median_step_ms\": %11,\n"
-                      "  \"particles_end\": %12\n}\n")
-                  .arg(QString::fromStdString(opt.preset.name), QString::fromStdString(st.device))
-                  .arg(secs, 0, 'f', 2)
-                  .arg(pen_s, 0, 'f', 2)
-                  .arg(frames)
-                  .arg(frames / secs, 0, 'f', 2)
-                  .arg(steps)
-                  .arg(steps / secs, 0, 'f', 3)
-                  .arg(sim_s, 0, 'f', 3)
-                  .arg(sim_s / secs, 0, 'f', 4)
-                  .arg(st.step_ms, 0, 'f', 1)
-                  .arg(st.particles);
-          f.write(j.toUtf8());
+      try {
+        if (!stats.isEmpty()) {
+          const nlohmann::json j = {{"preset", opt.preset.name}, {"device", st.device},
+                                    {"wall_s", secs},         {"pen_s", pen_s},
+                                    {"view_frames", frames},  {"view_fps", frames / secs},
+                                    {"steps", steps},         {"steps_per_s", steps / secs},
+                                    {"simulated_s", sim_s},   {"real_time_factor", sim_s / secs},
+                                    {"median_step_ms", st.step_ms}, {"particles_end", st.particles}};
+          wb::write_file_atomic(stats.toStdString(), j.dump(2) + "\n");
         }
+        QByteArray png;
+        QBuffer buffer(&png);
+        buffer.open(QIODevice::WriteOnly);
+        w.grab().save(&buffer, "PNG");
+        wb::write_file_atomic(out.toStdString(), png.constData(), size_t(png.size()));
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "wetbrush-studio: %s\n", wb::user_message(e).c_str());
+        QApplication::exit(1);
+        return;
       }
-      w.grab().save(out);
       std::printf("wrote %s\n", qPrintable(out));
       w.undo_stack()->setClean();
       QApplication::quit();

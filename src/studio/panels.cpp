@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/color/ryb.h"
+#include "core/io/atomic_file.h"
 #include "core/exec/error.h"
 #include "core/io/brush_json.h"
 
@@ -107,10 +108,13 @@ BrushPanel::BrushPanel(QWidget* parent) : QWidget(parent) {
     const QString name = QInputDialog::getText(this, "Save brush preset", "Name:", QLineEdit::Normal, "", &ok);
     if (!ok || name.trimmed().isEmpty()) return;
     QDir().mkpath(preset_dir_);
-    QFile f(preset_dir_ + "/" + name.trimmed() + ".json");
-    if (!f.open(QIODevice::WriteOnly | QIODevice::Truncate)) return;
-    f.write(QByteArray::fromStdString(brush_to_json(brush()).dump(2) + "\n"));
-    f.close();
+    try {
+      write_file_atomic((preset_dir_ + "/" + name.trimmed() + ".json").toStdString(),
+                        brush_to_json(brush()).dump(2) + "\n");
+    } catch (const std::exception& e) {
+      QMessageBox::warning(this, "Save brush preset", QString::fromStdString(user_message(e)));
+      return;
+    }
     reload_presets();
   });
 }

@@ -11,6 +11,7 @@
 #include <random>
 
 #include "backend_fixture.h"
+#include "core/io/atomic_file.h"
 #include "core/io/document.h"
 #include "core/io/png.h"
 #include "core/render/test_volumes.h"
@@ -212,22 +213,22 @@ TEST_F(DocumentTest, WriteBadFixtures) {
   save_painting(good, c, merged, {});
   const std::vector<uint8_t> g = read_file(good);
   fs::remove(good);
-  write_file(bad + "empty.ora", {});
-  write_file(bad + "truncated.ora", std::vector<uint8_t>(g.begin(), g.begin() + long(g.size() * 6 / 10)));
+  write_file_atomic(bad + "empty.ora", std::vector<uint8_t>{});
+  write_file_atomic(bad + "truncated.ora", std::vector<uint8_t>(g.begin(), g.begin() + long(g.size() * 6 / 10)));
   const auto png = encode_png8(merged.rgba.data(), merged.width, merged.height, 4);
-  write_file(bad + "png_renamed.ora", png);
-  write_file(bad + "no_mimetype.ora", make_zip({{"stack.xml", bytes_of("<image/>")}, {"mergedimage.png", png}}));
-  write_file(bad + "wrong_mimetype.ora", make_zip({{"mimetype", bytes_of("application/zip")}, {"stack.xml", bytes_of("<image/>")}}));
-  write_file(bad + "foreign.ora", make_zip({{"mimetype", bytes_of("image/openraster")},
+  write_file_atomic(bad + "png_renamed.ora", png);
+  write_file_atomic(bad + "no_mimetype.ora", make_zip({{"stack.xml", bytes_of("<image/>")}, {"mergedimage.png", png}}));
+  write_file_atomic(bad + "wrong_mimetype.ora", make_zip({{"mimetype", bytes_of("application/zip")}, {"stack.xml", bytes_of("<image/>")}}));
+  write_file_atomic(bad + "foreign.ora", make_zip({{"mimetype", bytes_of("image/openraster")},
                                             {"stack.xml", bytes_of("<image w=\"32\" h=\"32\"><stack/></image>")},
                                             {"mergedimage.png", png}}));
   std::vector<uint8_t> v = encode_volume(c);
   std::vector<uint8_t> flipped = v;
   flipped[v.size() - 5] ^= 0x01;  // inside the last tile's compressed data
-  write_file(bad + "bad_checksum.ora", make_zip({{"mimetype", bytes_of("image/openraster")}, {"wetbrush/volume.bin", flipped}}));
+  write_file_atomic(bad + "bad_checksum.ora", make_zip({{"mimetype", bytes_of("image/openraster")}, {"wetbrush/volume.bin", flipped}}));
   std::vector<uint8_t> newer = v;
   newer[8] = 2;  // format version 2
-  write_file(bad + "newer_version.ora", make_zip({{"mimetype", bytes_of("image/openraster")}, {"wetbrush/volume.bin", newer}}));
+  write_file_atomic(bad + "newer_version.ora", make_zip({{"mimetype", bytes_of("image/openraster")}, {"wetbrush/volume.bin", newer}}));
 }
 
 }  // namespace wb::test

@@ -17,8 +17,10 @@
 #include <thread>
 
 #include "backend_fixture.h"
+#include "core/io/atomic_file.h"
 #include "core/io/document.h"
 #include "core/io/png.h"
+#include "core/io/stroke.h"
 #include "core/render/test_volumes.h"
 
 namespace wb::test {
@@ -249,6 +251,44 @@ TEST_F(SaveKillTest, ReadOnlyFolderGivesAClearErrorAndKeepsTheOldFile) {
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 0) << "1: saved into a read-only folder, 2: unclear message, 3: cannot drop root";
   EXPECT_EQ(read_file(path_), before);
+  EXPECT_TRUE(temporaries().empty());
+}
+
+// Every other file the project writes goes through the same atomic write: a stroke recording,
+// an exported PNG map, a JSON report. On a full disk each fails with a clear error and leaves
+// the old file whole.
+TEST_F(SaveKillTest, EveryWriterOnAFullDiskKeepsTheOldFile) {
+  Stroke big;
+  big.samples.resize(2000);
+  for (size_t i = 0; i < big.samples.size(); ++i) big.samples[i].x = float(i), big.samples[i].t = 0.01 * double(i);
+  std::vector<uint8_t> noise(256 * 256 * 3);
+  uint32_t h = 12345;
+  for (uint8_t& b : noise) b = uint8_t((h = h * 1664525u + 1013904223u) >> 24);  // incompressible
+  const std::string text(200 * 1024, 'x');
+  const std::vector<std::pair<std::string, std::function<void(const std::string&)>>> writers = {
+      {"recording.json", [&](const std::string& f) { save_stroke_json(big, f); }},
+      {"normal.png", [&](const std::string& f) { write_png8(f, noise.data(), 256, 256, 3); }},
+      {"stats.json", [&](const std::string& f) { write_file_atomic(f, text); }},
+  };
+  for (const auto& [name, write] : writers) {
+    const std::string f = (dir_ / name).string();
+    write_file_atomic(f, std::string("old"));
+    const int status = in_child([&, f = f, write = write] {
+      ::signal(SIGXFSZ, SIG_IGN);
+      rlimit lim{16 * 1024, 16 * 1024};
+      if (::setrlimit(RLIMIT_FSIZE, &lim) != 0) return 3;
+      try {
+        write(f);
+      } catch (const Error& e) {
+        return std::string(e.what()).find(f) != std::string::npos ? 0 : 2;
+      }
+      return 1;
+    });
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 0) << name << ": 1: written past the limit, 2: unclear message, 3: setrlimit";
+    const std::vector<uint8_t> now = read_file(f);
+    EXPECT_EQ(std::string(now.begin(), now.end()), "old") << name;
+  }
   EXPECT_TRUE(temporaries().empty());
 }
 

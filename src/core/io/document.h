@@ -68,8 +68,4 @@ std::vector<uint8_t> encode_volume(const TileStore& canvas);
 TileStore decode_volume(const uint8_t* bytes, size_t size, const Device& device, const std::string& what,
                         const LoadLimits& limits = {});
 
-/// Writes bytes to `path` atomically (temporary file, fsync, rename, directory fsync).
-void write_file_atomic(const std::string& path, const std::vector<uint8_t>& bytes,
-                       const std::function<void(const std::string&)>& fault_hook = {});
-
 }  // namespace wb

@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "core/exec/error.h"
+#include "core/io/atomic_file.h"
 
 namespace wb {
 
@@ -155,14 +156,6 @@ PngPixels decode_png(const uint8_t* bytes, size_t size, const std::string& what,
   return px;
 }
 
-void write_file(const std::string& path, const std::vector<uint8_t>& bytes) {
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  if (!f) WB_THROW(path + ": cannot open for writing");
-  f.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-  f.close();
-  if (!f) WB_THROW(path + ": write failed");
-}
-
 std::vector<uint8_t> read_file(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
   if (!f) WB_THROW(path + ": cannot open for reading");
@@ -172,11 +165,11 @@ std::vector<uint8_t> read_file(const std::string& path) {
 }
 
 void write_png8(const std::string& path, const uint8_t* pixels, int width, int height, int channels) {
-  write_file(path, encode_png8(pixels, width, height, channels));
+  write_file_atomic(path, encode_png8(pixels, width, height, channels));
 }
 void write_png_gray16(const std::string& path, const uint16_t* pixels, int width, int height,
                       const std::vector<std::pair<std::string, std::string>>& text) {
-  write_file(path, encode_png_gray16(pixels, width, height, text));
+  write_file_atomic(path, encode_png_gray16(pixels, width, height, text));
 }
 PngPixels read_png(const std::string& path) {
   const auto b = read_file(path);

@@ -34,8 +34,6 @@ void write_png_gray16(const std::string& path, const uint16_t* pixels, int width
                       const std::vector<std::pair<std::string, std::string>>& text = {});
 PngPixels read_png(const std::string& path);
 
-/// Writes bytes to a file (plain, not atomic); throws wb::Error naming the path on failure.
-void write_file(const std::string& path, const std::vector<uint8_t>& bytes);
 /// Reads a whole file; throws wb::Error naming the path on failure.
 std::vector<uint8_t> read_file(const std::string& path);
 

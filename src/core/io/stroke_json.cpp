@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/exec/error.h"
+#include "core/io/atomic_file.h"
 #include "core/io/brush_json.h"
 #include "core/io/pen_pose.h"
 #include "core/io/stroke.h"
@@ -431,40 +432,7 @@ std::string stroke_to_json_string(const Stroke& st) {
 }
 
 void save_stroke_json(const Stroke& stroke, const std::string& path) {
-  const std::string text = stroke_to_json_string(stroke);
-  const std::string tmp = path + ".tmp";
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) WB_THROW("cannot write '" + tmp + "': " + std::strerror(errno));
-  size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      const int err = errno;
-      ::close(fd);
-      ::unlink(tmp.c_str());
-      WB_THROW("cannot write '" + tmp + "': " + std::strerror(err));
-    }
-    done += size_t(n);
-  }
-  if (::fsync(fd) != 0 || ::close(fd) != 0) {
-    const int err = errno;
-    ::unlink(tmp.c_str());
-    WB_THROW("cannot flush '" + tmp + "': " + std::strerror(err));
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int err = errno;
-    ::unlink(tmp.c_str());
-    WB_THROW("cannot rename '" + tmp + "' to '" + path + "': " + std::strerror(err));
-  }
-  // Make the rename itself durable.
-  const size_t slash = path.rfind('/');
-  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
-  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd >= 0) {
-    ::fsync(dfd);
-    ::close(dfd);
-  }
+  write_file_atomic(path, stroke_to_json_string(stroke));
 }
 
 Stroke load_stroke(const std::string& path) {
