@@ -52,6 +52,24 @@ QDoubleSpinBox* spin(double lo, double hi, double step, int decimals, const QStr
   s->setKeyboardTracking(false);
   return s;
 }
+
+/// The tooltip of a brush field: what it does, its range and unit, its place in the paper.
+QString brush_tip(const BrushFieldRange& f) {
+  QString t = QString::fromUtf8(f.tooltip) + QString(" (%1 to %2").arg(f.min).arg(f.max);
+  if (*f.unit) t += " " + QString::fromUtf8(f.unit);
+  t += ")";
+  if (*f.paper) t += ", " + QString::fromUtf8(f.paper);
+  return t;
+}
+
+/// A spin box for a brush field, its range and tooltip from the brush table (brush_json.h);
+/// named by the field's key.
+QDoubleSpinBox* brush_spin(const char* key, double step, int decimals) {
+  const BrushFieldRange& f = brush_field(key);
+  QDoubleSpinBox* s = spin(f.min, f.max, step, decimals, brush_tip(f));
+  s->setObjectName(QString::fromUtf8(key));
+  return s;
+}
 }  // namespace
 
 BrushPanel::BrushPanel(QWidget* parent) : QWidget(parent) {
@@ -59,22 +77,21 @@ BrushPanel::BrushPanel(QWidget* parent) : QWidget(parent) {
   shape_ = new QComboBox;
   for (BrushShape s : kShapes) shape_->addItem(QString::fromUtf8(to_string(s)));
   shape_->setToolTip("Bristle bundle shape (default sizes per shape: docs/FORMATS.md)");
-  size_ = spin(4, 200, 2, 0, "Ferrule width across the handle, cells (1 cell = 0.2 mm)");
+  size_ = brush_spin("width", 2, 0);
+  const BrushFieldRange& nb = brush_field("bristles");
   bristles_ = new QSpinBox;
-  bristles_->setRange(40, 600);
-  bristles_->setToolTip("Number of bristles (40-600); more is slower");
+  bristles_->setObjectName("bristles");
+  bristles_->setRange(int(nb.min), int(nb.max));
+  bristles_->setToolTip(brush_tip(nb));
   bristles_->setKeyboardTracking(false);
-  stiffness_ = spin(0, 1, 0.05, 2, "Bending stiffness in [0, 1] (PBD bending constraint weight)");
-  length_ = spin(10, 300, 5, 0, "Bristle length, cells (100 = 2 cm)");
-  beta_ = spin(0, 0.1, 0.01, 3, "beta_B: inertial factor of Eq. 2 in the brush frame, 0..0.1");
+  stiffness_ = brush_spin("stiffness", 0.05, 2);
+  length_ = brush_spin("length", 5, 0);
+  beta_ = brush_spin("beta_B", 0.01, 3);
   presets_ = new QComboBox;
   auto* save = new QPushButton("Save preset...");
   form->addRow("Shape", shape_);
-  form->addRow("Size", size_);
-  form->addRow("Bristles", bristles_);
-  form->addRow("Stiffness", stiffness_);
-  form->addRow("Length", length_);
-  form->addRow("\u03b2_B", beta_);
+  for (QWidget* w : std::initializer_list<QWidget*>{size_, bristles_, stiffness_, length_, beta_})
+    form->addRow(QString::fromUtf8(brush_field(w->objectName().toStdString()).label), w);
   form->addRow("Preset", presets_);
   form->addRow(save);
 

@@ -6,6 +6,8 @@
 // keeps the old file and the painting open and unsaved. Each test function stands alone: CTest
 // runs each in a process of its own (cmake/StudioTests.cmake).
 #include <QApplication>
+#include <QDoubleSpinBox>
+#include <QSpinBox>
 #include <QDir>
 #include <QElapsedTimer>
 #include <QFile>
@@ -30,6 +32,7 @@
 #include <omp.h>
 #include <optional>
 
+#include "core/io/brush_json.h"
 #include "core/io/document.h"
 #include "core/io/stroke.h"
 #include "studio/demo.h"
@@ -278,6 +281,30 @@ class StudioTest : public QObject {
     QVERIFY(!img.isNull());
     QCOMPARE(w_->view()->canvas_size(), QSize(kW, kH));
     QCOMPARE(w_->sim()->status().device, std::string("cpu"));
+  }
+
+  void brushPanelRangesAreTheBrushTable() {
+    // Every number the brush panel edits is a brush field, with the range the brush files and
+    // their validation use (brush_field_ranges): a preset the reader accepts is never clamped.
+    const auto spins = w_->brush_panel()->findChildren<QAbstractSpinBox*>();
+    QVERIFY(spins.size() >= 5);
+    for (QAbstractSpinBox* s : spins) {
+      const std::string key = s->objectName().toStdString();
+      QVERIFY2(!key.empty(), "a brush panel field without a brush-table key");
+      const BrushFieldRange& f = brush_field(key);
+      double lo = 0, hi = 0;
+      if (auto* d = qobject_cast<QDoubleSpinBox*>(s)) lo = d->minimum(), hi = d->maximum();
+      else if (auto* i = qobject_cast<QSpinBox*>(s)) lo = i->minimum(), hi = i->maximum();
+      else QFAIL("unknown spin box");
+      QVERIFY2(lo == f.min && hi == f.max, key.c_str());
+    }
+    // beta_B: the file format allows up to 1 (Newtonian), and so does the panel.
+    const BrushSpec before = w_->brush_panel()->brush();
+    BrushSpec b = before;
+    b.beta_B = 0.5f;
+    w_->brush_panel()->set_brush(b);
+    QCOMPARE(w_->brush_panel()->brush().beta_B, 0.5f);
+    w_->brush_panel()->set_brush(before);
   }
 
   void tabletEventsCarryPressureTiltRotation() {

@@ -25,21 +25,36 @@ struct Field {
 
 const std::vector<Field>& fields() {
   static const std::vector<Field> table = {
-      {{"bristles", 40, 600, true}, &BrushSpec::bristles},
-      {{"vertices_per_bristle", 4, 32, true}, &BrushSpec::vertices_per_bristle},
-      {{"samples_per_bristle", 16, 256, true}, &BrushSpec::samples_per_bristle},
-      {{"length", 1, 1000, false}, &BrushSpec::length},
-      {{"width", 1, 1000, false}, &BrushSpec::width},
-      {{"thickness", 1, 1000, false}, &BrushSpec::thickness},
-      {{"length_variation", 0, 0.5, false}, &BrushSpec::length_variation},
-      {{"stiffness", 0, 1, false}, &BrushSpec::stiffness},
-      {{"stiffness_variation", 0, 0.9, false}, &BrushSpec::stiffness_variation},
-      {{"bristle_radius", 0.01, 5, false}, &BrushSpec::bristle_radius},
+      {{"bristles", 40, 600, true, "Bristles", "", "§4.1", "Number of bristles; more is slower"},
+       &BrushSpec::bristles},
+      {{"vertices_per_bristle", 4, 32, true, "Vertices per bristle", "", "§4.1",
+        "Simulated vertices along each bristle (the chain of Eq. 2)"},
+       &BrushSpec::vertices_per_bristle},
+      {{"samples_per_bristle", 16, 256, true, "Samples per bristle", "", "§4.1",
+        "Bristle samples that carry paint, along each bristle"},
+       &BrushSpec::samples_per_bristle},
+      {{"length", 1, 1000, false, "Length", "cells", "", "Bristle length (100 cells = 2 cm)"}, &BrushSpec::length},
+      {{"width", 1, 1000, false, "Size", "cells", "", "Ferrule width across the handle (1 cell = 0.2 mm)"},
+       &BrushSpec::width},
+      {{"thickness", 1, 1000, false, "Thickness", "cells", "", "Ferrule thickness (flat and angular brushes)"},
+       &BrushSpec::thickness},
+      {{"length_variation", 0, 0.5, false, "Length variation", "", "", "Spread of bristle lengths, fraction"},
+       &BrushSpec::length_variation},
+      {{"stiffness", 0, 1, false, "Stiffness", "", "§4.1", "Bending stiffness (PBD bending constraint weight)"},
+       &BrushSpec::stiffness},
+      {{"stiffness_variation", 0, 0.9, false, "Stiffness variation", "", "", "Spread of bristle stiffness, fraction"},
+       &BrushSpec::stiffness_variation},
+      {{"bristle_radius", 0.01, 5, false, "Bristle radius", "cells", "Eq. 12",
+        "Radius of one bristle (a clump of hairs when large): its paint capacity and boundary"},
+       &BrushSpec::bristle_radius},
       // Paper Table 1 uses [0, 0.1]; 1 is plain Newtonian dynamics (Eq. 2), still valid.
-      {{"beta_B", 0, 1, false}, &BrushSpec::beta_B},
+      {{"beta_B", 0, 1, false, "\u03b2_B", "", "Eq. 2",
+        "Inertial factor in the brush frame: 0 follows the handle rigidly, 1 is Newtonian (Table 1: 0-0.1)"},
+       &BrushSpec::beta_B},
       // 1 would put the ferrule on the canvas at full pressure.
-      {{"max_press", 0, 0.9, false}, &BrushSpec::max_press},
-      {{"seed", 0, 4294967295.0, true}, &BrushSpec::seed},
+      {{"max_press", 0, 0.9, false, "Press depth", "", "", "How far full pressure presses the brush, of its length"},
+       &BrushSpec::max_press},
+      {{"seed", 0, 4294967295.0, true, "Seed", "", "", "Random seed of the bristle layout"}, &BrushSpec::seed},
   };
   return table;
 }
@@ -86,6 +101,12 @@ const std::vector<BrushFieldRange>& brush_field_ranges() {
     return r;
   }();
   return ranges;
+}
+
+const BrushFieldRange& brush_field(const std::string& key) {
+  for (const BrushFieldRange& r : brush_field_ranges())
+    if (key == r.key) return r;
+  WB_THROW("no brush field '" + key + "'");
 }
 
 nlohmann::json brush_to_json(const BrushSpec& brush) {

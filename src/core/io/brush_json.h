@@ -23,13 +23,22 @@ BrushSpec brush_from_json(const nlohmann::json& j, const std::string& context,
 void validate_brush(const BrushSpec& brush, const std::string& context);
 
 /// One row per numeric BrushSpec field: JSON key, valid range (inclusive), integer or not.
+/// One brush field: its JSON key, range and what a person reads about it. The one range table of
+/// the brush: the JSON reader and writer, validate_brush and the studio's brush panel take their
+/// ranges from it (as the simulation parameters take theirs from param_table()).
 struct BrushFieldRange {
   const char* key;
   double min;
   double max;
   bool integer;
+  const char* label = "";    ///< short human name
+  const char* unit = "";     ///< "cells", "" for dimensionless
+  const char* paper = "";    ///< "Eq. 2", "§4.1", or "" when not from the paper
+  const char* tooltip = "";  ///< one sentence on what it does
 };
-/// The table behind brush_from_json / validate_brush (also used to write docs and UIs).
+/// The table behind brush_from_json / validate_brush and the brush panel.
 const std::vector<BrushFieldRange>& brush_field_ranges();
+/// The row of `key`; throws wb::Error when there is none.
+const BrushFieldRange& brush_field(const std::string& key);
 
 }  // namespace wb
