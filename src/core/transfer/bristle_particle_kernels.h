@@ -46,10 +46,9 @@ WB_HD WB_INLINE float surface_capacity(float M_prime, float R, float r, float ce
 WB_HD WB_INLINE float surface_distance(Vec3 x, float R, float floor_z, const CellField& density, float threshold,
                                        float step, const CellField& dryness = CellField{}, float dry_threshold = 0.f) {
   float r = x.z - floor_z;
-  // Density that counts as surface at p: all of it, or only where the paint has dried.
+  // Density that counts as surface at p: all of it, or only the dried paint's.
   const auto surface = [&](Vec3 p) {
-    const float d = cell_field_at(density, p);
-    return dryness.f == nullptr || cell_field_at(dryness, p) >= dry_threshold ? d : 0.f;
+    return dryness.f == nullptr ? cell_field_at(density, p) : dried_density_at(density, dryness, dry_threshold, p);
   };
   if (density.f != nullptr && r > 0.f) {
     float prev = surface(x);

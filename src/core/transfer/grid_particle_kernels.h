@@ -73,6 +73,17 @@ WB_HD WB_INLINE float wet_density_at(const CellField& density, const CellField& 
   });
 }
 
+/// The same for the dried (solid) paint only: wet cells count as empty. The dryness of each cell
+/// decides, not an interpolated dryness (air cells have none, and interpolating it across a
+/// dried top put that top half a cell too low).
+WB_HD WB_INLINE float dried_density_at(const CellField& density, const CellField& dryness, float dry_threshold, Vec3 p) {
+  if (density.f == nullptr) return 0.f;
+  return trilinear_cells(density, p, [&](int64_t id) {
+    const float rho = density.f[id];
+    return cell_is_solid(rho, dryness.f[id], dry_threshold) ? rho : 0.f;
+  });
+}
+
 /// Trilinear density of the liquid (non-solid) paint at window position q, constant
 /// extension at the window's edges; solid cells count as empty. Used to keep candidates.
 WB_HD WB_INLINE float liquid_density_at(const PaintWindowView& pw, Vec3 q, float dry_threshold) {

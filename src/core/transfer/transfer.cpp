@@ -68,9 +68,9 @@ void d_emit_count(const Device& d, SampleView s, BristleLoadView l, TransferPara
 void d_emit_fill(const Device& d, SampleView s, BristleLoadView l, ParticleView p, const uint32_t* offset,
                  const uint32_t* count, const float* mass_each, const float* swept_each, const uint32_t* swept_n,
                  int64_t first, int64_t room, int64_t step_index, TransferParams prm, float floor_z, float dt,
-                 PaintWindowView pw, float* emitted) {
+                 PaintWindowView pw, float dry_threshold, float* emitted) {
   WB_DISPATCH(d, transfer_emit_fill(s, l, p, offset, count, mass_each, swept_each, swept_n, first, room, step_index,
-                                    prm, floor_z, dt, pw, emitted));
+                                    prm, floor_z, dt, pw, dry_threshold, emitted));
 }
 void d_grid_count(const Device& d, PaintWindowView pw, DistanceBlocks db, KeepBox keep, TransferParams prm, float dry,
                   uint32_t* count) {
@@ -421,7 +421,7 @@ void Transfer::emit(const SampleView& samples, BristleLoad& load, ParticleStore&
   if (n_new == 0) return;
   const ParticleView pv = particles.view();
   d_emit_fill(device_, samples, lv, pv, offset, count, mass_each, swept_each, swept_n, first, n_new, step_index_,
-              params_, env.floor_z, env.dt, env.paint, emitted);
+              params_, env.floor_z, env.dt, env.paint, env.dry_threshold, emitted);
   rec.emitted_count = n_new;
   reduce_sum_add_into(device_, emitted, ns, sum_field(&TransferSums::emitted_from_bristles), ws_);
   reduce_sum_add_into(device_, pv.m + first, n_new, sum_field(&TransferSums::emitted_into_particles), ws_);

@@ -246,7 +246,8 @@ void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadVi
   void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, const uint32_t* offset,               \
                           const uint32_t* count, const float* mass_each, const float* swept_each,                  \
                           const uint32_t* swept_n, int64_t first, int64_t room, int64_t step_index,                \
-                          TransferParams prm, float floor_z, float dt, PaintWindowView pw, float* emitted);        \
+                          TransferParams prm, float floor_z, float dt, PaintWindowView pw, float dry_threshold,    \
+                          float* emitted);                                                                         \
   void transfer_grid_count(PaintWindowView pw, DistanceBlocks db, KeepBox keep, TransferParams prm,                \
                            float dry_threshold, uint32_t* count);                                                                        \
   void transfer_grid_emit(PaintWindowView pw, MacView vel, ParticleView p, const uint32_t* count,                   \

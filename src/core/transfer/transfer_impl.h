@@ -362,8 +362,11 @@ void transfer_emit_count(SampleView s, BristleLoadView load, TransferParams prm,
 void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, const uint32_t* offset,
                         const uint32_t* count, const float* mass_each, const float* swept_each,
                         const uint32_t* swept_n, int64_t first, int64_t room, int64_t step_index, TransferParams prm,
-                        float floor_z, float dt, PaintWindowView pw, float* emitted) {
+                        float floor_z, float dt, PaintWindowView pw, float dry_threshold, float* emitted) {
   const int P = prm.emit_pattern;
+  const CellField density{pw.density, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
+  const CellField dryness{pw.dryness, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
+  const float thr = prm.surface_density, march = prm.march_step;
   const Vec3 lo(float(pw.ox), float(pw.oy), 0.f), hi(float(pw.ox + pw.nx), float(pw.oy + pw.ny), 0.f);
   const float cm = prm.cell_mass();
   parallel_for(load.count, [=] WB_HD(int64_t j) {
@@ -392,8 +395,23 @@ void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, cons
         // Left on the surface along the path slid this step, at rest with it.
         const int q = i - n_static;
         const int64_t slot = (j + step_index * int64_t(n_swept) + int64_t(q)) % int64_t(P);
-        p.x[k] = swept_position(xj, vt, dt, a, r, q, n_swept, sample_step_jitter(j, step_index),
-                                emission_pattern_point(int(slot), P), floor_z, lo, hi);
+        const float jitter = sample_step_jitter(j, step_index);
+        const Vec3 pattern = emission_pattern_point(int(slot), P);
+        // Laid where the path touches the surface: a point over a hollow the bristle bridged
+        // (its surface more than half a cell lower than at the contact) moves to the next point
+        // of the path that touches, else to the end of the path, where the contact is.
+        Vec3 at = swept_position(xj, vt, dt, a, r, q, n_swept, jitter, pattern, floor_z, lo, hi);
+        for (int t = 0; t < n_swept; ++t) {
+          const Vec3 cand = swept_position(xj, vt, dt, a, r, (q + t) % n_swept, n_swept, jitter, pattern, floor_z, lo, hi);
+          const float reach = r + 0.5f;
+          if (surface_distance(Vec3(cand.x, cand.y, xj.z), reach + march, floor_z, density, thr, march, dryness,
+                               dry_threshold) <= reach) {
+            at = cand;
+            break;
+          }
+          if (t + 1 == n_swept) at = swept_position(xj, vt, dt, a, r, n_swept, n_swept, 0.f, pattern, floor_z, lo, hi);
+        }
+        p.x[k] = at;
         p.v[k] = Vec3();
         p.m[k] = swept_each[j];
       }
