@@ -6,9 +6,6 @@
 
 namespace wb::WB_BACKEND_NS {
 
-WB_HD WB_INLINE int imin_p(int a, int b) { return a < b ? a : b; }
-WB_HD WB_INLINE int imax_p(int a, int b) { return a > b ? a : b; }
-
 void particles_adhesion_step(ParticleView p, SampleView s, SolidView solid, ParticleParams prm, float dt) {
   const int64_t n_samples = s.count();
   parallel_for(p.count, [=] WB_HD(int64_t k) {
@@ -79,25 +76,43 @@ void particles_init_scratch(ParticleView p, int64_t first, int64_t n) {
   });
 }
 
+/// Top of the dried paint in window column c (absolute canvas z), or floor_z where none: the
+/// highest cell the grid counts as solid (cell_is_solid), a partly filled one holding its paint at
+/// the bottom (the surface is rho up). `above` receives the first layer over it (0 where none).
+WB_HD WB_INLINE float column_solid_top(const PaintWindowView& pw, int64_t c, float dry_threshold, float floor_z,
+                                       int& above) {
+  const int64_t layer = int64_t(pw.nx) * pw.ny;
+  above = 0;
+  for (int k = pw.nz - 1; k >= 0; --k) {
+    const int64_t id = int64_t(k) * layer + c;
+    const float rho = pw.density[id];
+    if (rho > 0.f && pw.dryness[id] >= dry_threshold) {
+      above = k + 1;
+      return maxf(floor_z, float(pw.oz + k) + minf(rho, 1.f));
+    }
+  }
+  return floor_z;
+}
+
 void particles_solid_height(PaintWindowView pw, const float* particle_density, float dry_threshold,
                             float liquid_threshold, float floor_z, float* height, float* wet_top) {
   parallel_for(int64_t(pw.nx) * pw.ny, [=] WB_HD(int64_t c) {
     const int64_t layer = int64_t(pw.nx) * pw.ny;
-    float top = floor_z, wet = -1e30f;
-    for (int k = pw.nz - 1; k >= 0; --k) {
+    int above = 0;
+    const float top = column_solid_top(pw, c, dry_threshold, floor_z, above);
+    height[c] = top;
+    if (!wet_top) return;
+    // The highest liquid cell over it (the grid's joint liquid test) is the wet paint's free surface.
+    float wet = top;
+    for (int k = pw.nz - 1; k >= above; --k) {
       const int64_t id = int64_t(k) * layer + c;
-      const float rho = pw.density[id];
-      if (rho > 0.f && pw.dryness[id] >= dry_threshold) {  // the grid's solid test (cell_is_solid)
-        // A partly filled top cell holds its paint at the bottom: the surface is rho up.
-        top = maxf(top, float(pw.oz + k) + minf(rho, 1.f));
+      const float joint = pw.density[id] + (particle_density ? particle_density[id] : 0.f);
+      if (joint >= liquid_threshold) {
+        wet = maxf(top, float(pw.oz + k) + minf(joint, 1.f));
         break;
       }
-      // The highest liquid cell (the grid's joint liquid test) is the wet paint's free surface.
-      const float joint = rho + (particle_density ? particle_density[id] : 0.f);
-      if (wet < -1e29f && joint >= liquid_threshold) wet = float(pw.oz + k) + minf(joint, 1.f);
     }
-    height[c] = top;
-    if (wet_top) wet_top[c] = maxf(top, wet);
+    wet_top[c] = wet;
   });
 }
 
@@ -105,22 +120,14 @@ void particles_ground_surface(PaintWindowView pw, const float* particle_density,
                               float liquid_threshold, float floor_z, float* surface) {
   parallel_for(int64_t(pw.nx) * pw.ny, [=] WB_HD(int64_t c) {
     const int64_t layer = int64_t(pw.nx) * pw.ny;
-    float top = floor_z;
-    int k0 = imin_p(imax_p(int(floorf(floor_z)) - pw.oz, 0), pw.nz);
-    for (int k = pw.nz - 1; k >= k0; --k) {
-      const int64_t id = int64_t(k) * layer + c;
-      if (pw.density[id] > 0.f && pw.dryness[id] >= dry_threshold) {  // the grid's solid test
-        top = maxf(top, float(pw.oz + k) + minf(pw.density[id], 1.f));
-        k0 = k + 1;
-        break;
-      }
-    }
+    int above = 0;
+    float top = column_solid_top(pw, c, dry_threshold, floor_z, above);
     // Up from the solid through liquid cells (the joint test) to the first that is not, counting
     // its partial fill: paint held up in the air by the bristles, above a gap, is not ground.
-    for (int k = k0; k < pw.nz; ++k) {
+    for (int k = above; k < pw.nz; ++k) {
       const int64_t id = int64_t(k) * layer + c;
       const float joint = pw.density[id] + (particle_density ? particle_density[id] : 0.f);
-      top = maxf(top, float(pw.oz + k) + minf(joint, 1.f));  // the first air cell: its partial fill
+      top = maxf(top, float(pw.oz + k) + minf(joint, 1.f));
       if (joint < liquid_threshold) break;
     }
     surface[c] = top;

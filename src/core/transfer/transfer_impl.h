@@ -291,7 +291,7 @@ void transfer_to_grid_mark(ParticleView p, PaintWindowView pw, DistanceBlocks db
     // In flight above the paint (leaving the window, or thrown out of it): it lands first, its
     // centre half a cell over the surface (a particle is about a cell across).
     if (acc.surface) {
-      const int i = imin_t(imax_t(int(q.x), 0), pw.nx - 1), j = imin_t(imax_t(int(q.y), 0), pw.ny - 1);
+      const int i = clampi(int(q.x), 0, pw.nx - 1), j = clampi(int(q.y), 0, pw.ny - 1);
       q.z = minf(q.z, maxf(acc.surface[int64_t(j) * pw.nx + i] - float(pw.oz), 0.f) + 0.5f);
     }
     const Vec3 ck(p.pigment_r[k], p.pigment_y[k], p.pigment_b[k]);
@@ -400,16 +400,15 @@ void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, cons
         // Laid where the path touches the surface: a point over a hollow the bristle bridged
         // (its surface more than half a cell lower than at the contact) moves to the next point
         // of the path that touches, else to the end of the path, where the contact is.
-        Vec3 at = swept_position(xj, vt, dt, a, r, q, n_swept, jitter, pattern, floor_z, lo, hi);
+        const float reach = r + 0.5f;
+        Vec3 at = swept_position(xj, vt, dt, a, r, n_swept, n_swept, 0.f, pattern, floor_z, lo, hi);  // the end
         for (int t = 0; t < n_swept; ++t) {
           const Vec3 cand = swept_position(xj, vt, dt, a, r, (q + t) % n_swept, n_swept, jitter, pattern, floor_z, lo, hi);
-          const float reach = r + 0.5f;
           if (surface_distance(Vec3(cand.x, cand.y, xj.z), reach + march, floor_z, density, thr, march, dryness,
                                dry_threshold) <= reach) {
             at = cand;
             break;
           }
-          if (t + 1 == n_swept) at = swept_position(xj, vt, dt, a, r, n_swept, n_swept, 0.f, pattern, floor_z, lo, hi);
         }
         p.x[k] = at;
         p.v[k] = Vec3();
