@@ -207,7 +207,9 @@ void CanvasView::tabletEvent(QTabletEvent* e) {
                                float(e->rotation()));
   switch (e->type()) {
     case QEvent::TabletPress:
-      if (e->button() == Qt::LeftButton && !pen_down_) {
+      if (e->button() == Qt::LeftButton && !pen_down_ && (e->modifiers() & Qt::AltModifier)) {
+        Q_EMIT pickColor(to_canvas(e->position()));
+      } else if (e->button() == Qt::LeftButton && !pen_down_) {
         pen_down_ = tablet_down_ = true;
         last_input_ = in;
         Q_EMIT penPress(in, now());
@@ -240,6 +242,8 @@ void CanvasView::mousePressEvent(QMouseEvent* e) {
   if (e->button() == Qt::MiddleButton || (e->button() == Qt::LeftButton && (e->modifiers() & Qt::ShiftModifier))) {
     panning_ = true;
     pan_anchor_ = e->position();
+  } else if (e->button() == Qt::LeftButton && !pen_down_ && (e->modifiers() & Qt::AltModifier)) {
+    Q_EMIT pickColor(to_canvas(e->position()));
   } else if (e->button() == Qt::LeftButton && !pen_down_) {
     pen_down_ = true;
     const PenInput in = input_at(e->position(), mouse_pressure_, 0.f, 0.f, 0.f);

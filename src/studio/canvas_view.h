@@ -51,6 +51,8 @@ class CanvasView : public QOpenGLWidget, protected QOpenGLFunctions {
   void penPress(wb::studio::PenInput p, double now);
   void penMove(wb::studio::PenInput p, double now);
   void penRelease(wb::studio::PenInput p, double now);
+  /// Alt + click (mouse or pen): the eyedropper at this canvas point, cells.
+  void pickColor(QPointF canvas);
   void viewChanged();
 
  protected:

@@ -78,7 +78,8 @@ int main(int argc, char** argv) {
       QElapsedTimer timer;
       timer.start();
       const int64_t frames0 = w.view()->frames_drawn();
-      const int64_t steps0 = w.sim()->status().steps;
+      const SimStatus st0 = w.sim()->status();
+      const int64_t steps0 = st0.steps;
       const double pen_s = run_demo_painting(w);
       w.settle();
       QApplication::processEvents();
@@ -91,6 +92,11 @@ int main(int argc, char** argv) {
                   "preset %s\n",
                   secs, pen_s, (long long)frames, frames / secs, (long long)steps, steps / secs, sim_s / secs,
                   st.step_ms, (long long)st.particles, st.device.c_str(), opt.preset.name.c_str());
+      std::printf("demo: simulation thread, s: step %.1f, render %.1f, undo %.1f, player %.1f, commands %.1f, "
+                  "idle %.1f\n",
+                  st.times.step - st0.times.step, st.times.render - st0.times.render, st.times.undo - st0.times.undo,
+                  st.times.player - st0.times.player, st.times.commands - st0.times.commands,
+                  st.times.idle - st0.times.idle);
       try {
         if (!stats.isEmpty()) {
           const nlohmann::json j = {{"preset", opt.preset.name}, {"device", st.device},
@@ -98,7 +104,13 @@ int main(int argc, char** argv) {
                                     {"view_frames", frames},  {"view_fps", frames / secs},
                                     {"steps", steps},         {"steps_per_s", steps / secs},
                                     {"simulated_s", sim_s},   {"real_time_factor", sim_s / secs},
-                                    {"median_step_ms", st.step_ms}, {"particles_end", st.particles}};
+                                    {"median_step_ms", st.step_ms}, {"particles_end", st.particles},
+                                    {"worker_s", {{"commands", st.times.commands - st0.times.commands},
+                                                  {"player", st.times.player - st0.times.player},
+                                                  {"undo", st.times.undo - st0.times.undo},
+                                                  {"step", st.times.step - st0.times.step},
+                                                  {"render", st.times.render - st0.times.render},
+                                                  {"idle", st.times.idle - st0.times.idle}}}};
           wb::write_file_atomic(stats.toStdString(), j.dump(2) + "\n");
         }
         QByteArray png;

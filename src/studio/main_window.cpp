@@ -132,6 +132,7 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   // Pen input -> session clock -> simulation thread.
   connect(view_, &CanvasView::penPress, this, [this](PenInput p, double t) { push_clock(clock_.press(p, t)); });
   connect(view_, &CanvasView::penMove, this, [this](PenInput p, double t) { push_clock(clock_.move(p, t)); });
+  connect(view_, &CanvasView::pickColor, this, [this](QPointF c) { pick_color(c); });
   connect(view_, &CanvasView::penRelease, this, [this](PenInput p, double t) {
     push_clock(clock_.release(p, t));
     for (const StrokeEvent& e : pending_events_) push_clock(clock_.event(e));
@@ -376,6 +377,40 @@ void MainWindow::dry_canvas() {
   undo_->clear();
   dirty_ = true;
   update_title();
+}
+
+std::optional<std::array<float, 3>> MainWindow::pick_color(QPointF canvas) {
+  // The pigment the renderer blends for the top view there, read between two steps (one image
+  // tile rendered): what the artist sees, a glaze with the paper it lets through.
+  const int x = int(std::floor(canvas.x())), y = int(std::floor(canvas.y()));
+  auto done = std::make_shared<std::promise<std::optional<Vec3>>>();
+  std::future<std::optional<Vec3>> result = done->get_future();
+  sim_->post([done, x, y](SimThread& s) {
+    try {
+      done->set_value(s.renderer().pigment_at(s.sim().canvas(), x, y, s.sim().live_window()));
+    } catch (...) {
+      done->set_exception(std::current_exception());
+    }
+  });
+  std::optional<Vec3> ryb;
+  try {
+    ryb = result.get();
+  } catch (const std::exception& e) {
+    statusBar()->showMessage(QString("Eyedropper: %1").arg(QString::fromStdString(user_message(e))), 5000);
+    return std::nullopt;
+  }
+  if (!ryb) {
+    statusBar()->showMessage("Eyedropper: no paint there", 3000);
+    return std::nullopt;
+  }
+  const std::array<float, 3> c{ryb->x, ryb->y, ryb->z};
+  paint_panel_->set_well_ryb(paint_panel_->current_well(), c);
+  statusBar()->showMessage(QString("Eyedropper: well %1 takes the paint at (%2, %3)")
+                               .arg(paint_panel_->current_well() + 1)
+                               .arg(x)
+                               .arg(y),
+                           3000);
+  return c;
 }
 
 void MainWindow::new_canvas(int width, int height, QColor paper) {

@@ -59,6 +59,9 @@ class MainWindow : public QMainWindow {
   void wipe(float fraction);
   void clean_brush();
   void dry_canvas();
+  /// The eyedropper: puts the pigment of the paint shown at this canvas point (cells) into the
+  /// selected well. Returns it, or nothing over bare canvas (the well is left as it was).
+  std::optional<std::array<float, 3>> pick_color(QPointF canvas);
   /// Blocks until the simulation has consumed every input so far and the last stroke's undo
   /// record has arrived (tests).
   void settle();

@@ -254,8 +254,10 @@ void PaintPanel::select(int i) {
 
 QColor PaintPanel::well_color(int i) const { return ryb_to_qcolor(ryb_[size_t(i)]); }
 
-void PaintPanel::set_well_color(int i, const QColor& c) {
-  ryb_[size_t(i)] = qcolor_to_ryb(c);
+void PaintPanel::set_well_color(int i, const QColor& c) { set_well_ryb(i, qcolor_to_ryb(c)); }
+
+void PaintPanel::set_well_ryb(int i, const std::array<float, 3>& ryb) {
+  ryb_[size_t(i)] = ryb;
   const QColor shown = ryb_to_qcolor(ryb_[size_t(i)]);
   wells_[size_t(i)]->setStyleSheet(QString("QToolButton { background: %1; border: 2px solid #444; border-radius: 17px; }"
                                            "QToolButton:checked { border: 3px solid #fff; }")

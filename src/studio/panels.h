@@ -57,6 +57,9 @@ class PaintPanel : public QWidget {
   PaintLoad current_paint() const;
   int current_well() const { return current_; }
   void set_well_color(int i, const QColor& c);
+  /// Puts this pigment (RYB) in well i as it is (the eyedropper: no trip through RGB).
+  void set_well_ryb(int i, const std::array<float, 3>& ryb);
+  const std::array<float, 3>& well_ryb(int i) const { return ryb_[size_t(i)]; }
   QColor well_color(int i) const;
   int well_count() const { return int(wells_.size()); }
   /// Shows the brush's paint: mixed colour (RYB) and load in [0, 1].

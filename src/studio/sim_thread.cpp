@@ -17,6 +17,13 @@ double wall_now() {
   return duration<double>(steady_clock::now().time_since_epoch()).count();
 }
 
+/// Adds the time since `since` to `bucket`; returns now.
+double lap(double& bucket, double since) {
+  const double now = wall_now();
+  bucket += now - since;
+  return now;
+}
+
 /// Cells around the pen that one step may change: the active window, centred near the brush's
 /// footprint (the bristles' reach) and snapped to the grid's window snap.
 int step_reach(const SimConfig& c) {
@@ -330,11 +337,15 @@ void SimThread::run_step(const PlayerStep& step) {
   // Every step belongs to the undo record of the stroke it leads to: the steps between two
   // strokes (the lifted brush moving on, paint in flight landing) change tiles too.
   stroke_open_ = true;
+  double t = wall_now();
   undo_rec_.capture_rect(sim.canvas(), x0, y0, x1, y1);
+  t = lap(times_.undo, t);
   poses_.clear();
   for (int k = 1; k <= step.substeps; ++k) poses_.push_back(player_->pose_at(StrokePlayer::substep_time(step, k)));
+  t = lap(times_.player, t);
   const Int3 o0 = sim.live_window()->origin();
   sim.step(poses_.data(), step.substeps, float(step.dt));
+  lap(times_.step, t);
   // Paint changes only inside the active window (where it was and where it moved to).
   const Int3 o = sim.live_window()->origin(), n = sim.live_window()->dims();
   invalidate_rect(std::min(o.x, o0.x), std::min(o.y, o0.y), std::max(o.x, o0.x) + n.x, std::max(o.y, o0.y) + n.y);
@@ -429,6 +440,7 @@ void SimThread::publish_status(bool force) {
     status_.particles = particle_count(*sim_);
   }
   status_.steps = steps_;
+  status_.times = times_;
   status_.brush_ryb = {brush_color_.x, brush_color_.y, brush_color_.z};
   status_.brush_amount = brush_amount_;
   status_.lag_s = rec_.samples.empty() ? 0.0 : std::max(0.0, rec_.samples.back().t - t_done_);
@@ -439,6 +451,7 @@ void SimThread::run() {
   for (;;) {
     std::deque<std::function<void(SimThread&)>> cmds;
     bool more = false;
+    double t = wall_now();
     {
       std::unique_lock lk(in_mu_);
       more = busy_;
@@ -447,6 +460,7 @@ void SimThread::run() {
       cmds.swap(in_cmds_);
       busy_ = true;
     }
+    t = lap(times_.idle, t);
     for (auto& fn : cmds) {
       try {
         fn(*this);
@@ -454,12 +468,14 @@ void SimThread::run() {
         Q_EMIT failed(QString::fromStdString(user_message(e)));
       }
     }
+    t = lap(times_.commands, t);
     // A few steps, then look at the inputs again: commands (undo, save) never wait long.
     const double t_start = wall_now();
     if (busy_since == 0.0) busy_since = t_start, rate_t0_ = t_start;
     int n = 0;
     try {
       PlayerStep step;
+      double tp = t_start;
       while (n < 64 && wall_now() - t_start < 0.05 && step_available()) {
         bool found = false;
         while (player_->next(step)) {
@@ -468,10 +484,13 @@ void SimThread::run() {
             break;
           }
         }
+        lap(times_.player, tp);
         if (!found) break;
         run_step(step);
+        tp = wall_now();
         ++n;
       }
+      lap(times_.player, tp);
     } catch (const std::exception& e) {
       failed_ = true;
       {
@@ -480,7 +499,9 @@ void SimThread::run() {
       }
       Q_EMIT failed(QString::fromStdString(user_message(e)));
     }
+    t = wall_now();
     const bool pending = !failed_ && step_available();
+    t = lap(times_.player, t);
     if (!pending) {
       // Idle: the session time line is simulated up to its last sample; close the stroke.
       if (!prev_contact_) {
@@ -490,10 +511,12 @@ void SimThread::run() {
           Q_EMIT failed(QString::fromStdString(user_message(e)));
         }
       }
+      t = lap(times_.undo, t);
       render(true);
     } else {
       render(false);
     }
+    lap(times_.render, t);
     {
       std::lock_guard lk(status_mu_);
       status_.idle = !pending;

@@ -47,6 +47,16 @@ struct QualityPreset {
   static QualityPreset for_device(const Device& d) { return d.is_cuda() ? gpu() : cpu(); }
 };
 
+/// Where the simulation thread's wall time went since it started, seconds (docs/perf/studio.md).
+struct WorkerTimes {
+  double commands = 0.0;  ///< posted commands: brush changes, undo, snapshots for saves
+  double player = 0.0;    ///< session time line: stroke player rebuilds and step lookup
+  double undo = 0.0;      ///< tiles captured before each step and the settled record after a stroke
+  double step = 0.0;      ///< Simulator::step
+  double render = 0.0;    ///< incremental re-render of the canvas image and its copy to the view
+  double idle = 0.0;      ///< waiting for input
+};
+
 /// What the status bar shows; updated by the worker about twice a second.
 struct SimStatus {
   double steps_per_s = 0.0;     ///< simulation steps per wall second (last ~0.5 s of activity)
@@ -59,6 +69,7 @@ struct SimStatus {
   std::array<float, 3> brush_ryb{};  ///< mean colour of the paint on the brush (RYB)
   float brush_amount = 0.f;          ///< how full the brush is, 0..1
   std::string error;            ///< first error; stepping stops, the document is kept
+  WorkerTimes times;
 };
 
 class SimThread : public QObject {
@@ -171,6 +182,7 @@ class SimThread : public QObject {
   double rate_t0_ = 0.0;
   double last_status_ = 0.0;
   bool failed_ = false;
+  WorkerTimes times_;  ///< worker only; copied into status_ with it
 
   std::thread thread_;
 };

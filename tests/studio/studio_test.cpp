@@ -18,6 +18,7 @@
 #include <QTemporaryDir>
 #include <QTest>
 #include <QTimer>
+#include <QToolButton>
 
 #include <signal.h>
 #include <sys/resource.h>
@@ -32,6 +33,7 @@
 #include <omp.h>
 #include <optional>
 
+#include "core/color/ryb.h"
 #include "core/io/brush_json.h"
 #include "core/io/document.h"
 #include "core/io/stroke.h"
@@ -199,6 +201,8 @@ class StudioTest : public QObject {
     const PaintCensus c = on_sim(*w_, [](SimThread& s) { return s.sim().census(); });
     qInfo("stroke: %lld ms wall, %lld steps so far, %.1f ms/step, %lld particles; paint kg: grid %.4g, particles %.4g, bristles %.4g", (long long)t.elapsed(),
           (long long)st.steps, st.step_ms, (long long)st.particles, c.grid, c.particles, c.bristles);
+    qInfo("simulation thread so far, s: step %.1f, render %.1f, undo %.1f, player %.1f, commands %.1f, idle %.1f",
+          st.times.step, st.times.render, st.times.undo, st.times.player, st.times.commands, st.times.idle);
   }
 
   /// Paints a stroke on a new canvas and saves it to `path` (the old file of a failed save).
@@ -389,6 +393,50 @@ class StudioTest : public QObject {
     qInfo("widest painted column: light press (0.15) %d cells, heavy press (0.95) %d cells", light, heavy);
     QVERIFY2(light > 0, "a light press paints");
     QVERIFY2(heavy >= light + 3, "a harder press paints a wider stroke");
+  }
+
+  void eyedropperPicksThePaintedPigment() {
+    grid_only_canvas(false);
+    PaintPanel* pp = w_->paint_panel();
+    // Paint with well 0 set to a blue; then select well 1 and pick the colour off the stroke.
+    const std::array<float, 3> blue{0.05f, 0.1f, 0.9f};
+    pp->set_well_ryb(0, blue);
+    QTest::mouseClick(pp->findChildren<QToolButton*>()[0], Qt::LeftButton);
+    QCOMPARE(pp->current_well(), 0);
+    w_->clean_brush();
+    w_->dip(pp->current_paint());
+    stroke(60.f, 0.8f);
+    // The stroke's thickest column, near its middle.
+    const std::vector<float> col = column_density(*w_);
+    int bx = -1, by = -1;
+    float best = 0.f;
+    for (int y = 40; y < 80; ++y)
+      for (int x = 60; x < 100; ++x)
+        if (col[size_t(y) * kW + x] > best) best = col[size_t(y) * kW + x], bx = x, by = y;
+    QVERIFY2(best > 1.f, "the stroke left thick paint");
+    // What the renderer shows there (unlit), and the pigment behind it.
+    const Vec3 albedo = on_sim(*w_, [&](SimThread& s) {
+      const FloatImage a = s.renderer().render_albedo(s.sim().canvas(), s.sim().live_window());
+      return Vec3(a.at(bx, by, 0), a.at(bx, by, 1), a.at(bx, by, 2));
+    });
+    QTest::mouseClick(pp->findChildren<QToolButton*>()[1], Qt::LeftButton);
+    QCOMPARE(pp->current_well(), 1);
+    const std::array<float, 3> before = pp->well_ryb(1);
+    QTest::mouseClick(w_->view(), Qt::LeftButton, Qt::AltModifier, w_->view()->to_widget(QPointF(bx + 0.5, by + 0.5)).toPoint());
+    QCoreApplication::processEvents();
+    const std::array<float, 3> got = pp->well_ryb(1);
+    const Vec3 shown = ryb_to_rgb(Vec3(got[0], got[1], got[2]));
+    qInfo("picked at (%d, %d): RYB %.3f %.3f %.3f (painted %.2f %.2f %.2f); renders %.3f %.3f %.3f, shown %.3f %.3f %.3f",
+          bx, by, got[0], got[1], got[2], blue[0], blue[1], blue[2], shown.x, shown.y, shown.z, albedo.x, albedo.y,
+          albedo.z);
+    QVERIFY2(got != before, "Alt+click put a colour in the selected well");
+    QVERIFY2(pp->well_ryb(0) == blue, "the other wells keep theirs");
+    // The picked pigment renders as the canvas shows there, and thick paint is the brush's paint.
+    QVERIFY2(length(shown - albedo) < 0.02f, "the picked pigment renders the colour shown");
+    QVERIFY2(length(Vec3(got[0], got[1], got[2]) - Vec3(blue[0], blue[1], blue[2])) < 0.1f, "thick paint: the painted pigment");
+    // Bare canvas has no paint to pick: the well stays as it is.
+    QVERIFY(!w_->pick_color(QPointF(5.5, 5.5)).has_value());
+    QVERIFY2(pp->well_ryb(1) == got, "picking bare canvas leaves the well");
   }
 
   void undoRestoresExactCanvasRedoReapplies() {

@@ -343,6 +343,7 @@ struct RayHit {
   Vec3 pos;     ///< hit point, cells
   Vec3 normal;
   Vec3 albedo;  ///< unlit RGB after blending the pigment samples below the surface
+  Vec3 ryb;     ///< the pigment behind `albedo` (RYB; the paper's where the ray meets bare canvas)
   float dryness;
   float cover;  ///< share of the ground the paint hides (film_cover); 0 off the paint
 };
@@ -356,12 +357,12 @@ WB_HD WB_INLINE void pixel_ray(const CameraBasis& cam, float i, float j, Vec3& g
 /// Pigment gathered below the surface (§6): samples every penetration_step within
 /// L = oil * penetration_per_oil along the ray, tent-weighted w = 1 - s/L so that the surface
 /// counts most; samples inside a film see its paint, samples below the canvas the primed canvas.
-/// The blend is linear in RYB (glazing mixes pigment like the colour model does) and converted
-/// to RGB once.
+/// The blend is linear in RYB (glazing mixes pigment like the colour model does); the caller
+/// converts it to RGB once.
 WB_HD WB_INLINE Vec3 gather_pigment(const RenderVolume& v, const RenderParams& P, Vec3 hit, Vec3 dir, Vec3 n,
                                     PaintSample surf) {
   const float L = surf.oil * P.penetration_per_oil;
-  if (!(L > P.penetration_step)) return ryb_to_rgb(surf.ryb);
+  if (!(L > P.penetration_step)) return surf.ryb;
   Vec3 acc = surf.ryb;
   float wsum = 1.f;
   for (float s = P.penetration_step; s < L; s += P.penetration_step) {
@@ -377,7 +378,7 @@ WB_HD WB_INLINE Vec3 gather_pigment(const RenderVolume& v, const RenderParams& P
     acc += k.ryb * w;
     wsum += w;
   }
-  return ryb_to_rgb(acc / wsum);
+  return acc / wsum;
 }
 
 /// Casts one ray: march the surface density from `start` along `dir` at P.step until it reaches
@@ -387,6 +388,7 @@ WB_HD WB_INLINE RayHit cast_ray(const RenderVolume& v, const RenderParams& P, Ve
   h.kind = 0;
   h.normal = Vec3(0.f, 0.f, 1.f);
   h.albedo = P.background_rgb;
+  h.ryb = P.paper_ryb;
   h.dryness = 1.f;
   h.cover = 0.f;
   const float t_end = start.z / -dir.z;  // where the ray meets z = 0 (dir.z < 0)
@@ -438,10 +440,14 @@ WB_HD WB_INLINE RayHit cast_ray(const RenderVolume& v, const RenderParams& P, Ve
     // Pigment just inside the surface.
     const PaintSample surf = surface_paint(v, P, h.pos - h.normal * 0.5f);
     h.dryness = surf.dryness;
-    h.albedo = gather_pigment(v, P, h.pos, dir, h.normal, surf);
+    h.ryb = gather_pigment(v, P, h.pos, dir, h.normal, surf);
+    h.albedo = ryb_to_rgb(h.ryb);
     // A thin film lets some of the ground through; thick paint hides it.
     h.cover = f.thin * film_cover(P, f.height) + (1.f - f.thin);
-    if (h.cover < 1.f) h.albedo = lerp(P.paper_rgb, h.albedo, h.cover);
+    if (h.cover < 1.f) {
+      h.albedo = lerp(P.paper_rgb, h.albedo, h.cover);
+      h.ryb = lerp(P.paper_ryb, h.ryb, h.cover);
+    }
     return h;
   }
   const Vec3 g = start + dir * t_end;

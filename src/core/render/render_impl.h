@@ -180,6 +180,11 @@ void render_pixels(RenderVolume v, RenderParams P, CameraBasis cam, const Vec3* 
       fout[o * 4] = h.normal.x;
       fout[o * 4 + 1] = h.normal.y;
       fout[o * 4 + 2] = h.normal.z;
+    } else if (mode == int(RenderOutput::Pigment)) {
+      fout[o * 4] = h.ryb.x;
+      fout[o * 4 + 1] = h.ryb.y;
+      fout[o * 4 + 2] = h.ryb.z;
+      fout[o * 4 + 3] = float(h.kind);
     } else {
       fout[o * 4] = h.albedo.x;
       fout[o * 4 + 1] = h.albedo.y;

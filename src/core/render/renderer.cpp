@@ -237,6 +237,19 @@ FloatImage Renderer::render_float(TileStore& canvas, PaintWindow* live, RenderOu
   return out;
 }
 
+std::optional<Vec3> Renderer::pigment_at(TileStore& canvas, int x, int y, PaintWindow* live) {
+  constexpr int kTile = 32;
+  const Camera camera = Camera::top(canvas.dims());
+  if (x < 0 || y < 0 || x >= camera.width || y >= camera.height) return std::nullopt;
+  const int tiles_x = (camera.width + kTile - 1) / kTile;
+  prepare(canvas, camera, {int32_t((y / kTile) * tiles_x + x / kTile)}, kTile, live, nullptr);
+  run(RenderOutput::Pigment, camera, kTile, 1);
+  float px[4];
+  fout_.copy_range_to_host(px, size_t((y % kTile) * kTile + x % kTile) * 4, 4);
+  if (px[3] != 2.f) return std::nullopt;
+  return Vec3(px[0], px[1], px[2]);
+}
+
 FloatImage Renderer::render_height_map(TileStore& canvas, PaintWindow* live) {
   return render_float(canvas, live, RenderOutput::Height, 1);
 }

@@ -3,6 +3,7 @@
 // incremental per-tile image cache and the material exports (height, normal, albedo maps).
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "core/canvas/tile_store.h"
@@ -47,7 +48,7 @@ struct ParticleOverlay {
   Int3 origin{}, dims{};
 };
 
-enum class RenderOutput : int { Shaded = 0, Height = 1, Normal = 2, Albedo = 3 };
+enum class RenderOutput : int { Shaded = 0, Height = 1, Normal = 2, Albedo = 3, Pigment = 4 };
 
 class Renderer {
  public:
@@ -68,6 +69,10 @@ class Renderer {
   FloatImage render_normal_map(TileStore& canvas, PaintWindow* live = nullptr);
   /// Unlit colour per cell (pigment blended below the surface, no light, no AO), 3 channels.
   FloatImage render_albedo(TileStore& canvas, PaintWindow* live = nullptr);
+  /// The pigment (RYB) behind the top view's colour at cell (x, y): what render_albedo shows
+  /// there, before the conversion to RGB (a glaze's includes the paper it lets through). Empty
+  /// where the ray meets bare canvas or misses it. Renders one image tile.
+  std::optional<Vec3> pigment_at(TileStore& canvas, int x, int y, PaintWindow* live = nullptr);
 
   /// Renders the pixels of the listed image tiles (tile id = ty * tiles_x + tx, tiles of
   /// `tile_px` pixels) into `rgba` (host, width*height, packed RGBA8). Used by the cache.
