@@ -239,7 +239,10 @@ void CanvasView::tabletEvent(QTabletEvent* e) {
 void CanvasView::mousePressEvent(QMouseEvent* e) {
   setFocus();
   cursor_ = e->position();
-  if (e->button() == Qt::MiddleButton || (e->button() == Qt::LeftButton && (e->modifiers() & Qt::ShiftModifier))) {
+  if (e->button() == Qt::RightButton && !pen_down_) {
+    light_drag_ = true;
+    light_anchor_ = e->position();
+  } else if (e->button() == Qt::MiddleButton || (e->button() == Qt::LeftButton && (e->modifiers() & Qt::ShiftModifier))) {
     panning_ = true;
     pan_anchor_ = e->position();
   } else if (e->button() == Qt::LeftButton && !pen_down_ && (e->modifiers() & Qt::AltModifier)) {
@@ -255,7 +258,9 @@ void CanvasView::mousePressEvent(QMouseEvent* e) {
 
 void CanvasView::mouseMoveEvent(QMouseEvent* e) {
   cursor_ = e->position();
-  if (panning_) {
+  if (light_drag_) {
+    Q_EMIT lightDrag(e->position() - light_anchor_, false);
+  } else if (panning_) {
     const QPointF d = to_canvas(pan_anchor_) - to_canvas(e->position());
     pan_anchor_ = e->position();
     set_view(center_ + d, zoom_, rotation_deg_);
@@ -268,7 +273,10 @@ void CanvasView::mouseMoveEvent(QMouseEvent* e) {
 }
 
 void CanvasView::mouseReleaseEvent(QMouseEvent* e) {
-  if (panning_) {
+  if (light_drag_ && e->button() == Qt::RightButton) {
+    light_drag_ = false;
+    Q_EMIT lightDrag(e->position() - light_anchor_, true);
+  } else if (panning_) {
     panning_ = false;
   } else if (pen_down_ && !tablet_down_ && e->button() == Qt::LeftButton) {
     pen_down_ = false;

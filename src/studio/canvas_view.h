@@ -53,6 +53,9 @@ class CanvasView : public QOpenGLWidget, protected QOpenGLFunctions {
   void penRelease(wb::studio::PenInput p, double now);
   /// Alt + click (mouse or pen): the eyedropper at this canvas point, cells.
   void pickColor(QPointF canvas);
+  /// Right-button drag: the light follows the pointer (widget pixels moved since the press);
+  /// `done` on release.
+  void lightDrag(QPointF moved, bool done);
   void viewChanged();
 
  protected:
@@ -90,6 +93,8 @@ class CanvasView : public QOpenGLWidget, protected QOpenGLFunctions {
   bool tablet_down_ = false;
   float last_pressure_ = 0.5f;
   PenInput last_input_{};
+  bool light_drag_ = false;
+  QPointF light_anchor_;
   bool panning_ = false;
   QPointF pan_anchor_;
   QPointF cursor_{-1, -1};

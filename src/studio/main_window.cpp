@@ -181,6 +181,32 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
       s.invalidate_all();
     });
   });
+  // The light follows a right-button drag on the canvas: half a degree of direction per pixel
+  // across, a quarter degree of height per pixel up; the view re-renders once, on release.
+  connect(view_, &CanvasView::lightDrag, this, [this](QPointF moved, bool done) {
+    if (!light_dragging_) {
+      light_dragging_ = true;
+      drag_azimuth_ = view_panel_->azimuth();
+      drag_elevation_ = view_panel_->elevation();
+    }
+    view_panel_->set_light(drag_azimuth_ - 0.5f * float(moved.x()), drag_elevation_ - 0.25f * float(moved.y()), done);
+    if (done) light_dragging_ = false;
+  });
+  connect(view_panel_, &ViewPanel::obliqueToggled, this, [this](bool on) {
+    oblique_dock_->setVisible(on);
+    if (on) refresh_oblique();
+  });
+  connect(sim_.get(), &SimThread::obliqueReady, this, [this](QImage img) {
+    oblique_image_ = img;
+    ++oblique_renders_;
+    oblique_label_->setPixmap(QPixmap::fromImage(img));
+  });
+  connect(sim_.get(), &SimThread::frameReady, this, [this] {
+    if (view_panel_->oblique() && !oblique_timer_.isActive()) oblique_timer_.start();
+  });
+  oblique_timer_.setSingleShot(true);
+  oblique_timer_.setInterval(300);
+  connect(&oblique_timer_, &QTimer::timeout, this, [this] { refresh_oblique(); });
   connect(view_panel_, &ViewPanel::pressureChanged, this, [this](float mp, float gamma) {
     view_->set_mouse_pressure(mp);
     view_->set_pressure_gamma(gamma);
@@ -195,6 +221,17 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   dock(brush_panel_, "Brush");
   dock(paint_panel_, "Paint");
   dock(view_panel_, "View and input");
+  oblique_label_ = new QLabel;
+  oblique_label_->setAlignment(Qt::AlignCenter);
+  oblique_label_->setMinimumSize(240, 120);
+  oblique_dock_ = new QDockWidget("Oblique view", this);
+  oblique_dock_->setObjectName("Oblique view");
+  oblique_dock_->setWidget(oblique_label_);
+  addDockWidget(Qt::BottomDockWidgetArea, oblique_dock_);
+  oblique_dock_->hide();
+  connect(oblique_dock_, &QDockWidget::visibilityChanged, this, [this](bool visible) {
+    if (!visible && !oblique_dock_->isVisible()) view_panel_->set_oblique(false);
+  });
 
   // Status bar.
   status_sim_ = new QLabel;
@@ -377,6 +414,16 @@ void MainWindow::dry_canvas() {
   undo_->clear();
   dirty_ = true;
   update_title();
+}
+
+void MainWindow::refresh_oblique() {
+  if (!view_panel_->oblique()) return;
+  // Not while painting: the render would hold up the simulation. Asked again when it is idle.
+  if (!sim_->status().idle) {
+    oblique_timer_.start();
+    return;
+  }
+  sim_->post([](SimThread& s) { s.render_oblique(30.f, 720); });
 }
 
 std::optional<std::array<float, 3>> MainWindow::pick_color(QPointF canvas) {

@@ -2,6 +2,7 @@
 // menus (files, undo, canvas, recording), status bar (simulation rate, particles, device,
 // preset, frame rate), autosave and crash recovery.
 #pragma once
+#include <QDockWidget>
 #include <QLabel>
 #include <QMainWindow>
 #include <QTimer>
@@ -62,6 +63,11 @@ class MainWindow : public QMainWindow {
   /// The eyedropper: puts the pigment of the paint shown at this canvas point (cells) into the
   /// selected well. Returns it, or nothing over bare canvas (the well is left as it was).
   std::optional<std::array<float, 3>> pick_color(QPointF canvas);
+  ViewPanel* view_panel() const { return view_panel_; }
+  /// The oblique view as last rendered (null until the view is turned on).
+  QImage oblique_image() const { return oblique_image_; }
+  /// How many oblique views have arrived (tests wait on it).
+  int oblique_renders() const { return oblique_renders_; }
   /// Blocks until the simulation has consumed every input so far and the last stroke's undo
   /// record has arrived (tests).
   void settle();
@@ -83,6 +89,8 @@ class MainWindow : public QMainWindow {
   void autosave();
   void check_recovery();
   bool write_snapshot(const QString& path, bool wait, bool user_save);
+  /// Asks for a new oblique view once the simulation is idle (coalesced).
+  void refresh_oblique();
 
   StudioOptions options_;
   std::unique_ptr<SimThread> sim_;
@@ -109,6 +117,15 @@ class MainWindow : public QMainWindow {
   double frames_t_ = 0.0;
   double view_fps_ = 0.0;
   int saves_in_flight_ = 0;
+  // The oblique view: its dock, the last image, and a timer that asks for a new one when the
+  // canvas changed and the simulation is idle (a CPU render of the whole canvas takes a while).
+  QDockWidget* oblique_dock_ = nullptr;
+  QLabel* oblique_label_ = nullptr;
+  QImage oblique_image_;
+  int oblique_renders_ = 0;
+  QTimer oblique_timer_;
+  bool light_dragging_ = false;
+  float drag_azimuth_ = 0.f, drag_elevation_ = 0.f;
 };
 
 }  // namespace wb::studio

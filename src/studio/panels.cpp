@@ -1,6 +1,7 @@
 #include "studio/panels.h"
 
 #include <QButtonGroup>
+#include <QCheckBox>
 #include <QColorDialog>
 #include <QComboBox>
 #include <QDir>
@@ -301,18 +302,46 @@ ViewPanel::ViewPanel(QWidget* parent) : QWidget(parent) {
   relief_ = slider(0, 100, 65, "Strength of the relief shading");
   mouse_pressure_ = slider(0, 100, 50, "Pressure of the mouse (a tablet gives its own)");
   gamma_ = slider(30, 300, 100, "Pressure curve: output = input ^ (value / 100)");
+  azimuth_->setObjectName("light_azimuth");
+  elevation_->setObjectName("light_elevation");
+  auto* rake_b = new QPushButton("Raking light");
+  rake_b->setObjectName("rake");
+  rake_b->setToolTip("Light low across the canvas (12 degrees), to judge the relief. Drag on the canvas with "
+                     "the right button to move the light");
+  oblique_ = new QCheckBox("Oblique view");
+  oblique_->setObjectName("oblique");
+  oblique_->setToolTip("The whole canvas seen from 30 degrees above, under the same light, in its own panel");
   form->addRow("Light direction", azimuth_);
   form->addRow("Light height", elevation_);
   form->addRow("Relief", relief_);
+  form->addRow(rake_b, oblique_);
   form->addRow("Mouse pressure", mouse_pressure_);
   form->addRow("Pressure curve", gamma_);
-  for (QSlider* s : {azimuth_, elevation_, relief_})
-    connect(s, &QSlider::sliderReleased, this, [this] {
-      Q_EMIT lightingChanged(float(azimuth_->value()), float(elevation_->value()), relief_->value() / 100.f);
-    });
+  for (QSlider* s : {azimuth_, elevation_, relief_}) connect(s, &QSlider::sliderReleased, this, [this] { emit_lighting(); });
+  connect(rake_b, &QPushButton::clicked, this, [this] { rake(); });
+  connect(oblique_, &QCheckBox::toggled, this, [this](bool on) { Q_EMIT obliqueToggled(on); });
   for (QSlider* s : {mouse_pressure_, gamma_})
     connect(s, &QSlider::valueChanged, this,
             [this] { Q_EMIT pressureChanged(mouse_pressure_->value() / 100.f, gamma_->value() / 100.f); });
 }
+
+float ViewPanel::azimuth() const { return float(azimuth_->value()); }
+float ViewPanel::elevation() const { return float(elevation_->value()); }
+
+void ViewPanel::emit_lighting() {
+  Q_EMIT lightingChanged(float(azimuth_->value()), float(elevation_->value()), relief_->value() / 100.f);
+}
+
+void ViewPanel::set_light(float azimuth_deg, float elevation_deg, bool apply) {
+  const float a = std::fmod(std::fmod(azimuth_deg, 360.f) + 360.f, 360.f);
+  azimuth_->setValue(int(std::lround(a)) % 360);
+  elevation_->setValue(std::clamp(int(std::lround(elevation_deg)), elevation_->minimum(), elevation_->maximum()));
+  if (apply) emit_lighting();
+}
+
+void ViewPanel::rake() { set_light(azimuth(), 12.f, true); }
+
+void ViewPanel::set_oblique(bool on) { oblique_->setChecked(on); }
+bool ViewPanel::oblique() const { return oblique_->isChecked(); }
 
 }  // namespace wb::studio

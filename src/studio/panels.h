@@ -19,6 +19,7 @@ class QSlider;
 class QLabel;
 class QToolButton;
 class QButtonGroup;
+class QCheckBox;
 
 namespace wb::studio {
 
@@ -84,13 +85,26 @@ class ViewPanel : public QWidget {
   Q_OBJECT
  public:
   explicit ViewPanel(QWidget* parent = nullptr);
+  float azimuth() const;
+  float elevation() const;
+  /// Moves the light (azimuth wraps, elevation clamps to the slider's 5..90 degrees); the
+  /// sliders follow. `apply`: also emit lightingChanged (a drag applies once, when it ends).
+  void set_light(float azimuth_deg, float elevation_deg, bool apply);
+  /// Low light from the current direction, 12 degrees above the canvas: the relief in relief.
+  void rake();
+  void set_oblique(bool on);
+  bool oblique() const;
  Q_SIGNALS:
   /// Light from `azimuth_deg` (0 = from +x, counter-clockwise), `elevation_deg` above the
   /// canvas; `relief` scales the diffuse term (0 flat .. 1 strong).
   void lightingChanged(float azimuth_deg, float elevation_deg, float relief);
   void pressureChanged(float mouse_pressure, float gamma);
+  /// The oblique view (the whole canvas from 30 degrees above, in its own dock) on or off.
+  void obliqueToggled(bool on);
  private:
+  void emit_lighting();
   QSlider *azimuth_, *elevation_, *relief_, *mouse_pressure_, *gamma_;
+  QCheckBox* oblique_ = nullptr;
 };
 
 /// Display colour of an RYB pigment (Gossett-Chen cube, core/color/ryb.h).

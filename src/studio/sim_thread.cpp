@@ -252,6 +252,16 @@ Image SimThread::canvas_image() {
   return cache_->update(sim_->canvas(), sim_->live_window(), &overlay);
 }
 
+void SimThread::render_oblique(float elevation_deg, int max_width) {
+  if (!sim_) return;
+  const CanvasDims d = sim_->canvas().dims();
+  const float zoom = std::min(1.f, float(max_width) / float(d.width));
+  const Image img = renderer_.render(sim_->canvas(), Camera::oblique(d, elevation_deg, zoom), sim_->live_window());
+  QImage q(img.width, img.height, QImage::Format_RGBA8888);
+  for (int y = 0; y < img.height; ++y) std::memcpy(q.scanLine(y), img.at(0, y), size_t(img.width) * 4);
+  Q_EMIT obliqueReady(q);
+}
+
 void SimThread::drain() {
   PlayerStep step;
   while (step_available()) {

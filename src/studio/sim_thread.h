@@ -110,6 +110,9 @@ class SimThread : public QObject {
   void invalidate_rect(int x0, int y0, int x1, int y1);
   /// The whole canvas rendered now (one pixel per cell).
   Image canvas_image();
+  /// Renders the whole canvas from `elevation_deg` above, at most `max_width` pixels wide,
+  /// under the view's light, and hands it to the UI (obliqueReady).
+  void render_oblique(float elevation_deg, int max_width);
   const SimConfig& config() const { return config_; }
   /// Simulates every step the inputs so far allow (before a restart or a snapshot).
   void drain();
@@ -125,6 +128,8 @@ class SimThread : public QObject {
   /// One stroke finished: the tiles it changed (undo record).
   void strokeFinished(std::shared_ptr<wb::TileDiff> diff);
   void failed(QString message);
+  /// The oblique view asked for by render_oblique().
+  void obliqueReady(QImage image);
 
  private:
   void run();

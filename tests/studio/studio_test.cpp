@@ -17,6 +17,7 @@
 #include <QPushButton>
 #include <QTemporaryDir>
 #include <QTest>
+#include <QThread>
 #include <QTimer>
 #include <QToolButton>
 
@@ -437,6 +438,64 @@ class StudioTest : public QObject {
     // Bare canvas has no paint to pick: the well stays as it is.
     QVERIFY(!w_->pick_color(QPointF(5.5, 5.5)).has_value());
     QVERIFY2(pp->well_ryb(1) == got, "picking bare canvas leaves the well");
+  }
+
+  void obliqueViewAndRakingLight() {
+    grid_only_canvas(false);
+    ViewPanel* vp = w_->view_panel();
+    // Right-button drag on the canvas moves the light: 100 px left turns it 50 degrees, 40 px
+    // down lowers it 10 degrees.
+    vp->set_light(200.f, 50.f, true);
+    const QPoint a = w_->view()->rect().center();
+    QTest::mousePress(w_->view(), Qt::RightButton, Qt::NoModifier, a);
+    QTest::mouseMove(w_->view(), a + QPoint(-100, 40));
+    {
+      QMouseEvent release(QEvent::MouseButtonRelease, QPointF(a + QPoint(-100, 40)), w_->view()->mapToGlobal(QPointF(a + QPoint(-100, 40))),
+                          Qt::RightButton, Qt::NoButton, Qt::NoModifier);
+      QApplication::sendEvent(w_->view(), &release);
+    }
+    qInfo("light after the drag: azimuth %.0f, elevation %.0f", vp->azimuth(), vp->elevation());
+    QCOMPARE(vp->azimuth(), 250.f);
+    QCOMPARE(vp->elevation(), 40.f);
+    // The oblique view appears when asked for and follows the canvas and the light.
+    const auto wait_render = [&](int after) {
+      QElapsedTimer t;
+      t.start();
+      while (w_->oblique_renders() <= after && t.elapsed() < 60000) {
+        QCoreApplication::processEvents(QEventLoop::AllEvents, 20);
+        QThread::msleep(5);
+      }
+      return w_->oblique_renders() > after;
+    };
+    const auto differ = [](const QImage& x, const QImage& y) {
+      int64_t d = 0;
+      for (int j = 0; j < x.height(); ++j)
+        for (int i = 0; i < x.width(); ++i) d += std::abs(qGray(x.pixel(i, j)) - qGray(y.pixel(i, j)));
+      return double(d) / double(x.width() * x.height());
+    };
+    int n = w_->oblique_renders();
+    vp->set_oblique(true);
+    QVERIFY2(wait_render(n), "turning the oblique view on renders it");
+    const QImage blank = w_->oblique_image();
+    QVERIFY(!blank.isNull());
+    QCOMPARE(blank.width(), kW);  // the whole canvas, one pixel per cell for a canvas this small
+    QVERIFY2(blank.height() < kH, "seen from 30 degrees the canvas is foreshortened");
+    n = w_->oblique_renders();
+    stroke(60.f, 0.8f);
+    QVERIFY2(wait_render(n), "a stroke refreshes the oblique view");
+    const QImage painted = w_->oblique_image();
+    const double stroke_change = differ(blank, painted);
+    n = w_->oblique_renders();
+    vp->rake();
+    QCOMPARE(vp->elevation(), 12.f);
+    QVERIFY2(wait_render(n), "a new light refreshes the oblique view");
+    const double light_change = differ(painted, w_->oblique_image());
+    qInfo("oblique view %dx%d: mean grey change %.2f after the stroke, %.2f under the raking light", painted.width(),
+          painted.height(), stroke_change, light_change);
+    QVERIFY2(stroke_change > 0.5, "the stroke shows in the oblique view");
+    QVERIFY2(light_change > 0.5, "the raking light shows in the oblique view");
+    vp->set_oblique(false);
+    vp->set_light(231.f, 50.f, true);
   }
 
   void undoRestoresExactCanvasRedoReapplies() {
