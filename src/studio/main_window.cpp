@@ -220,7 +220,11 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   };
   dock(brush_panel_, "Brush");
   dock(paint_panel_, "Paint");
+  brush_preview_ = new BrushPreview;
+  dock(brush_preview_, "Brush preview");
   dock(view_panel_, "View and input");
+  // The preview follows the brush with every frame while painting, and the status timer otherwise.
+  connect(sim_.get(), &SimThread::frameReady, brush_preview_, [this] { brush_preview_->set_picture(sim_->brush_picture()); });
   oblique_label_ = new QLabel;
   oblique_label_->setAlignment(Qt::AlignCenter);
   oblique_label_->setMinimumSize(240, 120);
@@ -685,6 +689,7 @@ void MainWindow::update_status() {
   status_device_->setText(QString("Device %1 \u00b7 Preset %2")
                               .arg(QString::fromStdString(st.device), QString::fromStdString(options_.preset.name)));
   paint_panel_->show_brush(st.brush_ryb, st.brush_amount);
+  if (brush_preview_->isVisible()) brush_preview_->set_picture(sim_->brush_picture());
 }
 
 void MainWindow::update_title() {

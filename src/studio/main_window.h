@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/io/undo_tiles.h"
+#include "studio/brush_preview.h"
 #include "studio/canvas_view.h"
 #include "studio/panels.h"
 #include "studio/pen_clock.h"
@@ -64,6 +65,7 @@ class MainWindow : public QMainWindow {
   /// selected well. Returns it, or nothing over bare canvas (the well is left as it was).
   std::optional<std::array<float, 3>> pick_color(QPointF canvas);
   ViewPanel* view_panel() const { return view_panel_; }
+  BrushPreview* brush_preview() const { return brush_preview_; }
   /// The oblique view as last rendered (null until the view is turned on).
   QImage oblique_image() const { return oblique_image_; }
   /// How many oblique views have arrived (tests wait on it).
@@ -99,6 +101,7 @@ class MainWindow : public QMainWindow {
   BrushPanel* brush_panel_ = nullptr;
   PaintPanel* paint_panel_ = nullptr;
   ViewPanel* view_panel_ = nullptr;
+  BrushPreview* brush_preview_ = nullptr;
   QUndoStack* undo_ = nullptr;
   QMenu* recent_menu_ = nullptr;
   QLabel* status_sim_ = nullptr;

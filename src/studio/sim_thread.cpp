@@ -245,6 +245,11 @@ void SimThread::invalidate_rect(int x0, int y0, int x1, int y1) {
   dirty_y1_ = std::max(dirty_y1_, y1);
 }
 
+BrushPicture SimThread::brush_picture() const {
+  std::lock_guard lk(frame_mu_);
+  return picture_;
+}
+
 Image SimThread::canvas_image() {
   if (!cache_ || !sim_) return {};
   if (dirty_x1_ >= 0) render(true);
@@ -329,8 +334,6 @@ void SimThread::run_step(const PlayerStep& step) {
   if (!started_) {
     sim.reset_brush(player_->pose_at(player_->t_begin()));
     apply_initial_paint(sim, rec_.paint);
-    brush_color_ = Vec3(rec_.paint.ryb[0], rec_.paint.ryb[1], rec_.paint.ryb[2]);
-    brush_amount_ = rec_.paint.load;
     started_ = true;
   }
   // Events first (they fire in the first step ending at or after them), then the pen-down reload.
@@ -377,21 +380,7 @@ void SimThread::run_step(const PlayerStep& step) {
 
 void SimThread::apply_event(const StrokeEvent& e) {
   apply_paint_event(*sim_, e);
-  switch (e.kind) {
-    case StrokeEventKind::Dip: {
-      const float add = std::max(0.f, e.load - brush_amount_);
-      brush_color_ = brush_amount_ <= 0.f ? Vec3(e.ryb[0], e.ryb[1], e.ryb[2])
-                                          : color_mix(brush_color_, Vec3(e.ryb[0], e.ryb[1], e.ryb[2]), brush_amount_, add);
-      brush_amount_ = std::max(brush_amount_, e.load);
-      break;
-    }
-    case StrokeEventKind::Wipe: brush_amount_ *= 1.f - e.fraction; break;
-    case StrokeEventKind::Clean:
-      brush_amount_ = 0.f;
-      brush_color_ = Vec3(0.f, 0.f, 0.f);
-      break;
-    case StrokeEventKind::Dry: invalidate_all(); break;
-  }
+  if (e.kind == StrokeEventKind::Dry) invalidate_all();
 }
 
 void SimThread::finish_stroke() {
@@ -411,10 +400,16 @@ void SimThread::finish_stroke() {
 
 void SimThread::render(bool force) {
   if (!cache_ || !sim_) return;
-  if (dirty_x1_ < 0) return;
   const double now = wall_now();
   if (!force && now - last_render_ < 1.0 / 30.0) return;
   last_render_ = now;
+  // The brush as it is now (preview, swatch), with every frame and after palette actions.
+  BrushPicture picture = sim_->brush_picture();
+  {
+    std::lock_guard lk(frame_mu_);
+    picture_ = std::move(picture);
+  }
+  if (dirty_x1_ < 0) return;
   ParticleOverlay overlay = sim_->particle_overlay();
   const Image& img = cache_->update(sim_->canvas(), sim_->live_window(), &overlay);
   // Copy the changed pixels (the marked rectangle grown by the renderer's reach) to the front.
@@ -451,8 +446,11 @@ void SimThread::publish_status(bool force) {
   }
   status_.steps = steps_;
   status_.times = times_;
-  status_.brush_ryb = {brush_color_.x, brush_color_.y, brush_color_.z};
-  status_.brush_amount = brush_amount_;
+  {
+    std::lock_guard fk(frame_mu_);
+    status_.brush_ryb = {picture_.mean_ryb.x, picture_.mean_ryb.y, picture_.mean_ryb.z};
+    status_.brush_amount = picture_.amount;
+  }
   status_.lag_s = rec_.samples.empty() ? 0.0 : std::max(0.0, rec_.samples.back().t - t_done_);
 }
 

@@ -66,8 +66,8 @@ struct SimStatus {
   double lag_s = 0.0;           ///< session time not simulated yet
   bool idle = true;
   std::string device;
-  std::array<float, 3> brush_ryb{};  ///< mean colour of the paint on the brush (RYB)
-  float brush_amount = 0.f;          ///< how full the brush is, 0..1
+  std::array<float, 3> brush_ryb{};  ///< mean colour of the paint on the brush (RYB), from the device
+  float brush_amount = 0.f;          ///< how full the brush is: load / potential capacity
   std::string error;            ///< first error; stepping stops, the document is kept
   WorkerTimes times;
 };
@@ -119,9 +119,8 @@ class SimThread : public QObject {
   /// Paint the brush holds (the palette's current well) for recordings that start now.
   void set_paint(const PaintLoad& p) { paint_ = p; }
   const PaintLoad& paint() const { return paint_; }
-  /// Mean colour (RYB) and amount (0..1) of the paint on the brush, as tracked for the UI.
-  Vec3 brush_color() const { return brush_color_; }
-  float brush_amount() const { return brush_amount_; }
+  /// The brush's pose and paint as of the last rendered frame (the preview and the swatch).
+  BrushPicture brush_picture() const;
 
  Q_SIGNALS:
   void frameReady();
@@ -146,8 +145,6 @@ class SimThread : public QObject {
   Renderer renderer_;
   std::unique_ptr<CanvasImageCache> cache_;
   PaintLoad paint_{};
-  Vec3 brush_color_{};
-  float brush_amount_ = 0.f;
 
   // Inputs (UI -> worker).
   mutable std::mutex in_mu_;
@@ -177,6 +174,7 @@ class SimThread : public QObject {
   mutable std::mutex frame_mu_;
   QImage front_;
   QRect front_dirty_;
+  BrushPicture picture_;
   int dirty_x0_ = 1 << 30, dirty_y0_ = 1 << 30, dirty_x1_ = -1, dirty_y1_ = -1;
   double last_render_ = 0.0;
 

@@ -24,6 +24,49 @@ TEST_F(SimulatorTest, CleanBrushLeavesNoPaint) {
   EXPECT_EQ(sim.counters().nonfinite_events, 0);
 }
 
+// The studio's brush preview and swatch read the brush's paint from the device: it is what was
+// loaded, it mixes as Algorithm 2 mixes, it runs down as the brush paints, and its bristles hang
+// below the ferrule and reach the canvas when pressed.
+TEST_F(SimulatorTest, BrushPictureIsTheBrushsPaintAndPose) {
+  const SimConfig c = small_config();
+  Simulator sim(c, pose_at(c.brush, 128, 128, 0.f, false));
+  BrushPicture b = sim.brush_picture();
+  EXPECT_EQ(b.amount, 0.f);
+  ASSERT_EQ(b.vertices.size(), size_t(c.brush.bristles) * size_t(c.brush.vertices_per_bristle));
+  ASSERT_EQ(b.ryb.size(), size_t(c.brush.bristles));
+  PaintLoad p = red();
+  p.load = 0.6f;
+  sim.load_paint(p);
+  b = sim.brush_picture();
+  EXPECT_NEAR(b.amount, 0.6f, 1e-3f);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(b.mean_ryb[k], p.ryb[k], 1e-4f);
+  for (float f : b.fill) EXPECT_NEAR(f, 0.6f, 1e-3f);
+  // Topped up with blue: the mix Algorithm 2 gives, the same as BristleLoad::mean_color.
+  PaintLoad blue = p;
+  blue.ryb[0] = blue.ryb[1] = 0.f;
+  blue.ryb[2] = 1.f;
+  blue.load = 0.9f;
+  sim.dip(blue);
+  b = sim.brush_picture();
+  const Vec3 expect = sim.load().mean_color(sim.workspace());
+  EXPECT_NEAR(b.amount, 0.9f, 1e-3f);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(b.mean_ryb[k], expect[k], 1e-4f);
+  EXPECT_GT(b.mean_ryb[2], 0.2f);
+  EXPECT_GT(b.mean_ryb[0], 0.2f);
+  // Bristles hang below the ferrule; pressed, their tips reach the canvas; painting uses paint.
+  float lowest = 0.f;
+  for (const Vec3& v : b.vertices) lowest = std::min(lowest, v.z);
+  EXPECT_LT(lowest, -0.5f * c.brush.length);
+  for (int i = 0; i < 8; ++i) sim.step(pose_at(c.brush, 120.f + 2.f * i, 128.f, 1.f), 1.f / 60.f);
+  b = sim.brush_picture();
+  lowest = 0.f;
+  for (const Vec3& v : b.vertices) lowest = std::min(lowest, v.z);
+  EXPECT_NEAR(lowest, b.canvas_z, 1.5f) << "pressed bristles touch the canvas";
+  EXPECT_LT(b.amount, 0.9f) << "painting takes paint off the brush";
+  sim.clean();
+  EXPECT_EQ(sim.brush_picture().amount, 0.f);
+}
+
 TEST_F(SimulatorTest, PressedLoadedBrushPaintsUnderItsFootprintAndBooksClose) {
   const SimConfig c = small_config();
   const float cx = 128.f, cy = 128.f;

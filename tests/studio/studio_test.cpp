@@ -440,6 +440,48 @@ class StudioTest : public QObject {
     QVERIFY2(pp->well_ryb(1) == got, "picking bare canvas leaves the well");
   }
 
+  void brushPreviewShowsTheBrushAndItsPaint() {
+    grid_only_canvas(false);
+    BrushPreview* bp = w_->brush_preview();
+    const auto wait_for = [&](const std::function<bool()>& ok) {
+      QElapsedTimer t;
+      t.start();
+      while (!ok() && t.elapsed() < 5000) {
+        QCoreApplication::processEvents(QEventLoop::AllEvents, 20);
+        QThread::msleep(5);
+      }
+      return ok();
+    };
+    w_->clean_brush();
+    w_->settle();
+    QVERIFY2(wait_for([&] { return bp->picture().bristles == brush_.bristles && bp->picture().amount == 0.f; }),
+             "a clean brush: all bristles, no paint");
+    PaintLoad blue = w_->paint_panel()->current_paint();
+    blue.ryb[0] = 0.05f;
+    blue.ryb[1] = 0.1f;
+    blue.ryb[2] = 0.9f;
+    blue.load = 0.7f;
+    w_->dip(blue);
+    // The dip is applied with the next step: a short hover makes one.
+    tablet_stroke(w_->view(), line_points(QPointF(20, 20), QPointF(22, 20), 3, 0.f), 20);
+    w_->settle();
+    QVERIFY2(wait_for([&] { return std::abs(bp->picture().amount - 0.7f) < 0.02f; }), "the dip fills the preview");
+    const Vec3 c = bp->picture().mean_ryb;
+    qInfo("preview after the dip: amount %.3f, RYB %.3f %.3f %.3f", bp->picture().amount, c.x, c.y, c.z);
+    QVERIFY(std::abs(c.z - 0.9f) < 0.02f && std::abs(c.x - 0.05f) < 0.02f);
+    // While painting, pressed bristles touch the canvas; afterwards the brush holds less.
+    int touching = 0;
+    const auto conn = connect(w_->sim(), &SimThread::frameReady, this, [&] { touching = std::max(touching, bp->touching()); });
+    stroke(60.f, 0.8f);
+    disconnect(conn);
+    QVERIFY2(wait_for([&] { return bp->picture().amount < 0.69f; }), "painting takes paint off the brush");
+    qInfo("preview: at most %d bristle vertices touching while painting; amount after %.3f", touching,
+          bp->picture().amount);
+    QVERIFY2(touching > 0, "pressed bristles touch the canvas in the preview");
+    const QImage shot = bp->grab().toImage();
+    QVERIFY(!shot.isNull());
+  }
+
   void obliqueViewAndRakingLight() {
     grid_only_canvas(false);
     ViewPanel* vp = w_->view_panel();

@@ -1,5 +1,7 @@
 #include "core/sim/simulator.h"
 
+#include "core/color/ryb.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -223,6 +225,44 @@ TransferEnv Simulator::transfer_env() {
   // the grid on the next step and no cell is sampled into particles.
   if (!config_.particles) env.keep = nowhere();
   return env;
+}
+
+BrushPicture Simulator::brush_picture() const {
+  BrushPicture b;
+  b.bristles = brush_->bristles();
+  b.vertices_per_bristle = brush_->vertices_per_bristle();
+  const Vec3 ferrule = brush_->pose().position;
+  b.vertices = brush_->vertices_to_host();
+  for (Vec3& v : b.vertices) v -= ferrule;
+  b.canvas_z = -ferrule.z;
+  const std::vector<float> m = load_->m.to_host(), cap = load_->potential.to_host(), r = load_->pigment_r.to_host(),
+                           y = load_->pigment_y.to_host(), bl = load_->pigment_b.to_host();
+  const int64_t per = brush_->spec().samples_per_bristle;
+  b.ryb.assign(size_t(b.bristles), Vec3{});
+  b.fill.assign(size_t(b.bristles), 0.f);
+  // Colours mix by mass as Algorithm 2 mixes them (linear RYB, then the mean brightness).
+  double mass = 0.0, capacity = 0.0, bright = 0.0;
+  Vec3 sum{};
+  for (int k = 0; k < b.bristles; ++k) {
+    double mk = 0.0, ck = 0.0, bk = 0.0;
+    Vec3 sk{};
+    for (int64_t j = k * per; j < (k + 1) * per; ++j) {
+      const Vec3 c(r[size_t(j)], y[size_t(j)], bl[size_t(j)]);
+      mk += m[size_t(j)];
+      ck += cap[size_t(j)];
+      sk += c * m[size_t(j)];
+      bk += double(pigment_brightness(c)) * m[size_t(j)];
+    }
+    if (mk > 0.0) b.ryb[size_t(k)] = rescale_to_brightness(sk / float(mk), float(bk / mk));
+    b.fill[size_t(k)] = ck > 0.0 ? float(mk / ck) : 0.f;
+    mass += mk;
+    capacity += ck;
+    bright += bk;
+    sum += sk;
+  }
+  if (mass > 0.0) b.mean_ryb = rescale_to_brightness(sum / float(mass), float(bright / mass));
+  b.amount = capacity > 0.0 ? float(mass / capacity) : 0.f;
+  return b;
 }
 
 ParticleOverlay Simulator::particle_overlay() {

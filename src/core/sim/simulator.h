@@ -5,6 +5,7 @@
 #include <array>
 #include <memory>
 #include <utility>
+#include <vector>
 
 #include "core/brush/brush.h"
 #include "core/canvas/tile_store.h"
@@ -51,6 +52,18 @@ struct SimCounters {
   int64_t returned_at_moves = 0;
 };
 
+/// The brush as the artist sees it (the studio's brush preview and paint swatch), read from
+/// the device: each bristle's vertices relative to the ferrule in canvas axes, and its paint.
+struct BrushPicture {
+  int bristles = 0, vertices_per_bristle = 0;
+  std::vector<Vec3> vertices;  ///< bristle-major, canvas axes, cells, the ferrule at the origin
+  float canvas_z = 0.f;        ///< the canvas plane in those coordinates (minus the ferrule's height)
+  std::vector<Vec3> ryb;       ///< per bristle: mass-weighted pigment of its samples (0 when dry)
+  std::vector<float> fill;     ///< per bristle: load / potential capacity (Eq. 12), 0..~1
+  Vec3 mean_ryb{};             ///< the whole brush's pigment, mass-weighted (0 when clean)
+  float amount = 0.f;          ///< the whole brush's load / potential capacity
+};
+
 class Simulator {
  public:
   Simulator(const SimConfig& config, const BrushPose& initial_pose);
@@ -93,6 +106,8 @@ class Simulator {
   /// The live window and the particles, for the renderer.
   PaintWindow* live_window() { return &grid_->window().paint(); }
   ParticleOverlay particle_overlay();
+  /// The brush's pose and paint now (a few small copies from the device; for the UI, not per step).
+  BrushPicture brush_picture() const;
   /// Dried paint of the canvas as the brush sees it now (views into the current tile pool).
   SolidField solid_field();
 
