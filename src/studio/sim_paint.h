@@ -1,6 +1,7 @@
-// The studio's calls into the simulator's paint API (paper §5: the brush's load; dip, wipe,
-// clean; drying), in one place and in the same order as the replay driver (core/sim/replay),
-// so that the live session and `wetbrush replay` of its recording do the same things.
+// The studio's access to the canvas between steps: flushing the window, the settled canvas
+// for files, exports and undo, dropping paint in flight and reloading the window after tiles
+// were written from outside. (Steps and palette events go through core/sim/replay's drive_step,
+// as in `wetbrush replay`, so that a session and the replay of its recording do the same things.)
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -10,10 +11,6 @@
 
 namespace wb::studio {
 
-/// Loads the brush with the recording's paint (start of a recording, pen-down reloads).
-void apply_initial_paint(Simulator& sim, const PaintLoad& paint);
-/// A palette event: dip, wipe, clean or dry.
-void apply_paint_event(Simulator& sim, const StrokeEvent& e);
 /// Writes the live window back to the canvas tiles without changing the simulation (its next
 /// scatter overwrites the same cells with its own values). Paint in flight (particles) is not
 /// on the tiles: see with_settled_canvas.

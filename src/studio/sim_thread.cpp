@@ -7,6 +7,7 @@
 
 #include "core/color/ryb.h"
 #include "core/exec/error.h"
+#include "core/sim/replay.h"
 #include "studio/sim_paint.h"
 
 namespace wb::studio {
@@ -333,14 +334,16 @@ void SimThread::run_step(const PlayerStep& step) {
   Simulator& sim = *sim_;
   if (!started_) {
     sim.reset_brush(player_->pose_at(player_->t_begin()));
-    apply_initial_paint(sim, rec_.paint);
+    sim.load_paint(rec_.paint);
     started_ = true;
   }
-  // Events first (they fire in the first step ending at or after them), then the pen-down reload.
-  while (next_event_ < rec_.events.size() && rec_.events[next_event_].t <= step.t) apply_event(rec_.events[next_event_++]);
+  // Events fire in the first step ending at or after them. The pen-down edge is the session's:
+  // a player rebuilt at a knot mid-stroke starts with the pen already down.
+  const size_t first_event = next_event_;
+  while (next_event_ < rec_.events.size() && rec_.events[next_event_].t <= step.t) ++next_event_;
+  const std::span<const StrokeEvent> events(rec_.events.data() + first_event, next_event_ - first_event);
   const bool edge = step.pen_down && !prev_contact_;
   prev_contact_ = step.pen_down;
-  if (edge && rec_.paint.reload_on_pen_down) apply_initial_paint(sim, rec_.paint);
 
   // Undo: capture the tiles this step may touch before it runs.
   const int reach = step_reach(config_);
@@ -353,11 +356,18 @@ void SimThread::run_step(const PlayerStep& step) {
   double t = wall_now();
   undo_rec_.capture_rect(sim.canvas(), x0, y0, x1, y1);
   t = lap(times_.undo, t);
-  poses_.clear();
-  for (int k = 1; k <= step.substeps; ++k) poses_.push_back(player_->pose_at(StrokePlayer::substep_time(step, k)));
-  t = lap(times_.player, t);
   const Int3 o0 = sim.live_window()->origin();
-  sim.step(poses_.data(), step.substeps, float(step.dt));
+  drive_step(sim, *player_, step, events, edge && rec_.paint.reload_on_pen_down, poses_);
+  for (const StrokeEvent& e : events)
+    if (e.kind == StrokeEventKind::Dry) invalidate_all();
+  if (wall_now() - t > 0.1) {  // DEBUG
+    std::string o;
+    for (const auto& nm : sim.profiler().names()) {
+      const auto& v = sim.profiler().samples(nm);
+      if (!v.empty() && v.back() > 5.0) o += nm + "=" + std::to_string(int(v.back())) + " ";
+    }
+    std::fprintf(stderr, "SLOW step %.0f ms substeps %d: %s\n", (wall_now() - t) * 1e3, step.substeps, o.c_str());
+  }
   lap(times_.step, t);
   // Paint changes only inside the active window (where it was and where it moved to).
   const Int3 o = sim.live_window()->origin(), n = sim.live_window()->dims();
@@ -378,10 +388,6 @@ void SimThread::run_step(const PlayerStep& step) {
   }
 }
 
-void SimThread::apply_event(const StrokeEvent& e) {
-  apply_paint_event(*sim_, e);
-  if (e.kind == StrokeEventKind::Dry) invalidate_all();
-}
 
 void SimThread::finish_stroke() {
   if (!stroke_open_ || !sim_) return;

@@ -135,7 +135,6 @@ class SimThread : public QObject {
   bool step_available();
   void rebuild_player();
   void run_step(const PlayerStep& step);
-  void apply_event(const StrokeEvent& e);
   void finish_stroke();
   void render(bool force);
   void publish_status(bool force);

@@ -24,7 +24,7 @@ TEST_F(SolidHeightTest, DriedPaintRaisesTheFloorWetPaintDoesNot) {
   }
   w.from_host(f);
   DeviceBuffer<float> h(device_, size_t(n.x) * n.y), wet(device_, size_t(n.x) * n.y);
-  particles_solid_height(device_, w.view(), nullptr, 0.95f, 0.5f, 0.25f, h.data(), wet.data());
+  particles_solid_height(device_, w.view(), nullptr, 0.95f, 0.5f, 0.25f, false, h.data(), wet.data());
   const std::vector<float> hh = h.to_host(), ww = wet.to_host();
   for (int j = 0; j < n.y; ++j) {
     EXPECT_FLOAT_EQ(hh[size_t(j) * n.x + 0], 0.25f) << "no paint: the canvas floor";
@@ -39,6 +39,17 @@ TEST_F(SolidHeightTest, DriedPaintRaisesTheFloorWetPaintDoesNot) {
     EXPECT_FLOAT_EQ(ww[size_t(j) * n.x + 3], 3.f) << "three wet cells on the canvas";
     EXPECT_FLOAT_EQ(ww[size_t(j) * n.x + 4], 5.f);
   }
+  // What the particles rest on: the grid's cells, one state each, so wet paint over the half-full
+  // dried top cell starts at that cell's top.
+  DeviceBuffer<float> hg(device_, size_t(n.x) * n.y), wg(device_, size_t(n.x) * n.y);
+  particles_solid_height(device_, w.view(), nullptr, 0.95f, 0.5f, 0.25f, true, hg.data(), wg.data());
+  const std::vector<float> hgh = hg.to_host(), wgh = wg.to_host();
+  for (int j = 0; j < n.y; ++j)
+    for (int i = 0; i < n.x; ++i) {
+      const size_t c = size_t(j) * n.x + i;
+      EXPECT_FLOAT_EQ(hgh[c], i == 1 ? 3.f : hh[c]) << "column " << i;
+      EXPECT_FLOAT_EQ(wgh[c], i == 1 ? 3.f : ww[c]) << "column " << i;
+    }
   // A particle resting above column 1 is 0.5 cells from the solid; above column 3, 2.25.
   SolidView s;
   s.floor_z = 0.25f;

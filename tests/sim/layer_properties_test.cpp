@@ -363,6 +363,53 @@ TEST_F(LayerPropertiesTest, LightBrushScumblesTheTopsOfADriedRidgedLayer) {
   EXPECT_GT(tops, 1.2 * valleys) << "a scumble catches the paint on the tops of the dried layer";
 }
 
+TEST_F(LayerPropertiesTest, LightBrushPaintsOnADriedStrokeWhateverItsHeight) {
+  // A dried stroke 20 cells wide across the drag, its top cell full or partly filled; the light
+  // brush of the scumble test dragged over it. It lays as much on the stroke as on the canvas
+  // before it, and does not push what it laid there off the stroke's far edge. (With a partly
+  // filled top the bristles once rested on the whole cell, half a cell above the surface the
+  // transfer measures from, and the particles sank into that cell, where the grid holds no wet
+  // paint: the stroke took nothing and a pile formed past its edge. docs/TRANSFER.md.)
+  constexpr int kW = 192, kH = 64, kOn0 = 80, kOn1 = 100;
+  constexpr float kX0 = 24.f, kX1 = 152.f;
+  for (const float H : {1.2f, 1.5f, 2.f, 2.5f}) {
+    SimConfig c = layer_config(CanvasDims{kW, kH, kDepth});
+    Simulator sim(c, pose_at(c.brush, kX0, kY, 0.f, false));
+    write_layer(sim, [&](int x, int, int z) {
+      PaintCell p;
+      const float d = x >= kOn0 && x < kOn1 ? std::clamp(H - float(z), 0.f, 1.f) : 0.f;
+      if (d > 0.f) p.density = d, p.pigment_r = 0.1f, p.pigment_y = 0.15f, p.pigment_b = 0.85f, p.oil = 0.3f, p.dryness = 1.f;
+      return p;
+    });
+    PaintLoad white;
+    white.ryb[0] = white.ryb[1] = white.ryb[2] = 0.f;
+    white.load = 0.3f;
+    sim.load_paint(white);
+    drag(sim, kX0, kX1, 300.f, 0.1f);
+    EXPECT_EQ(sim.counters().nonfinite_events, 0);
+    const auto f = canvas_fields(sim);
+    // New paint per column (the cells that are not dried), over the track's middle rows.
+    auto fresh = [&](int x) {
+      double v = 0;
+      for (int y = int(kY) - 4; y <= int(kY) + 4; ++y)
+        for (int z = 0; z < kDepth; ++z) {
+          const size_t id = (size_t(z) * kH + y) * kW + x;
+          if (!(f[0][id] > 0.f && f[5][id] >= c.params.grid.dry_threshold)) v += f[0][id];
+        }
+      return v / 9.0;
+    };
+    double before = 0, on = 0, past = 0;
+    for (int x = 50; x < kOn0; ++x) before += fresh(x) / (kOn0 - 50);
+    for (int x = kOn0; x < kOn1; ++x) on += fresh(x) / (kOn1 - kOn0);
+    for (int x = kOn1; x < kOn1 + 10; ++x) past = std::max(past, fresh(x));
+    std::printf("dried stroke %.1f cells high: new paint per column %.3f before it, %.3f on it, at most %.3f just past it\n",
+                H, before, on, past);
+    EXPECT_GT(before, 0.05) << "the brush paints the canvas";
+    EXPECT_GT(on, 0.6 * before) << "the brush paints the dried stroke " << H << " cells high";
+    EXPECT_LT(past, 4.0 * before) << "no paint pushed off the stroke's far edge";
+  }
+}
+
 }  // namespace
 // --- support ------------------------------------------------------------------------------------
 

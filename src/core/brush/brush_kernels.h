@@ -120,16 +120,30 @@ WB_HD WB_INLINE bool solid_cell(const SolidField& s, int cx, int cy, int cz) {
   return t.density[at] > 0.f && t.dryness_at(slot, at) * 65535.f >= s.dryness_threshold * 65535.f - 0.5f;
 }
 
+/// Top of the dried paint in cell (cx, cy, cz), the top of a run of dried cells: the paint fills
+/// the cell from below to its density (as the particles' and the transfer's dried surface reads
+/// it, column_solid_top and dried_density_at), so a half-filled top cell is a half-cell step, not
+/// a whole one. A whole-cell top held the bristles up to half a cell above the surface that the
+/// transfer measured their gap from, and a light brush laid nothing on such a stroke.
+WB_HD WB_INLINE float dried_top_of(const SolidField& s, int cx, int cy, int cz) {
+  const TileStoreView& t = s.tiles;
+  const int32_t slot = t.slot_of_tile[(cy / kTileSize) * t.tiles_x + cx / kTileSize];
+  const int64_t at = int64_t(slot) * t.tile_cells() + t.cell_offset(cx % kTileSize, cy % kTileSize, cz);
+  const float fill = t.density[at];
+  return float(cz) + (fill < 1.f ? fill : 1.f);
+}
+
 /// Height a point at x must be lifted to: 0 below the canvas plane, the top of the run of
-/// dried cells containing it when it is inside dried paint, else its own z (no contact).
+/// dried cells containing it when it is inside dried paint, else 0 (no contact above z = 0).
 WB_HD WB_INLINE float support_height(const SolidField& s, Vec3 x) {
   float h = 0.f;
   if (s.valid) {
     const int cx = floor_to_int(x.x), cy = floor_to_int(x.y);
     int cz = x.z < 0.f ? 0 : floor_to_int(x.z);
     if (solid_cell(s, cx, cy, cz)) {
-      while (cz < s.tiles.depth && solid_cell(s, cx, cy, cz)) ++cz;
-      h = float(cz);
+      while (cz + 1 < s.tiles.depth && solid_cell(s, cx, cy, cz + 1)) ++cz;
+      const float top = dried_top_of(s, cx, cy, cz);
+      if (x.z < top) h = top;
     }
   }
   return h;
@@ -144,7 +158,7 @@ WB_HD WB_INLINE float ground_below(const SolidField& s, Vec3 x, float reach) {
     const int top = floor_to_int(x.z) < s.tiles.depth - 1 ? floor_to_int(x.z) : s.tiles.depth - 1;
     const int bottom = floor_to_int(x.z - reach);
     for (int cz = top; cz >= bottom && cz >= 0; --cz)
-      if (solid_cell(s, cx, cy, cz)) return float(cz + 1);
+      if (solid_cell(s, cx, cy, cz)) return dried_top_of(s, cx, cy, cz);
   }
   return -1e30f;
 }

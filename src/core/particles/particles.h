@@ -50,7 +50,7 @@ void particles_compact_field(const Device& d, const uint32_t* src, uint32_t* dst
 /// density plus `particle_density` (the particles' raster, nullable) at or above liquid_threshold;
 /// where the layer near the bristles is mostly particles (§5.2), its grid density alone is air.
 void particles_solid_height(const Device& d, const PaintWindowView& pw, const float* particle_density,
-                            float dry_threshold, float liquid_threshold, float floor_z, float* height,
+                            float dry_threshold, float liquid_threshold, float floor_z, bool grid_cells, float* height,
                             float* wet_top = nullptr);
 /// The ground a particle in flight lands on, per window column (absolute canvas z): the solid's
 /// top (as `height` above), raised through the liquid cells (joint test) stacked on it up to the
@@ -76,7 +76,7 @@ void particles_init_scratch(const Device& d, const ParticleView& p, int64_t firs
   void particles_ground_surface(PaintWindowView pw, const float* particle_density, float dry_threshold,          \
                                 float liquid_threshold, float floor_z, float* surface);                          \
   void particles_solid_height(PaintWindowView pw, const float* particle_density, float dry_threshold,            \
-                              float liquid_threshold, float floor_z, float* height, float* wet_top);
+                              float liquid_threshold, float floor_z, bool grid_cells, float* height, float* wet_top);
 
 namespace cpu {
 WB_PARTICLES_BACKEND_DECLS

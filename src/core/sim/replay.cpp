@@ -41,29 +41,19 @@ Replay::Replay(Simulator& sim, StrokePlayer& player)
   poses_.reserve(size_t(std::max(1, player_.stroke().max_substeps)));
 }
 
-void Replay::apply_event(const StrokeEvent& e) {
-  PaintLoad well;
-  switch (e.kind) {
-    case StrokeEventKind::Dip:
-      well.ryb[0] = e.ryb[0], well.ryb[1] = e.ryb[1], well.ryb[2] = e.ryb[2];
-      well.oil = e.oil;
-      well.load = e.load;
-      sim_.dip(well);
-      break;
-    case StrokeEventKind::Wipe: sim_.wipe(e.fraction); break;
-    case StrokeEventKind::Clean: sim_.clean(); break;
-    case StrokeEventKind::Dry: sim_.dry_canvas(); break;
-  }
+void drive_step(Simulator& sim, const StrokePlayer& player, const PlayerStep& step, std::span<const StrokeEvent> events,
+                bool reload, std::vector<BrushPose>& poses) {
+  for (const StrokeEvent& e : events) sim.apply(e);
+  if (reload) sim.load_paint(player.stroke().paint);
+  poses.clear();
+  for (int k = 1; k <= step.substeps; ++k) poses.push_back(player.pose_at(StrokePlayer::substep_time(step, k)));
+  sim.step(poses.data(), step.substeps, float(step.dt));
 }
 
 bool Replay::advance() {
   PlayerStep step;
   if (!player_.next(step)) return false;
-  for (const StrokeEvent& e : step.events) apply_event(e);
-  if (step.pen_down_edge && player_.stroke().paint.reload_on_pen_down) sim_.load_paint(player_.stroke().paint);
-  poses_.clear();
-  for (int k = 1; k <= step.substeps; ++k) poses_.push_back(player_.pose_at(StrokePlayer::substep_time(step, k)));
-  sim_.step(poses_.data(), step.substeps, float(step.dt));
+  drive_step(sim_, player_, step, step.events, step.pen_down_edge && player_.stroke().paint.reload_on_pen_down, poses_);
   // A bristle is in contact when a sample is within one cell of the canvas or dried paint.
   if (recorded_ == int64_t(contacts_.size())) {  // sized for the player's step count: not reached
     contacts_.grow_keep(size_t(recorded_) + 1);

@@ -4,6 +4,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <span>
 #include <vector>
 
 #include "core/io/stroke_player.h"
@@ -17,6 +18,13 @@ struct CanvasRect {
   int x0 = 0, y0 = 0, width = 0, height = 0;
 };
 CanvasRect stroke_region(const Stroke& stroke);
+
+/// One step of a stroke through the simulator, the step driver of `wetbrush replay` and the
+/// studio: the palette events due in it, the pen-down reload (`reload`: the pen touches down in
+/// this step and the stroke's paint says reload_on_pen_down) with the player's stroke paint, the
+/// sub-step poses and Simulator::step. `poses` is the caller's scratch, reused between steps.
+void drive_step(Simulator& sim, const StrokePlayer& player, const PlayerStep& step, std::span<const StrokeEvent> events,
+                bool reload, std::vector<BrushPose>& poses);
 
 class Replay {
  public:
@@ -42,7 +50,6 @@ class Replay {
   std::vector<uint8_t> brush_image() const;
 
  private:
-  void apply_event(const StrokeEvent& e);
 
   Simulator& sim_;
   StrokePlayer& player_;

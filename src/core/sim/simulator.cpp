@@ -115,6 +115,22 @@ void Simulator::dip(const PaintLoad& paint) { books_.external(load_->dip(paint))
 void Simulator::wipe(float fraction) { books_.external(-load_->wipe(fraction)); }
 void Simulator::clean() { books_.external(-load_->clean()); }
 
+void Simulator::apply(const StrokeEvent& e) {
+  switch (e.kind) {
+    case StrokeEventKind::Dip: {
+      PaintLoad well;
+      for (int c = 0; c < 3; ++c) well.ryb[c] = e.ryb[c];
+      well.oil = e.oil;
+      well.load = e.load;
+      dip(well);
+      break;
+    }
+    case StrokeEventKind::Wipe: wipe(e.fraction); break;
+    case StrokeEventKind::Clean: clean(); break;
+    case StrokeEventKind::Dry: dry_canvas(); break;
+  }
+}
+
 void Simulator::dry_canvas() {
   settle();
   canvas_->dry_all();
@@ -154,7 +170,7 @@ std::array<float, 4> Simulator::samples_box() {
   // brush's half width around where its tips meet the canvas), in the same copy.
   const ParticleParams& pp = config_.params.particles;
   particles_solid_height(device(), win.paint().view(), nullptr, config_.params.grid.dry_threshold,
-                         config_.params.grid.liquid_threshold, pp.floor_z, solid_height_.data());
+                         config_.params.grid.liquid_threshold, pp.floor_z, false, solid_height_.data());
   const Vec3 tip = footprint_centre(brush_->pose(), config_.brush.length);
   joint_ground_under(device(), solid_height_.data(), wn.x, wn.y, o.x, o.y, tip.x, tip.y,
                      0.5f * std::max(config_.brush.width, config_.brush.thickness), pp.floor_z, extent_scratch_.data());
@@ -424,7 +440,7 @@ void Simulator::particle_stage(float dt) {
   joint_scale(device(), raster_mass_.data(), raster_density_.data(), int64_t(raster_mass_.size()),
               1.f / transfer_->params().cell_mass());
   particles_solid_height(device(), win.paint().view(), raster_density_.data(), config_.params.grid.dry_threshold,
-                         config_.params.grid.liquid_threshold, prm.floor_z, solid_height_.data(), wet_top_.data());
+                         config_.params.grid.liquid_threshold, prm.floor_z, true, solid_height_.data(), wet_top_.data());
   SolidView solid;
   solid.floor_z = prm.floor_z;
   solid.height = solid_height_.data();

@@ -95,6 +95,8 @@ class Simulator {
   void dip(const PaintLoad& paint);         ///< dip a dirty brush into a well
   void wipe(float fraction);
   void clean();
+  /// A palette event of a stroke file or the studio: dip, wipe, clean or dry (the one mapping).
+  void apply(const StrokeEvent& e);
 
   /// "Let it dry": flushes the window, dries every painted cell of the canvas, reloads.
   void dry_canvas();
