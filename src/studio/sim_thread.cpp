@@ -360,14 +360,6 @@ void SimThread::run_step(const PlayerStep& step) {
   drive_step(sim, *player_, step, events, edge && rec_.paint.reload_on_pen_down, poses_);
   for (const StrokeEvent& e : events)
     if (e.kind == StrokeEventKind::Dry) invalidate_all();
-  if (wall_now() - t > 0.1) {  // DEBUG
-    std::string o;
-    for (const auto& nm : sim.profiler().names()) {
-      const auto& v = sim.profiler().samples(nm);
-      if (!v.empty() && v.back() > 5.0) o += nm + "=" + std::to_string(int(v.back())) + " ";
-    }
-    std::fprintf(stderr, "SLOW step %.0f ms substeps %d: %s\n", (wall_now() - t) * 1e3, step.substeps, o.c_str());
-  }
   lap(times_.step, t);
   // Paint changes only inside the active window (where it was and where it moved to).
   const Int3 o = sim.live_window()->origin(), n = sim.live_window()->dims();
