@@ -372,12 +372,17 @@ TEST_F(LayerPropertiesTest, LightBrushPaintsOnADriedStrokeWhateverItsHeight) {
   // paint: the stroke took nothing and a pile formed past its edge. docs/TRANSFER.md.)
   constexpr int kW = 192, kH = 64, kOn0 = 80, kOn1 = 100;
   constexpr float kX0 = 24.f, kX1 = 152.f;
-  for (const float H : {1.2f, 1.5f, 2.f, 2.5f}) {
+  // The last: a 2.5-cell stroke under the dried trace of its wet top (0.06 and 0.02 of a cell in
+  // the two cells above), as a stroke that dried leaves it.
+  for (const float H : {1.2f, 1.5f, 2.f, 2.5f, -2.5f}) {
     SimConfig c = layer_config(CanvasDims{kW, kH, kDepth});
     Simulator sim(c, pose_at(c.brush, kX0, kY, 0.f, false));
     write_layer(sim, [&](int x, int, int z) {
       PaintCell p;
-      const float d = x >= kOn0 && x < kOn1 ? std::clamp(H - float(z), 0.f, 1.f) : 0.f;
+      const float top = std::abs(H);
+      float d = x >= kOn0 && x < kOn1 ? std::clamp(top - float(z), 0.f, 1.f) : 0.f;
+      if (H < 0.f && x >= kOn0 && x < kOn1 && z == 3) d = 0.06f;
+      if (H < 0.f && x >= kOn0 && x < kOn1 && z == 4) d = 0.02f;
       if (d > 0.f) p.density = d, p.pigment_r = 0.1f, p.pigment_y = 0.15f, p.pigment_b = 0.85f, p.oil = 0.3f, p.dryness = 1.f;
       return p;
     });
@@ -402,8 +407,8 @@ TEST_F(LayerPropertiesTest, LightBrushPaintsOnADriedStrokeWhateverItsHeight) {
     for (int x = 50; x < kOn0; ++x) before += fresh(x) / (kOn0 - 50);
     for (int x = kOn0; x < kOn1; ++x) on += fresh(x) / (kOn1 - kOn0);
     for (int x = kOn1; x < kOn1 + 10; ++x) past = std::max(past, fresh(x));
-    std::printf("dried stroke %.1f cells high: new paint per column %.3f before it, %.3f on it, at most %.3f just past it\n",
-                H, before, on, past);
+    std::printf("dried stroke %.1f cells high%s: new paint per column %.3f before it, %.3f on it, at most %.3f just past it\n",
+                std::abs(H), H < 0.f ? " under a dried trace" : "", before, on, past);
     EXPECT_GT(before, 0.05) << "the brush paints the canvas";
     EXPECT_GT(on, 0.6 * before) << "the brush paints the dried stroke " << H << " cells high";
     EXPECT_LT(past, 4.0 * before) << "no paint pushed off the stroke's far edge";

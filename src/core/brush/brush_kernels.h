@@ -108,7 +108,7 @@ WB_HD WB_INLINE int floor_to_int(float v) {
   return f < -1e9f ? -1000000000 : (f > 1e9f ? 1000000000 : int(f));
 }
 
-/// True when canvas cell (cx, cy, cz) holds dried paint (density > 0, dryness >= threshold).
+/// True when canvas cell (cx, cy, cz) is dried paint the brush rests on (dried_solid).
 WB_HD WB_INLINE bool solid_cell(const SolidField& s, int cx, int cy, int cz) {
   if (!s.valid) return false;
   const TileStoreView& t = s.tiles;
@@ -117,7 +117,7 @@ WB_HD WB_INLINE bool solid_cell(const SolidField& s, int cx, int cy, int cz) {
   if (slot < 0) return false;
   const int64_t at = int64_t(slot) * t.tile_cells() + t.cell_offset(cx % kTileSize, cy % kTileSize, cz);
   // With the drying the tile has not stored yet (TileStoreView::dryness_at), on the 16-bit lattice.
-  return t.density[at] > 0.f && t.dryness_at(slot, at) * 65535.f >= s.dryness_threshold * 65535.f - 0.5f;
+  return t.density[at] >= kSolidDensity && t.dryness_at(slot, at) * 65535.f >= s.dryness_threshold * 65535.f - 0.5f;
 }
 
 /// Top of the dried paint in cell (cx, cy, cz), the top of a run of dried cells: the paint fills

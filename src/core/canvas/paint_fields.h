@@ -2,6 +2,7 @@
 // density, dryness), listed once. The list generates the dense window's buffers,
 // its POD view, the tile encoding and the document serialisation.
 #pragma once
+#include "core/exec/hd.h"
 
 // X(name, description)
 #define WB_PAINT_FIELDS(X)                                                            \
@@ -16,6 +17,17 @@ namespace wb {
 
 /// Number of fields in WB_PAINT_FIELDS.
 inline constexpr int kPaintFieldCount = 6;
+
+/// Dried paint is solid (§4.2 "we treat it as a solid cell") where a cell holds at least this much
+/// of it: the level at which the grid counts paint as liquid and the renderer and the transfer find
+/// its surface. A cell with less (the dried trace of a wet stroke's thin top and edges, often a few
+/// hundredths) lies above that surface; counted solid as a whole, it held the brush, the particles
+/// and the grid's wet paint up to a cell above the dried surface (docs/TRANSFER.md "The brush on
+/// dried paint"). One rule for the grid, the particles, the transfer and the brush.
+inline constexpr float kSolidDensity = 0.5f;
+WB_HD WB_INLINE bool dried_solid(float density, float dryness, float dry_threshold) {
+  return density >= kSolidDensity && dryness >= dry_threshold;
+}
 
 /// One cell's paint, decoded (host-side helper type for tests, I/O and probes).
 struct PaintCell {

@@ -8,18 +8,18 @@
 
 #include <cstdint>
 
+#include "core/canvas/paint_fields.h"
 #include "core/grid/grid_fields.h"
 #include "core/math/vec.h"
 
 namespace wb {
 
-/// Cell class from paint and canvas: solid when off the canvas or dried (density > 0 and
-/// dryness >= threshold, §4.2 "we treat it as a solid cell"), liquid when density >=
-/// the liquid threshold, else air.
+/// Cell class from paint and canvas: solid when off the canvas or dried (dried_solid, §4.2 "we
+/// treat it as a solid cell"), liquid when density >= the liquid threshold, else air.
 WB_HD WB_INLINE uint8_t classify_cell(float density, float dryness, bool on_canvas, float liquid_threshold,
                                       float dry_threshold) {
   if (!on_canvas) return kCellSolid;
-  if (density > 0.f && dryness >= dry_threshold) return kCellSolid;
+  if (dried_solid(density, dryness, dry_threshold)) return kCellSolid;
   return density >= liquid_threshold ? kCellLiquid : kCellAir;
 }
 

@@ -86,7 +86,7 @@ WB_HD WB_INLINE float column_solid_top(const PaintWindowView& pw, int64_t c, flo
   for (int k = pw.nz - 1; k >= 0; --k) {
     const int64_t id = int64_t(k) * layer + c;
     const float rho = pw.density[id];
-    if (rho > 0.f && pw.dryness[id] >= dry_threshold) {
+    if (dried_solid(rho, pw.dryness[id], dry_threshold)) {
       above = k + 1;
       return maxf(floor_z, float(pw.oz + k) + minf(rho, 1.f));
     }

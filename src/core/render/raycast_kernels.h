@@ -30,12 +30,17 @@ struct SplatView {
 inline constexpr int kTopBlock = 8;  ///< cells per side of a block of the coarse top map
 
 /// The paint of one column taken as a film lying on the canvas: its thickness is the column
-/// integral of density (paint volume per unit area), its paint the density-weighted mean (kept
-/// for thin columns only, thin > 0: thick paint is never read as a film).
+/// integral of density (paint volume per unit area), its paint the density-weighted mean (for
+/// thin columns, thin > 0). A thick column's paint above its densest top, too thin to reach the
+/// threshold on its own (a scumble on dried paint, a glaze on a stroke), is a coat lying on it:
+/// `coat` is the height of the column's paint stacked from the bottom of its top thick cell, and
+/// the colour fields hold the coat's paint.
 struct FilmColumn {
   float height;                    ///< sum of the column's densities, cells
-  uint16_t r, y, b, oil, dryness;  ///< unorm16, as in the tiles; 0 in thick columns
+  uint16_t r, y, b, oil, dryness;  ///< unorm16, as in the tiles: the film's paint, or the coat's
   uint16_t thin;                   ///< column_thinness of its densest cell, unorm16
+  uint16_t coated;                 ///< 1: a thick column with paint above its top thick cell
+  float coat;                      ///< thick columns: the paint stacked from the bottom of the top thick cell, cells
 };
 
 /// Everything the ray caster reads: tiles, the optional live window and particle splat
@@ -200,7 +205,7 @@ WB_HD WB_INLINE PaintSample sample_paint(const RenderVolume& v, Vec3 p) {
 /// Film record of column (x, y); none off the map (no ray of the rendered tiles samples there).
 WB_HD WB_INLINE FilmColumn column_film(const RenderVolume& v, int x, int y) {
   const int lx = x - v.top_x0, ly = y - v.top_y0;
-  if (!v.film || lx < 0 || ly < 0 || lx >= v.top_w || ly >= v.top_h) return FilmColumn{0.f, 0, 0, 0, 0, 0, 0};
+  if (!v.film || lx < 0 || ly < 0 || lx >= v.top_w || ly >= v.top_h) return FilmColumn{0.f, 0, 0, 0, 0, 0, 0, 0, 0.f};
   return v.film[int64_t(ly) * v.top_w + lx];
 }
 
@@ -215,13 +220,17 @@ struct FilmSample {
   float height;  ///< film height F, cells
   float thin;    ///< the columns' thinness, weighted by their paint (bare columns do not vote)
   PaintSample paint;  ///< the columns' mean paint, weighted by their paint (when asked for)
+  /// Where a column near holds a coat: the height of the paint stacked in the columns (a thick
+  /// column's coat top, a thin one's film, 0 bare), and the coats' paint (when asked for).
+  float coat;
+  PaintSample coat_paint;
 };
 WB_HD WB_INLINE FilmSample film_at(const RenderVolume& v, float x, float y, bool with_paint) {
   const float fx = x - 0.5f, fy = y - 0.5f;
   const float flx = floorf(fx), fly = floorf(fy);
   const int ix = int(flx), iy = int(fly);
   const float ax = fx - flx, ay = fy - fly;
-  FilmSample f{0.f, 0.f, PaintSample{Vec3(0.f, 0.f, 0.f), 0.f, 0.f, 0.f}};
+  FilmSample f{0.f, 0.f, PaintSample{Vec3(0.f, 0.f, 0.f), 0.f, 0.f, 0.f}, 0.f, PaintSample{Vec3(0.f, 0.f, 0.f), 0.f, 0.f, 0.f}};
   // Thick paint and bare canvas all around (the block map says so): no film, thin = 0, exactly
   // what the four columns would give. Blocks off the map are not trusted.
   if (v.block_film) {
@@ -231,10 +240,22 @@ WB_HD WB_INLINE FilmSample film_at(const RenderVolume& v, float x, float y, bool
       if (bx < v.blk_w && by < v.blk_h && !v.block_film[by * v.blk_w + bx]) return f;
     }
   }
+  float stack = 0.f, wc = 0.f;
+  bool coated = false;
   for (int c = 0; c < 4; ++c) {
     const float w = ((c & 1) ? ax : 1.f - ax) * ((c & 2) ? ay : 1.f - ay);
     if (w <= 0.f) continue;
     const FilmColumn k = column_film(v, ix + (c & 1), iy + (c >> 1));
+    stack += w * (k.coat > 0.f ? k.coat : (k.thin != 0 ? k.height : 0.f));
+    if (k.coated) {
+      coated = true;
+      wc += w;
+      if (with_paint) {
+        f.coat_paint.ryb += Vec3(decode_unorm16(k.r), decode_unorm16(k.y), decode_unorm16(k.b)) * w;
+        f.coat_paint.oil += decode_unorm16(k.oil) * w;
+        f.coat_paint.dryness += decode_unorm16(k.dryness) * w;
+      }
+    }
     const float wd = w * k.height;
     if (!(wd > 0.f)) continue;
     f.height += wd;
@@ -256,6 +277,15 @@ WB_HD WB_INLINE FilmSample film_at(const RenderVolume& v, float x, float y, bool
     f.thin /= f.height;
     f.paint.density = f.height;
   }  // no paint in these columns: thin = 0 leaves the volume's density (of paint off the map)
+  if (coated) {
+    f.coat = stack;
+    if (with_paint) {
+      const float s = 1.f / wc;
+      f.coat_paint.ryb = f.coat_paint.ryb * s;
+      f.coat_paint.oil *= s;
+      f.coat_paint.dryness *= s;
+    }
+  }
   return f;
 }
 
@@ -271,22 +301,39 @@ WB_HD WB_INLINE float film_density(const RenderParams& P, float F, float z) {
 
 /// Density as the surface sees it: the film's where the paint is thin, the volume's where it is
 /// thick, blended by thinness between. Films lie below z_top_max (tops count them).
+/// A coat lies on thick paint: the solid is the volume's or the paint stacked in the columns,
+/// whichever is higher (where nothing is above the thick top, the stack is at or below the
+/// volume's threshold surface and changes nothing).
 WB_HD WB_INLINE float surface_density(const RenderVolume& v, const RenderParams& P, Vec3 p) {
   if (p.z >= float(v.z_top_max) + P.threshold) return sample_density(v, p);
   const FilmSample f = film_at(v, p.x, p.y, false);
   const float df = film_density(P, f.height, p.z);
   if (f.thin >= 1.f) return df;
   const float d = sample_density(v, p);
-  if (f.thin <= 0.f) return d;
-  return f.thin * df + (1.f - f.thin) * d;
+  const float dv = f.thin <= 0.f ? d : f.thin * df + (1.f - f.thin) * d;
+  return f.coat > 0.f ? maxf(dv, film_density(P, f.coat, p.z)) : dv;
+}
+
+/// Paint of the coat where it is what the surface sees (its density over the volume's).
+WB_HD WB_INLINE PaintSample with_coat(const RenderParams& P, const FilmSample& f, Vec3 p, PaintSample k) {
+  if (!(f.coat > 0.f)) return k;
+  const float dc = film_density(P, f.coat, p.z);
+  if (!(dc > k.density)) return k;
+  const float wk = k.density, wc = dc - k.density;
+  PaintSample out;
+  out.ryb = (k.ryb * wk + f.coat_paint.ryb * wc) / dc;
+  out.oil = (k.oil * wk + f.coat_paint.oil * wc) / dc;
+  out.dryness = (k.dryness * wk + f.coat_paint.dryness * wc) / dc;
+  out.density = dc;
+  return out;
 }
 
 /// Paint as the surface sees it: the film's and the volume's paint mixed by their shares of
-/// surface_density (density = that).
+/// surface_density (density = that), and a coat's where it lies on thick paint.
 WB_HD WB_INLINE PaintSample surface_paint(const RenderVolume& v, const RenderParams& P, Vec3 p) {
   if (p.z >= float(v.z_top_max) + P.threshold) return sample_paint(v, p);
   const FilmSample f = film_at(v, p.x, p.y, true);
-  if (f.thin <= 0.f) return sample_paint(v, p);
+  if (f.thin <= 0.f) return with_coat(P, f, p, sample_paint(v, p));
   PaintSample k = f.paint;
   const float wf = f.thin * film_density(P, f.height, p.z);
   k.density = wf;
@@ -298,7 +345,7 @@ WB_HD WB_INLINE PaintSample surface_paint(const RenderVolume& v, const RenderPar
   k.oil = (f.paint.oil * wf + s.oil * wv) / wt;
   k.dryness = (f.paint.dryness * wf + s.dryness * wv) / wt;
   k.density = wt;
-  return k;
+  return with_coat(P, f, p, k);
 }
 
 /// Share of the ground that paint F cells thick hides (Beer–Lambert): the ground shows through

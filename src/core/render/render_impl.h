@@ -44,11 +44,35 @@ void render_top_map(RenderVolume v, RenderParams P, int x0, int y0, int w, int h
         dmax = d > dmax ? d : dmax;
       }
     }
-    FilmColumn f{sum, 0, 0, 0, 0, 0, 0};
+    FilmColumn f{sum, 0, 0, 0, 0, 0, 0, 0, 0.f};
     const float thin = column_thinness(P, dmax);
-    if (sum > 0.f && thin > 0.f) {
+    // A thick column: its top thick cell (density at the threshold or more) and the paint above it.
+    int kt = -1;
+    float above = 0.f, dt = 0.f, dry_above = 0.f, dry_top = 0.f;
+    if (sum > 0.f && !(thin > 0.f)) {
+      for (int z = t - 1; z >= 0; --z) {
+        const RenderCell c = tiles_only ? RenderCell{v.tiles.density[a0 + z * dz], 0.f, 0.f, 0.f, 0.f,
+                                                     v.tiles.dryness_at(slot, a0 + z * dz)}
+                                        : cell_full_raw(v, x, y, z);
+        if (c.density >= P.threshold) {
+          kt = z;
+          dt = c.density;
+          dry_top = c.dryness;
+          break;
+        }
+        if (c.density > 0.f) above += c.density, dry_above += c.density * c.dryness;
+      }
+    }
+    // A coat is wet paint on dried (or drying) paint: a layer of its own, which the grid keeps in
+    // the cells above the dried ones. Paint above a wet top is that top's own surface, partly
+    // filled cells the threshold surface already passes through.
+    const bool coat = kt >= 0 && above > 0.f && dry_top - dry_above / above >= 0.5f;
+    if (sum > 0.f && (thin > 0.f || coat)) {
+      // The film's paint (a thin column: all of it) or the coat's (the cells above kt).
+      const int z0 = coat ? kt + 1 : 0;
+      const float total = coat ? above : sum;
       float r = 0.f, yy = 0.f, b = 0.f, oil = 0.f, dry = 0.f;
-      for (int z = 0; z < t; ++z) {
+      for (int z = z0; z < t; ++z) {
         RenderCell c;
         if (tiles_only) {
           const int64_t a = a0 + z * dz;
@@ -69,10 +93,14 @@ void render_top_map(RenderVolume v, RenderParams P, int x0, int y0, int w, int h
         oil += c.density * c.oil;
         dry += c.density * c.dryness;
       }
-      const float s = 1.f / sum;
+      const float s = 1.f / total;
       f = FilmColumn{sum, encode_unorm16(r * s), encode_unorm16(yy * s), encode_unorm16(b * s),
-                     encode_unorm16(oil * s), encode_unorm16(dry * s), encode_unorm16(thin)};
+                     encode_unorm16(oil * s), encode_unorm16(dry * s), encode_unorm16(thin), 0, 0.f};
+      if (coat) f.coated = 1;
     }
+    // Every thick column's stack (the paint from the bottom of its top thick cell): a coat's
+    // neighbours give its edge their own height.
+    if (kt >= 0) f.coat = float(kt) + (dt < 1.f ? dt : 1.f) + above;
     // Densities above 1 pack more paint than the cells hold: rays must start above that film.
     const int tf = int(ceilf(sum));
     t = tf > t ? tf : t;
@@ -93,13 +121,13 @@ void render_block_top(const uint16_t* top, const FilmColumn* film, int w, int h,
       }
     blocks[i] = m;
     // A film sample at a point reads the columns up to one past the block of its lower corner:
-    // the flag looks one column beyond the block on every side.
+    // the flag (a film or a coat near) looks one column beyond the block on every side.
     uint8_t any = 0;
     for (int y = by * kTopBlock - 1; y <= (by + 1) * kTopBlock && !any; ++y)
       for (int x = bx * kTopBlock - 1; x <= (bx + 1) * kTopBlock; ++x) {
         if (x < 0 || y < 0 || x >= w || y >= h) continue;
         const FilmColumn& f = film[int64_t(y) * w + x];
-        if (f.thin != 0 && f.height > 0.f) {
+        if ((f.thin != 0 && f.height > 0.f) || f.coat > 0.f) {
           any = 1;
           break;
         }

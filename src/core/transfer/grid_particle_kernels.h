@@ -20,9 +20,9 @@ inline constexpr float kFarDistance2 = 1e20f;
 WB_HD WB_INLINE int imax_t(int a, int b) { return a > b ? a : b; }
 WB_HD WB_INLINE int imin_t(int a, int b) { return a < b ? a : b; }
 
-/// Dried paint is solid: it neither becomes particles nor receives them (§4.2 "dryness").
+/// Dried paint is solid (dried_solid): it neither becomes particles nor receives them (§4.2 "dryness").
 WB_HD WB_INLINE bool cell_is_solid(float density, float dryness, float dry_threshold) {
-  return density > 0.f && dryness >= dry_threshold;
+  return dried_solid(density, dryness, dry_threshold);
 }
 
 /// A cell-centred window scalar field (cell (i,j,k) centre at (i+1/2, j+1/2, k+1/2)).

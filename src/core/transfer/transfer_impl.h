@@ -436,7 +436,8 @@ void transfer_grid_count(PaintWindowView pw, DistanceBlocks db, KeepBox keep, Tr
   parallel_for(pw.size(), [=] WB_HD(int64_t c) {
     count[c] = 0u;
     const float rho = pw.density[c];
-    if (!(rho > 0.f) || rho < min_rho || cell_is_solid(rho, pw.dryness[c], dry_threshold)) return;
+    // Dried paint, solid or a thin trace, stays on the canvas (the brush does not re-wet it).
+    if (!(rho > 0.f) || rho < min_rho || pw.dryness[c] >= dry_threshold) return;
     const int i = int(c % pw.nx), j = int((c / pw.nx) % pw.ny), k = int(c / (int64_t(pw.nx) * pw.ny));
     // Paint outside the keep box stays grid paint: particles there would go straight back.
     if (!keep.contains(i, j, k) || !db.near(Vec3(float(i) + 0.5f, float(j) + 0.5f, float(k) + 0.5f))) return;
