@@ -41,6 +41,7 @@ struct FilmColumn {
   uint16_t thin;                   ///< column_thinness of its densest cell, unorm16
   uint16_t coated;                 ///< 1: a thick column with paint above its top thick cell
   float coat;                      ///< thick columns: the paint stacked from the bottom of the top thick cell, cells
+  float coat_thick;                ///< coated columns: the coat's own paint, cells
 };
 
 /// Everything the ray caster reads: tiles, the optional live window and particle splat
@@ -205,7 +206,7 @@ WB_HD WB_INLINE PaintSample sample_paint(const RenderVolume& v, Vec3 p) {
 /// Film record of column (x, y); none off the map (no ray of the rendered tiles samples there).
 WB_HD WB_INLINE FilmColumn column_film(const RenderVolume& v, int x, int y) {
   const int lx = x - v.top_x0, ly = y - v.top_y0;
-  if (!v.film || lx < 0 || ly < 0 || lx >= v.top_w || ly >= v.top_h) return FilmColumn{0.f, 0, 0, 0, 0, 0, 0, 0, 0.f};
+  if (!v.film || lx < 0 || ly < 0 || lx >= v.top_w || ly >= v.top_h) return FilmColumn{0.f, 0, 0, 0, 0, 0, 0, 0, 0.f, 0.f};
   return v.film[int64_t(ly) * v.top_w + lx];
 }
 
@@ -223,7 +224,7 @@ struct FilmSample {
   /// Where a column near holds a coat: the height of the paint stacked in the columns (a thick
   /// column's coat top, a thin one's film, 0 bare), and the coats' paint (when asked for).
   float coat;
-  PaintSample coat_paint;
+  PaintSample coat_paint;  ///< density: the coats' own thickness, cells
 };
 WB_HD WB_INLINE FilmSample film_at(const RenderVolume& v, float x, float y, bool with_paint) {
   const float fx = x - 0.5f, fy = y - 0.5f;
@@ -250,6 +251,7 @@ WB_HD WB_INLINE FilmSample film_at(const RenderVolume& v, float x, float y, bool
     if (k.coated) {
       coated = true;
       wc += w;
+      f.coat_paint.density += k.coat_thick * w;
       if (with_paint) {
         f.coat_paint.ryb += Vec3(decode_unorm16(k.r), decode_unorm16(k.y), decode_unorm16(k.b)) * w;
         f.coat_paint.oil += decode_unorm16(k.oil) * w;
@@ -279,6 +281,7 @@ WB_HD WB_INLINE FilmSample film_at(const RenderVolume& v, float x, float y, bool
   }  // no paint in these columns: thin = 0 leaves the volume's density (of paint off the map)
   if (coated) {
     f.coat = stack;
+    f.coat_paint.density /= wc;
     if (with_paint) {
       const float s = 1.f / wc;
       f.coat_paint.ryb = f.coat_paint.ryb * s;
@@ -494,6 +497,16 @@ WB_HD WB_INLINE RayHit cast_ray(const RenderVolume& v, const RenderParams& P, Ve
     if (h.cover < 1.f) {
       h.albedo = lerp(P.paper_rgb, h.albedo, h.cover);
       h.ryb = lerp(P.paper_ryb, h.ryb, h.cover);
+    }
+    // A coat on dried paint hides the paint under it as a film hides the canvas (film_cover of
+    // its own thickness), wherever the ray meets the coat rather than the paint beside it.
+    const float ct = f.coat_paint.density;
+    if (f.coat > 0.f && ct > 0.f && h.pos.z > f.coat - ct) {
+      const FilmSample fc = film_at(v, h.pos.x, h.pos.y, true);
+      const Vec3 under = sample_paint(v, Vec3(h.pos.x, h.pos.y, maxf(f.coat - ct - 0.5f, 0.f))).ryb;
+      const float cov = film_cover(P, ct);
+      h.ryb = lerp(under, fc.coat_paint.ryb, cov);
+      h.albedo = lerp(ryb_to_rgb(under), ryb_to_rgb(fc.coat_paint.ryb), cov);
     }
     return h;
   }
