@@ -32,7 +32,6 @@
 #include "core/exec/error.h"
 #include "core/io/material_maps.h"
 #include "core/io/png.h"
-#include "studio/sim_paint.h"
 
 namespace wb::studio {
 namespace {
@@ -502,7 +501,7 @@ bool MainWindow::write_snapshot(const QString& path, bool wait, bool user_save) 
   sim_->post([done, file, from_blank](SimThread& s) {
     try {
       // The paint at rest, with what is in flight now; the simulation goes on unchanged.
-      auto copy = std::make_shared<TileStore>(settled_canvas_copy(s.sim()));
+      auto copy = std::make_shared<TileStore>(s.sim().settled_canvas_copy(Device{}));
       auto image = std::make_shared<Image>(s.canvas_image());
       const Vec3 paper = s.renderer().params().paper_rgb;
       nlohmann::json meta = {{"generator", "wetbrush-studio"},
@@ -643,7 +642,7 @@ bool MainWindow::export_maps(const QString& height_path, const QString& normal_p
   const std::string hp = height_path.toStdString(), np = normal_path.toStdString();
   sim_->post([done, hp, np](SimThread& s) {
     try {
-      TileStore canvas = settled_canvas_copy(s.sim(), s.sim().device());
+      TileStore canvas = s.sim().settled_canvas_copy(s.sim().device());
       write_material_maps(s.sim().device(), canvas, MaterialMapPaths{hp, np, ""});
       done->set_value("");
     } catch (const std::exception& e) {

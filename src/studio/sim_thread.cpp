@@ -8,7 +8,6 @@
 #include "core/color/ryb.h"
 #include "core/exec/error.h"
 #include "core/sim/replay.h"
-#include "studio/sim_paint.h"
 
 namespace wb::studio {
 namespace {
@@ -173,7 +172,7 @@ void SimThread::rebuild(const SimConfig& config, bool keep_canvas) {
   rest.position = Vec3(config.canvas.width * 0.5f, config.canvas.height * 0.5f, config.brush.length * 1.5f);
   sim_ = std::make_unique<Simulator>(config_, rest);
   if (keep_canvas && same_dims) {
-    const TileStore kept = settled_canvas_copy(*old);  // with the paint that was in flight
+    const TileStore kept = old->settled_canvas_copy(Device{});  // with the paint that was in flight
     for (int id : kept.allocated_tile_ids()) sim_->canvas().write_tile(kept.read_tile(id));
   }
   old.reset();
@@ -222,8 +221,7 @@ void SimThread::restart_recording(bool from_blank) {
 
 void SimThread::canvas_written() {
   if (!sim_) return;
-  reload_window(*sim_);
-  drop_particles(*sim_);
+  sim_->canvas_replaced();
   undo_rec_.reset();
   stroke_open_ = false;
 }
@@ -389,7 +387,7 @@ void SimThread::finish_stroke() {
   // as they are at rest now, so that its undo returns to exactly this canvas.
   auto diff = std::make_shared<TileDiff>();
   const Int3 o = sim_->live_window()->origin(), n = sim_->live_window()->dims();
-  with_settled_canvas(*sim_, [&](TileStore& c) {
+  sim_->with_settled_canvas([&](TileStore& c) {
     *diff = undo_rec_.finish(c);
     undo_rec_.capture_rect(c, o.x, o.y, o.x + n.x, o.y + n.y);
   });
@@ -440,7 +438,7 @@ void SimThread::publish_status(bool force) {
     const double med = sim_->profiler().median_ms("sim.step");
     if (med > 0) status_.step_ms = med;
     sim_->profiler().clear();  // bounded memory over a long session
-    status_.particles = particle_count(*sim_);
+    status_.particles = sim_->particle_count();
   }
   status_.steps = steps_;
   status_.times = times_;

@@ -67,6 +67,60 @@ TEST_F(SimulatorTest, BrushPictureIsTheBrushsPaintAndPose) {
   EXPECT_EQ(sim.brush_picture().amount, 0.f);
 }
 
+// Files, exports and undo see the settled canvas (particles returned by Eq. 16); taking it leaves
+// the simulation exactly as it was. A canvas written from outside drops the paint in flight and
+// the books record it.
+TEST_F(SimulatorTest, SettledCanvasLeavesTheSimulationAsItWasAndReplacedCanvasIsBooked) {
+  const SimConfig c = small_config();
+  Simulator a(c, pose_at(c.brush, 120, 128, 0.f, false)), b(c, pose_at(c.brush, 120, 128, 0.f, false));
+  for (Simulator* s : {&a, &b}) s->load_paint(red());
+  auto stroke = [&](Simulator& s, int i0, int i1) {
+    for (int i = i0; i < i1; ++i) s.step(pose_at(c.brush, 120.f + 2.f * i, 128.f, 0.8f), 1.f / 60.f);
+  };
+  stroke(a, 0, 8);
+  stroke(b, 0, 8);
+  ASSERT_GT(a.particle_count(), 0) << "paint in flight";
+  const int64_t in_flight = a.particle_count();
+  const auto window_before = a.live_window()->to_host();
+  const ParticleHost particles_before = a.particles().to_host();
+  const double canvas_before = a.canvas().total_density();
+  const double mass_before = a.census().total();
+  const TileStore copy = a.settled_canvas_copy(Device{});
+  // Exactly as it was: the window, every particle, the canvas and the books' view of them.
+  EXPECT_EQ(a.live_window()->to_host(), window_before);
+  const ParticleHost particles_after = a.particles().to_host();
+  ASSERT_EQ(particles_after.size(), particles_before.size());
+  for (size_t k = 0; k < particles_before.size(); ++k) {
+    ASSERT_EQ(particles_after.x[k].x, particles_before.x[k].x);
+    ASSERT_EQ(particles_after.m[k], particles_before.m[k]);
+  }
+  // (the canvas's running sum adds and takes back the same paint: equal to rounding)
+  EXPECT_NEAR(a.canvas().total_density(), canvas_before, 1e-9 * canvas_before);
+  EXPECT_NEAR(a.census().total(), mass_before, 1e-9 * mass_before);
+  const PaintCensus census = a.census();
+  const double cell_mass = c.params.transfer.cell_mass();
+  EXPECT_NEAR(copy.total_density() * cell_mass, census.grid + census.particles, 1e-6 * census.total())
+      << "the settled canvas holds the paint on the canvas and in flight";
+  EXPECT_EQ(a.particle_count(), in_flight) << "taking it leaves the particles";
+  // And it goes on as one that took no copy (within the run-to-run spread of parallel sums).
+  stroke(a, 8, 12);
+  stroke(b, 8, 12);
+  EXPECT_NEAR(double(a.particle_count()), double(b.particle_count()), 0.01 * double(b.particle_count()));
+  EXPECT_NEAR(a.census().grid, b.census().grid, 1e-3 * b.census().total());
+  EXPECT_NEAR(a.census().bristles, b.census().bristles, 1e-3 * b.census().total());
+  // Undo writes a tile back under the window: the paint in flight goes, and the books say so.
+  const PaintCensus before = a.census();
+  a.flush_window();
+  TileData t = a.canvas().read_tile((128 / kTileSize) * a.canvas().tiles_x() + 130 / kTileSize);
+  std::fill(t.density.begin(), t.density.end(), 0.f);  // as an undo to the blank canvas writes it
+  a.canvas().write_tile(t);
+  a.canvas_replaced();
+  EXPECT_EQ(a.particle_count(), 0);
+  stroke(a, 12, 14);
+  EXPECT_LT(std::abs(a.books().max_drift()), 1e-4) << "dropped " << before.particles << " kg in flight";
+  EXPECT_EQ(a.counters().nonfinite_events, 0);
+}
+
 TEST_F(SimulatorTest, PressedLoadedBrushPaintsUnderItsFootprintAndBooksClose) {
   const SimConfig c = small_config();
   const float cx = 128.f, cy = 128.f;

@@ -40,7 +40,6 @@
 #include "core/io/stroke.h"
 #include "studio/demo.h"
 #include "studio/main_window.h"
-#include "studio/sim_paint.h"
 
 using namespace wb;
 using namespace wb::studio;
@@ -76,7 +75,7 @@ std::vector<float> column_density(TileStore& c) {
 /// Column paint of the studio's canvas with its paint at rest.
 std::vector<float> column_density(MainWindow& w) {
   return on_sim(w, [](SimThread& s) {
-    TileStore c = settled_canvas_copy(s.sim());
+    TileStore c = s.sim().settled_canvas_copy(Device{});
     return column_density(c);
   });
 }
@@ -100,7 +99,7 @@ std::vector<uint8_t> canonical_volume(TileStore& c, bool with_dryness = true) {
 /// the paint alone (the painting keeps drying while it is painted and undone).
 std::vector<uint8_t> volume_bytes(MainWindow& w, bool with_dryness = true) {
   return on_sim(w, [with_dryness](SimThread& s) {
-    TileStore c = settled_canvas_copy(s.sim());
+    TileStore c = s.sim().settled_canvas_copy(Device{});
     return canonical_volume(c, with_dryness);
   });
 }
@@ -660,7 +659,7 @@ class StudioTest : public QObject {
       return d;
     };
     const std::vector<int> live_dry = on_sim(*w_, [&](SimThread& s) {
-      TileStore c = settled_canvas_copy(s.sim());
+      TileStore c = s.sim().settled_canvas_copy(Device{});
       return dryness_codes(c);
     });
     const std::vector<float> live = column_density(*w_);

@@ -75,6 +75,11 @@ void ActiveWindow::flush() {
   gathered_mass_ = paint_.total_density(ws_);
 }
 
+void ActiveWindow::restore(const std::vector<std::vector<float>>& host, double gathered_mass) {
+  paint_.from_host(host);
+  gathered_mass_ = gathered_mass;
+}
+
 void ActiveWindow::reload() {
   canvas_->gather(paint_);
   gathered_mass_ = paint_.total_density(ws_);

@@ -36,6 +36,9 @@ class ActiveWindow {
   bool recentre_on(Vec3 brush, int snap);
   /// Writes the window to the canvas without moving (the canvas is then up to date).
   void flush();
+  /// Puts back the window a flush (or a settle) started from: its paint, as `host` holds it
+  /// (PaintWindow::to_host), and the mass it had gathered, so the books read as before.
+  void restore(const std::vector<std::vector<float>>& host, double gathered_mass);
   /// Re-reads the window from the canvas (after the canvas changed, e.g. dry_all); velocity kept.
   void reload();
 

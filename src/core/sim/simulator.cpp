@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/exec/algorithms.h"
+#include "core/io/undo_tiles.h"
 #include "core/particles/particles.h"
 #include "core/sim/joint_fields.h"
 
@@ -153,6 +154,100 @@ void Simulator::settle() {
     books_.record(rec, record_census(rec));
   }
   grid_->window().flush();
+}
+
+void Simulator::flush_window() { grid_->window().flush(); }
+
+namespace {
+
+/// Every particle field (state and scratch) on the host, for an exact restore.
+struct ParticleCopy {
+  int64_t count = 0;
+#define WB_X(type, name, doc) std::vector<type> name;
+  WB_PARTICLE_FIELDS(WB_X)
+#undef WB_X
+};
+
+ParticleCopy copy_particles(const ParticleStore& p) {
+  ParticleCopy c;
+  c.count = p.size();
+#define WB_X(type, name, doc)      \
+  c.name.resize(size_t(c.count)); \
+  p.name.copy_to_host(c.name.data(), size_t(c.count));
+  WB_PARTICLE_FIELDS(WB_X)
+#undef WB_X
+  return c;
+}
+
+void restore_particles(ParticleStore& p, const ParticleCopy& c) {
+  p.clear();
+  p.append_uninitialised(c.count);
+#define WB_X(type, name, doc) p.name.copy_range_from_host(c.name.data(), 0, size_t(c.count));
+  WB_PARTICLE_FIELDS(WB_X)
+#undef WB_X
+}
+
+/// False for a tile that is all zero (as an undo writes back a tile that was never allocated).
+bool tile_has_paint(const TileData& t) {
+  const auto nonzero = [](const auto& v) { return std::any_of(v.begin(), v.end(), [](auto x) { return x != 0; }); };
+  return nonzero(t.density) || nonzero(t.pigment_r) || nonzero(t.pigment_y) || nonzero(t.pigment_b) ||
+         nonzero(t.oil) || nonzero(t.dryness);
+}
+
+}  // namespace
+
+void Simulator::with_settled_canvas(const std::function<void(TileStore&)>& fn) {
+  ActiveWindow& win = grid_->window();
+  PaintWindow& w = win.paint();
+  TileStore& canvas = *canvas_;
+  if (particles_.size() == 0) {  // nothing in flight: the flushed window is the settled canvas
+    flush_window();
+    fn(canvas);
+    return;
+  }
+  // settle() changes the window, the particles and the tiles under the window (its books entry
+  // closes: paint only moves from the particles to the grid).
+  const std::vector<std::vector<float>> window = w.to_host();
+  const double gathered = win.gathered_mass();
+  const ParticleCopy particles = copy_particles(particles_);
+  std::vector<TileSnapshot> tiles;
+  const Int3 o = w.origin(), n = w.dims();
+  const int tx0 = std::max(0, o.x / kTileSize), ty0 = std::max(0, o.y / kTileSize);
+  const int tx1 = std::min(canvas.tiles_x() - 1, (o.x + n.x - 1) / kTileSize);
+  const int ty1 = std::min(canvas.tiles_y() - 1, (o.y + n.y - 1) / kTileSize);
+  for (int ty = ty0; ty <= ty1; ++ty)
+    for (int tx = tx0; tx <= tx1; ++tx) tiles.push_back(snapshot_tile(canvas, ty * canvas.tiles_x() + tx));
+  const auto restore = [&] {
+    win.restore(window, gathered);
+    restore_particles(particles_, particles);
+    for (const TileSnapshot& t : tiles) restore_tile(canvas, t);
+  };
+  try {
+    settle();
+    fn(canvas);
+  } catch (...) {
+    restore();
+    throw;
+  }
+  restore();
+}
+
+TileStore Simulator::settled_canvas_copy(const Device& device) {
+  TileStore copy(device, canvas_->dims());
+  with_settled_canvas([&](TileStore& c) {
+    for (int id : c.allocated_tile_ids()) {
+      TileData t = c.read_tile(id);
+      if (tile_has_paint(t)) copy.write_tile(t);
+    }
+  });
+  return copy;
+}
+
+void Simulator::canvas_replaced() {
+  const double before = census().total();
+  grid_->window().reload();
+  particles_.clear();
+  books_.external(census().total() - before);
 }
 
 std::array<float, 4> Simulator::samples_box() {

@@ -3,6 +3,7 @@
 // this file only sequences them, times them and keeps the books.
 #pragma once
 #include <array>
+#include <functional>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -105,6 +106,24 @@ class Simulator {
   void settle();
   /// Where the paint is now, kg.
   PaintCensus census();
+
+  // --- the canvas as files, undo and the studio see it ---
+  /// Runs `fn` on the canvas as it is when every paint comes to rest now (settle: the particles
+  /// back into the grid by Eq. 16, the window written to the tiles), then puts the simulation back
+  /// exactly as it was (window, particles, the tiles under the window): a session that saves
+  /// replays like one that does not. Saves, exports and undo records see this canvas.
+  void with_settled_canvas(const std::function<void(TileStore&)>& fn);
+  /// A copy of the settled canvas on `device`, without tiles that are all zero.
+  TileStore settled_canvas_copy(const Device& device);
+  /// Writes the live window to the tiles without changing the simulation (its next scatter
+  /// writes the same cells).
+  void flush_window();
+  /// The canvas's tiles were written from outside (undo, redo, open, a kept canvas): the window is
+  /// read back from them and the paint in flight, which belonged to the canvas that was replaced,
+  /// is dropped. The books record the change as paint that entered or left from outside.
+  void canvas_replaced();
+  /// Liquid particles in flight.
+  int64_t particle_count() const { return particles_.size(); }
   /// The live window and the particles, for the renderer.
   PaintWindow* live_window() { return &grid_->window().paint(); }
   ParticleOverlay particle_overlay();
