@@ -1,5 +1,6 @@
 // wetbrush studio: the desktop painting application (Qt 6 Widgets, OpenGL canvas view).
 #include <QApplication>
+#include <QThread>
 #include <QBuffer>
 #include <QCommandLineParser>
 #include <QElapsedTimer>
@@ -113,6 +114,18 @@ int main(int argc, char** argv) {
                                                   {"idle", st.times.idle - st0.times.idle}}}};
           wb::write_file_atomic(stats.toStdString(), j.dump(2) + "\n");
         }
+        // The picture: the painting under a raking light, with the oblique view beside it.
+        const int renders = w.oblique_renders();
+        w.view_panel()->rake();
+        w.view_panel()->set_oblique(true);
+        QElapsedTimer wait;
+        wait.start();
+        while (w.oblique_renders() <= renders && wait.elapsed() < 60000) {
+          QApplication::processEvents(QEventLoop::AllEvents, 50);
+          QThread::msleep(10);
+        }
+        w.settle();
+        QApplication::processEvents();
         QByteArray png;
         QBuffer buffer(&png);
         buffer.open(QIODevice::WriteOnly);
