@@ -595,7 +595,7 @@ bool MainWindow::open_from(const QString& path) {
       SimConfig c = s.config();
       c.canvas = p.canvas.dims();
       s.rebuild(c, false);
-      for (int id : p.canvas.allocated_tile_ids()) s.sim().canvas().write_tile(p.canvas.read_tile(id));
+      s.sim().canvas().copy_from(p.canvas);  // loaded onto the simulator's device: copied there
       s.canvas_written();
       s.restart_recording(false);
       s.invalidate_all();

@@ -172,8 +172,14 @@ void SimThread::rebuild(const SimConfig& config, bool keep_canvas) {
   rest.position = Vec3(config.canvas.width * 0.5f, config.canvas.height * 0.5f, config.brush.length * 1.5f);
   sim_ = std::make_unique<Simulator>(config_, rest);
   if (keep_canvas && same_dims) {
-    const TileStore kept = old->settled_canvas_copy(Device{});  // with the paint that was in flight
-    for (int id : kept.allocated_tile_ids()) sim_->canvas().write_tile(kept.read_tile(id));
+    // The paint that was in flight comes too; the old simulator goes, so it settles for good,
+    // and its canvas is copied on the device.
+    old->settle();
+    if (old->device() == config.device) {
+      sim_->canvas().copy_from(old->canvas());
+    } else {
+      for (int id : old->canvas().allocated_tile_ids()) sim_->canvas().write_tile(old->canvas().read_tile(id));
+    }
   }
   old.reset();
   canvas_written();

@@ -4,6 +4,7 @@
 #include <random>
 
 #include "backend_fixture.h"
+#include "core/exec/memory.h"
 #include "core/canvas/tile_store.h"
 #include "core/io/undo_tiles.h"
 
@@ -157,6 +158,31 @@ TEST_F(TileStoreTest, TileReadWriteRoundTrip) {
   b.gather(wb);
   EXPECT_EQ(wa.to_host(), wb.to_host());
   EXPECT_THROW(b.write_tile(TileData{}), Error);
+}
+
+TEST_F(TileStoreTest, CopyOnTheDeviceIsExactAndReadsNothingBack) {
+  TileStore a(device_, CanvasDims{256, 256, 16}), b(device_, CanvasDims{256, 256, 16});
+  PaintWindow w(device_, Int3{100, 60, 16});
+  w.set_origin({30, 40, 0});
+  w.from_host(random_fields(w.cell_count(), 11));
+  a.scatter(w);
+  a.advance_drying(0.25);  // owed drying travels with the copy
+  PaintWindow old(device_, Int3{40, 40, 16});
+  old.set_origin({200, 200, 0});
+  old.from_host(random_fields(old.cell_count(), 12));
+  b.scatter(old);  // b held other paint: the copy replaces it
+  const int64_t reads = mem::host_reads();
+  b.copy_from(a);
+  EXPECT_EQ(mem::host_reads(), reads) << "the canvas is not read back to the host";
+  EXPECT_EQ(a.allocated_tiles(), b.allocated_tiles());
+  EXPECT_EQ(a.allocated_tile_ids(), b.allocated_tile_ids());
+  EXPECT_DOUBLE_EQ(a.total_density(), b.total_density());
+  EXPECT_EQ(a.drying_clock(), b.drying_clock());
+  PaintWindow wa(device_, Int3{256, 256, 16}), wb(device_, Int3{256, 256, 16});
+  a.gather(wa);
+  b.gather(wb);
+  EXPECT_EQ(wa.to_host(), wb.to_host());
+  EXPECT_THROW(b.copy_from(TileStore(device_, CanvasDims{128, 256, 16})), Error);
 }
 
 TEST_F(TileStoreTest, PaintDriesByTheClockAndUndoKeepsTheDrying) {

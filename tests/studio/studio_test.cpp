@@ -33,8 +33,10 @@
 #include <numeric>
 #include <omp.h>
 #include <optional>
+#include <tuple>
 
 #include "core/color/ryb.h"
+#include "core/exec/memory.h"
 #include "core/io/brush_json.h"
 #include "core/io/document.h"
 #include "core/io/stroke.h"
@@ -479,6 +481,28 @@ class StudioTest : public QObject {
     QVERIFY2(touching > 0, "pressed bristles touch the canvas in the preview");
     const QImage shot = bp->grab().toImage();
     QVERIFY(!shot.isNull());
+  }
+
+  void brushChangeAndOpenReadNoCanvasBack() {
+    grid_only_canvas(false);
+    stroke(30.f, 0.8f, 20.f, 140.f);
+    stroke(60.f, 0.8f);
+    stroke(90.f, 0.8f, 20.f, 140.f);
+    // The canvas goes to the new simulator on the device: the host reads a brush change makes
+    // (the settle's counts, the books, the first render) do not grow with the painting.
+    const auto [tiles, reads, volume_before, volume_after] = on_sim(*w_, [](SimThread& s) {
+      const int64_t tiles = s.sim().canvas().allocated_tiles();
+      const double before = s.sim().settled_canvas_copy(Device{}).total_density();
+      const int64_t r0 = mem::host_reads();
+      s.rebuild(s.config(), true);
+      const int64_t reads = mem::host_reads() - r0;
+      return std::tuple<int64_t, int64_t, double, double>(tiles, reads, before, s.sim().canvas().total_density());
+    });
+    qInfo("brush change with %lld painted tiles: %lld host reads; paint %.4f -> %.4f cell volumes", (long long)tiles,
+          (long long)reads, volume_before, volume_after);
+    QVERIFY2(tiles > 40, "a painting of many tiles");
+    QVERIFY2(reads < tiles, "the canvas is not read back tile by tile (6 reads a tile before)");
+    QVERIFY2(std::abs(volume_after - volume_before) <= 1e-6 * volume_before, "the paint, in flight too, is kept");
   }
 
   void obliqueViewAndRakingLight() {

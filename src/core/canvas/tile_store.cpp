@@ -160,6 +160,28 @@ void TileStore::clear() {
   }
 }
 
+void TileStore::copy_from(const TileStore& src) {
+  WB_REQUIRE(src.dims_ == dims_, "TileStore::copy_from: the canvases differ in size");
+  WB_REQUIRE(src.device_ == device_, "TileStore::copy_from: the canvases live on different devices");
+  if (&src == this) return;
+  clear();
+  grow_pool(src.slots_used_);
+  host_slot_ = src.host_slot_;
+  tile_of_slot_ = src.tile_of_slot_;
+  host_dried_to_ = src.host_dried_to_;
+  slots_used_ = src.slots_used_;
+  clock_ = src.clock_;
+  mass_ = src.mass_;
+  slot_of_tile_.copy_from_host(host_slot_);
+  const size_t cells = size_t(slots_used_) * size_t(tile_cells());
+  if (cells == 0) return;
+  mem::copy_on_device(device_, density_.data(), src.density_.data(), cells * sizeof(float));
+  const DeviceBuffer<uint16_t>* from[] = {&src.pigment_r_, &src.pigment_y_, &src.pigment_b_, &src.oil_, &src.dryness_};
+  DeviceBuffer<uint16_t>* to[] = {&pigment_r_, &pigment_y_, &pigment_b_, &oil_, &dryness_};
+  for (int f = 0; f < 5; ++f) mem::copy_on_device(device_, to[f]->data(), from[f]->data(), cells * sizeof(uint16_t));
+  mem::copy_on_device(device_, dried_to_.data(), src.dried_to_.data(), size_t(slots_used_) * sizeof(float));
+}
+
 size_t TileStore::memory_bytes() const {
   size_t b = host_slot_.size() * sizeof(int32_t) * 2 + tile_of_slot_.capacity() * sizeof(int32_t);
   b += density_.bytes() + pigment_r_.bytes() + pigment_y_.bytes() + pigment_b_.bytes() + oil_.bytes() +

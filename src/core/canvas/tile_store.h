@@ -95,6 +95,9 @@ class TileStore {
   double drying_clock() const { return clock_; }
   /// Empties the canvas (keeps the pool's memory).
   void clear();
+  /// Becomes a copy of `src` (same dimensions, same device), copied on the device: a brush
+  /// change or an opened painting replaces the live canvas without a trip through the host.
+  void copy_from(const TileStore& src);
 
   int allocated_tiles() const { return slots_used_; }
   /// Bytes held now: tile index (host and device) plus the pool's capacity.
