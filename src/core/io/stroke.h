@@ -12,17 +12,9 @@
 #include "core/brush/brush_spec.h"
 #include "core/canvas/tile_store.h"
 #include "core/io/pen_sample.h"
+#include "core/transfer/paint_load.h"
 
 namespace wb {
-
-/// Paint on the brush at the start of the stroke (and at every pen-down when reloading).
-struct PaintLoad {
-  float ryb[3] = {0.1f, 0.15f, 0.85f};  ///< pigment, RYB in [0, 1] (default: a deep blue)
-  float oil = 0.3f;                     ///< oil fraction in [0, 1] (viscosity, transparency)
-  float load = 0.8f;                    ///< fraction of the bristles' capacity filled, [0, 1]
-  bool reload_on_pen_down = true;       ///< refill to `load` at every pen-down edge
-  bool operator==(const PaintLoad&) const = default;
-};
 
 enum class StrokeEventKind {
   Dip,    ///< dip the brush into a palette well: load paint `ryb`/`oil` up to `load`

@@ -9,7 +9,7 @@
 #include "core/exec/buffer.h"
 #include "core/exec/device.h"
 #include "core/exec/workspace.h"
-#include "core/io/stroke.h"
+#include "core/transfer/paint_load.h"
 #include "core/math/vec.h"
 #include "core/transfer/transfer_params.h"
 
