@@ -143,21 +143,7 @@ SimStatus SimThread::status() const {
   return status_;
 }
 
-QRect SimThread::take_frame(QImage& canvas) {
-  std::lock_guard lk(frame_mu_);
-  if (front_.isNull() || front_dirty_.isEmpty()) return {};
-  QRect r = front_dirty_;
-  if (canvas.size() != front_.size() || canvas.format() != front_.format()) {
-    canvas = front_.copy();
-    r = front_.rect();
-  } else {
-    const int bpp = 4;
-    for (int y = r.top(); y <= r.bottom(); ++y)
-      std::memcpy(canvas.scanLine(y) + r.left() * bpp, front_.constScanLine(y) + r.left() * bpp, size_t(r.width()) * bpp);
-  }
-  front_dirty_ = QRect();
-  return r;
-}
+QRect SimThread::take_frame(QImage& canvas) { return frames_.take(canvas); }
 
 // --- simulation thread ------------------------------------------------------------------
 
@@ -184,12 +170,7 @@ void SimThread::rebuild(const SimConfig& config, bool keep_canvas) {
   old.reset();
   canvas_written();
   restart_recording(recording_from_blank_.load() && sim_->canvas().allocated_tiles() == 0);
-  if (!cache_ || !same_dims) {
-    cache_ = std::make_unique<CanvasImageCache>(renderer_, Camera::top(config.canvas), 32);
-    std::lock_guard lk(frame_mu_);
-    front_ = QImage(config.canvas.width, config.canvas.height, QImage::Format_RGBA8888);
-    front_.fill(Qt::black);
-  }
+  if (!frames_.ready() || !same_dims) frames_.reset(config.canvas);
   {
     std::lock_guard lk(status_mu_);
     status_.device = config.device.to_string();
@@ -232,35 +213,13 @@ void SimThread::canvas_written() {
   stroke_open_ = false;
 }
 
-void SimThread::invalidate_all() {
-  if (!cache_) return;
-  cache_->mark_all_dirty();
-  dirty_x0_ = 0;
-  dirty_y0_ = 0;
-  dirty_x1_ = config_.canvas.width;
-  dirty_y1_ = config_.canvas.height;
-}
+void SimThread::invalidate_all() { frames_.invalidate_all(); }
 
-void SimThread::invalidate_rect(int x0, int y0, int x1, int y1) {
-  if (!cache_) return;
-  cache_->mark_dirty(x0, y0, x1, y1);
-  dirty_x0_ = std::min(dirty_x0_, x0);
-  dirty_y0_ = std::min(dirty_y0_, y0);
-  dirty_x1_ = std::max(dirty_x1_, x1);
-  dirty_y1_ = std::max(dirty_y1_, y1);
-}
+void SimThread::invalidate_rect(int x0, int y0, int x1, int y1) { frames_.invalidate_rect(x0, y0, x1, y1); }
 
-BrushPicture SimThread::brush_picture() const {
-  std::lock_guard lk(frame_mu_);
-  return picture_;
-}
+BrushPicture SimThread::brush_picture() const { return frames_.brush_picture(); }
 
-Image SimThread::canvas_image() {
-  if (!cache_ || !sim_) return {};
-  if (dirty_x1_ >= 0) render(true);
-  ParticleOverlay overlay = sim_->particle_overlay();
-  return cache_->update(sim_->canvas(), sim_->live_window(), &overlay);
-}
+Image SimThread::canvas_image() { return sim_ ? frames_.canvas_image(*sim_) : Image{}; }
 
 void SimThread::render_oblique(float elevation_deg, int max_width) {
   if (!sim_) return;
@@ -401,33 +360,7 @@ void SimThread::finish_stroke() {
 }
 
 void SimThread::render(bool force) {
-  if (!cache_ || !sim_) return;
-  const double now = wall_now();
-  if (!force && now - last_render_ < 1.0 / 30.0) return;
-  last_render_ = now;
-  // The brush as it is now (preview, swatch), with every frame and after palette actions.
-  BrushPicture picture = sim_->brush_picture();
-  {
-    std::lock_guard lk(frame_mu_);
-    picture_ = std::move(picture);
-  }
-  if (dirty_x1_ < 0) return;
-  ParticleOverlay overlay = sim_->particle_overlay();
-  const Image& img = cache_->update(sim_->canvas(), sim_->live_window(), &overlay);
-  // Copy the changed pixels (the marked rectangle grown by the renderer's reach) to the front.
-  const int m = 48;
-  const QRect r = QRect(QPoint(dirty_x0_ - m, dirty_y0_ - m), QPoint(dirty_x1_ + m, dirty_y1_ + m))
-                      .intersected(QRect(0, 0, img.width, img.height));
-  dirty_x0_ = dirty_y0_ = 1 << 30;
-  dirty_x1_ = dirty_y1_ = -1;
-  if (r.isEmpty()) return;
-  {
-    std::lock_guard lk(frame_mu_);
-    for (int y = r.top(); y <= r.bottom(); ++y)
-      std::memcpy(front_.scanLine(y) + r.left() * 4, img.at(r.left(), y), size_t(r.width()) * 4);
-    front_dirty_ |= r;
-  }
-  Q_EMIT frameReady();
+  if (sim_ && frames_.render(*sim_, force)) Q_EMIT frameReady();
 }
 
 void SimThread::publish_status(bool force) {
@@ -448,11 +381,9 @@ void SimThread::publish_status(bool force) {
   }
   status_.steps = steps_;
   status_.times = times_;
-  {
-    std::lock_guard fk(frame_mu_);
-    status_.brush_ryb = {picture_.mean_ryb.x, picture_.mean_ryb.y, picture_.mean_ryb.z};
-    status_.brush_amount = picture_.amount;
-  }
+  const BrushPicture picture = frames_.brush_picture();
+  status_.brush_ryb = {picture.mean_ryb.x, picture.mean_ryb.y, picture.mean_ryb.z};
+  status_.brush_amount = picture.amount;
   status_.lag_s = rec_.samples.empty() ? 0.0 : std::max(0.0, rec_.samples.back().t - t_done_);
 }
 

@@ -1,5 +1,6 @@
-// The studio's simulation thread: owns the Simulator, the renderer and its incremental
-// image cache, and the session recording. The UI thread only enqueues time-stamped pen
+// The studio's simulation thread: owns the Simulator, the renderer, the session recording and
+// its undo records; its pictures (canvas image, brush picture) are FrameCache's. The UI thread
+// only enqueues time-stamped pen
 // samples, palette events and commands, and takes the latest rendered pixels; it never waits
 // for a step. Steps run at the fixed dt of the session time line (pen_clock.h) through the
 // same StrokePlayer that `wetbrush replay` uses, so a saved recording replays to the same canvas.
@@ -22,6 +23,7 @@
 #include "core/io/undo_tiles.h"
 #include "core/render/renderer.h"
 #include "core/sim/simulator.h"
+#include "studio/frame_cache.h"
 #include "studio/pen_clock.h"
 
 namespace wb::studio {
@@ -142,7 +144,6 @@ class SimThread : public QObject {
   SimConfig config_;
   std::unique_ptr<Simulator> sim_;
   Renderer renderer_;
-  std::unique_ptr<CanvasImageCache> cache_;
   PaintLoad paint_{};
 
   // Inputs (UI -> worker).
@@ -169,13 +170,8 @@ class SimThread : public QObject {
   StrokeTileRecorder undo_rec_;
   bool stroke_open_ = false;
 
-  // Frames (worker -> UI).
-  mutable std::mutex frame_mu_;
-  QImage front_;
-  QRect front_dirty_;
-  BrushPicture picture_;
-  int dirty_x0_ = 1 << 30, dirty_y0_ = 1 << 30, dirty_x1_ = -1, dirty_y1_ = -1;
-  double last_render_ = 0.0;
+  // Frames (worker -> UI): the canvas image and the brush picture.
+  FrameCache frames_{renderer_};
 
   mutable std::mutex status_mu_;
   SimStatus status_;

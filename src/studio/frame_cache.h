@@ -1,0 +1,53 @@
+// The studio's pictures of the simulation, made on the simulation thread and taken by the UI:
+// the canvas image, re-rendered incrementally where the paint changed (CanvasImageCache) at most
+// 30 times a second, the changed rectangle handed over to the view, and the brush as it is now
+// (Simulator::brush_picture) for the preview and the paint swatch. One job: SimThread runs the
+// simulation and asks this for frames.
+#pragma once
+#include <QImage>
+#include <QRect>
+
+#include <memory>
+#include <mutex>
+
+#include "core/render/renderer.h"
+#include "core/sim/simulator.h"
+
+namespace wb::studio {
+
+class FrameCache {
+ public:
+  explicit FrameCache(Renderer& renderer) : renderer_(renderer) {}
+
+  // --- simulation thread ---
+  /// A canvas of these dimensions: a new image cache and a black front image.
+  void reset(CanvasDims dims);
+  bool ready() const { return cache_ != nullptr; }
+  /// The whole canvas must be drawn again (light, paper, a new canvas).
+  void invalidate_all();
+  /// Cells [x0, x1) x [y0, y1) changed.
+  void invalidate_rect(int x0, int y0, int x1, int y1);
+  /// Re-renders what changed and copies it to the front image, at most 30 times a second unless
+  /// `force`; the brush picture is taken with it. True when the front image changed.
+  bool render(Simulator& sim, bool force);
+  /// The whole canvas rendered now (one pixel per cell).
+  Image canvas_image(Simulator& sim);
+
+  // --- UI thread (locked) ---
+  /// Copies the pixels changed since the last call into `canvas`; returns their rectangle.
+  QRect take(QImage& canvas);
+  BrushPicture brush_picture() const;
+
+ private:
+  Renderer& renderer_;
+  std::unique_ptr<CanvasImageCache> cache_;
+  CanvasDims dims_{};
+  double last_render_ = 0.0;
+  int dirty_x0_ = 1 << 30, dirty_y0_ = 1 << 30, dirty_x1_ = -1, dirty_y1_ = -1;
+  mutable std::mutex mu_;  ///< guards what the UI takes: front_, front_dirty_, picture_
+  QImage front_;
+  QRect front_dirty_;
+  BrushPicture picture_;
+};
+
+}  // namespace wb::studio
