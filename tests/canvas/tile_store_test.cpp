@@ -25,6 +25,24 @@ class TileStoreTest : public BackendTest {
     }
     return f;
   }
+  /// A 256^2 x 16 canvas with random paint over a window at `origin` of `size`.
+  TileStore painted(unsigned seed, Int3 origin = {30, 40, 0}, Int3 size = {100, 60, 16}) {
+    TileStore c(device_, CanvasDims{256, 256, 16});
+    PaintWindow w(device_, size);
+    w.set_origin(origin);
+    w.from_host(random_fields(w.cell_count(), seed));
+    c.scatter(w);
+    return c;
+  }
+  /// The same tiles, total and cells.
+  void expect_same_canvas(TileStore& a, TileStore& b) {
+    EXPECT_EQ(a.allocated_tiles(), b.allocated_tiles());
+    EXPECT_DOUBLE_EQ(a.total_density(), b.total_density());
+    PaintWindow wa(device_, Int3{256, 256, 16}), wb(device_, Int3{256, 256, 16});
+    a.gather(wa);
+    b.gather(wb);
+    EXPECT_EQ(wa.to_host(), wb.to_host());
+  }
 };
 
 TEST_F(TileStoreTest, EmptyDefaultCanvasIsSmall) {
@@ -145,43 +163,21 @@ TEST_F(TileStoreTest, DryAllSolidifiesPaintOnly) {
 }
 
 TEST_F(TileStoreTest, TileReadWriteRoundTrip) {
-  TileStore a(device_, CanvasDims{256, 256, 16}), b(device_, CanvasDims{256, 256, 16});
-  PaintWindow w(device_, Int3{100, 60, 16});
-  w.set_origin({30, 40, 0});
-  w.from_host(random_fields(w.cell_count(), 9));
-  a.scatter(w);
+  TileStore a = painted(9), b(device_, CanvasDims{256, 256, 16});
   for (int id : a.allocated_tile_ids()) b.write_tile(a.read_tile(id));
-  EXPECT_EQ(a.allocated_tiles(), b.allocated_tiles());
-  EXPECT_DOUBLE_EQ(a.total_density(), b.total_density());
-  PaintWindow wa(device_, Int3{256, 256, 16}), wb(device_, Int3{256, 256, 16});
-  a.gather(wa);
-  b.gather(wb);
-  EXPECT_EQ(wa.to_host(), wb.to_host());
+  expect_same_canvas(a, b);
   EXPECT_THROW(b.write_tile(TileData{}), Error);
 }
 
 TEST_F(TileStoreTest, CopyOnTheDeviceIsExactAndReadsNothingBack) {
-  TileStore a(device_, CanvasDims{256, 256, 16}), b(device_, CanvasDims{256, 256, 16});
-  PaintWindow w(device_, Int3{100, 60, 16});
-  w.set_origin({30, 40, 0});
-  w.from_host(random_fields(w.cell_count(), 11));
-  a.scatter(w);
+  TileStore a = painted(11), b = painted(12, {200, 200, 0}, {40, 40, 16});  // b's paint is replaced
   a.advance_drying(0.25);  // owed drying travels with the copy
-  PaintWindow old(device_, Int3{40, 40, 16});
-  old.set_origin({200, 200, 0});
-  old.from_host(random_fields(old.cell_count(), 12));
-  b.scatter(old);  // b held other paint: the copy replaces it
   const int64_t reads = mem::host_reads();
   b.copy_from(a);
   EXPECT_EQ(mem::host_reads(), reads) << "the canvas is not read back to the host";
-  EXPECT_EQ(a.allocated_tiles(), b.allocated_tiles());
   EXPECT_EQ(a.allocated_tile_ids(), b.allocated_tile_ids());
-  EXPECT_DOUBLE_EQ(a.total_density(), b.total_density());
   EXPECT_EQ(a.drying_clock(), b.drying_clock());
-  PaintWindow wa(device_, Int3{256, 256, 16}), wb(device_, Int3{256, 256, 16});
-  a.gather(wa);
-  b.gather(wb);
-  EXPECT_EQ(wa.to_host(), wb.to_host());
+  expect_same_canvas(a, b);
   EXPECT_THROW(b.copy_from(TileStore(device_, CanvasDims{128, 256, 16})), Error);
 }
 
