@@ -42,7 +42,7 @@ class ContainmentTest : public SimulatorTest {
  protected:
   /// What a failure names: the first part of the live state holding a non-finite value.
   static std::string nonfinite_part(Simulator& sim) {
-    ActiveWindow& win = sim.grid().window();
+    ActiveWindow& win = SimulatorTestAccess::grid(sim).window();
     const auto fields = win.paint().to_host();
     for (size_t f = 0; f < fields.size(); ++f)
       if (!all_finite(fields[f])) return "window field " + std::to_string(f);
@@ -69,32 +69,32 @@ TEST_F(ContainmentTest, PoisonInAnyStageIsFoundCountedAndNeverSaved) {
   };
   const std::vector<Target> targets = {
       {"window density", [](Simulator& s, const Device& d) {
-         PaintWindow& w = s.grid().window().paint();
+         PaintWindow& w = SimulatorTestAccess::grid(s).window().paint();
          poison(d, w.density.data(), w.cell_count(), kNaN);
        }},
       {"window pigment", [](Simulator& s, const Device& d) {
-         PaintWindow& w = s.grid().window().paint();
+         PaintWindow& w = SimulatorTestAccess::grid(s).window().paint();
          poison(d, w.pigment_y.data(), w.cell_count(), kInf);
        }},
       {"window velocity", [](Simulator& s, const Device&) {
          // Every x face: the brush's drag and the advection read them at once.
-         DeviceBuffer<float>& u = s.grid().window().velocity(0);
+         DeviceBuffer<float>& u = SimulatorTestAccess::grid(s).window().velocity(0);
          u.copy_from_host(std::vector<float>(u.size(), kNaN));
        }},
       {"particle position", [](Simulator& s, const Device& d) {
-         poison(d, reinterpret_cast<float*>(s.particles().x.data()), 3 * s.particles().size(), kNaN);
+         poison(d, reinterpret_cast<float*>(SimulatorTestAccess::particles(s).x.data()), 3 * SimulatorTestAccess::particles(s).size(), kNaN);
        }},
       {"particle velocity", [](Simulator& s, const Device& d) {
-         poison(d, reinterpret_cast<float*>(s.particles().v.data()), 3 * s.particles().size(), kInf);
+         poison(d, reinterpret_cast<float*>(SimulatorTestAccess::particles(s).v.data()), 3 * SimulatorTestAccess::particles(s).size(), kInf);
        }},
-      {"particle mass", [](Simulator& s, const Device& d) { poison(d, s.particles().m.data(), s.particles().size(), kInf); }},
+      {"particle mass", [](Simulator& s, const Device& d) { poison(d, SimulatorTestAccess::particles(s).m.data(), SimulatorTestAccess::particles(s).size(), kInf); }},
       {"particle pigment", [](Simulator& s, const Device& d) {
-         poison(d, s.particles().pigment_r.data(), s.particles().size(), kNaN);
+         poison(d, SimulatorTestAccess::particles(s).pigment_r.data(), SimulatorTestAccess::particles(s).size(), kNaN);
        }},
-      {"load mass", [](Simulator& s, const Device& d) { poison(d, s.load().m.data(), s.load().size(), kNaN); }},
-      {"load pigment", [](Simulator& s, const Device& d) { poison(d, s.load().pigment_b.data(), s.load().size(), kInf); }},
+      {"load mass", [](Simulator& s, const Device& d) { poison(d, SimulatorTestAccess::load(s).m.data(), SimulatorTestAccess::load(s).size(), kNaN); }},
+      {"load pigment", [](Simulator& s, const Device& d) { poison(d, SimulatorTestAccess::load(s).pigment_b.data(), SimulatorTestAccess::load(s).size(), kInf); }},
       {"sample velocity", [](Simulator& s, const Device& d) {
-         SampleView v = s.brush().samples();
+         SampleView v = SimulatorTestAccess::brush(s).samples();
          poison(d, reinterpret_cast<float*>(v.v), 3 * v.count(), kNaN);
        },
        true},

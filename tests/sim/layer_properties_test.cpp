@@ -49,7 +49,7 @@ class LayerPropertiesTest : public SimulatorTest {
   static void write_layer(Simulator& sim, const CellFn& cell) {
     const CanvasDims d = sim.canvas().dims();
     fill_volume(sim.canvas(), 0, 0, d.width, d.height, cell);
-    sim.grid().window().reload();
+    SimulatorTestAccess::grid(sim).window().reload();
   }
 
   /// The books from the census taken after the layer was written: the simulator opened its
@@ -99,7 +99,7 @@ class LayerPropertiesTest : public SimulatorTest {
           const Int3 o = sim.grid().window().origin(), n = sim.grid().window().dims();
           const size_t cells = size_t(n.x) * n.y * n.z;
           std::vector<float> psi(cells), vx(cells), vy(cells), vz(cells);
-          sim.brush().rasterize(o, n, psi.data(), vx.data(), vy.data(), vz.data());
+          SimulatorTestAccess::brush(sim).rasterize(o, n, psi.data(), vx.data(), vy.data(), vz.data());
           double sum = 0, peak = 0;
           int touched = 0, columns = 0;
           for (int y = 0; y < n.y; ++y)
@@ -440,7 +440,7 @@ TEST_F(LayerPropertiesTest, ParticlesComeToRestOnAWetLayer) {
       drop.pigment_r.push_back(0.9f), drop.pigment_y.push_back(0.05f), drop.pigment_b.push_back(0.05f);
       drop.oil.push_back(0.3f), drop.dryness.push_back(0.f);
     }
-  sim.particles().append(drop);
+  SimulatorTestAccess::particles(sim).append(drop);
   Books books;
   books.open(sim);
   for (int s = 0; s < 30; ++s) sim.step(lifted, kDt);  // half a second
@@ -451,7 +451,7 @@ TEST_F(LayerPropertiesTest, ParticlesComeToRestOnAWetLayer) {
   double zsum = 0, msum = 0;
   for (size_t k = 0; k < left.size(); ++k)
     if (left.pigment_r[k] > 0.5f) zsum += double(left.m[k]) * left.x[k].z, msum += left.m[k];
-  sim.grid().window().flush();
+  SimulatorTestAccess::grid(sim).window().flush();
   const auto f = canvas_fields(sim);
   const double cell_mass = c.params.transfer.cell_mass();
   for (int z = 0; z < kDepth; ++z)

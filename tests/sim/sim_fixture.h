@@ -5,6 +5,16 @@
 #include "core/io/pen_pose.h"
 #include "core/sim/simulator.h"
 
+namespace wb {
+/// The stages' state behind Simulator's API, for tests that poison or inspect it.
+struct SimulatorTestAccess {
+  static Brush& brush(Simulator& s) { return *s.brush_; }
+  static Grid& grid(Simulator& s) { return *s.grid_; }
+  static ParticleStore& particles(Simulator& s) { return s.particles_; }
+  static BristleLoad& load(Simulator& s) { return *s.load_; }
+};
+}  // namespace wb
+
 namespace wb::test {
 
 class SimulatorTest : public BackendTest {

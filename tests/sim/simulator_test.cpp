@@ -48,7 +48,7 @@ TEST_F(SimulatorTest, BrushPictureIsTheBrushsPaintAndPose) {
   blue.load = 0.9f;
   sim.dip(blue);
   b = sim.brush_picture();
-  const Vec3 expect = sim.load().mean_color(sim.workspace());
+  const Vec3 expect = SimulatorTestAccess::load(sim).mean_color(ws_);
   EXPECT_NEAR(b.amount, 0.9f, 1e-3f);
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(b.mean_ryb[k], expect[k], 1e-4f);
   EXPECT_GT(b.mean_ryb[2], 0.2f);
@@ -306,10 +306,10 @@ TEST_F(SimulatorTest, SecondPassMovesWetPaintAndPicksUpItsColour) {
   blue.load = 0.5f;
   sim.reset_brush(pose_at(c.brush, 128, 100, 0.f, false));
   sim.load_paint(blue);
-  const Vec3 before = sim.load().mean_color(ws_);
+  const Vec3 before = SimulatorTestAccess::load(sim).mean_color(ws_);
   for (int i = 0; i < 4; ++i) sim.step(pose_at(c.brush, 128.f, 100.f, 0.2f * float(i)), 1.f / 60.f);
   for (int i = 0; i < 28; ++i) sim.step(pose_at(c.brush, 128.f, 100.f + 2.f * float(i), 0.8f), 1.f / 60.f);
-  const Vec3 after = sim.load().mean_color(ws_);
+  const Vec3 after = SimulatorTestAccess::load(sim).mean_color(ws_);
   for (int i = 0; i < 6; ++i) sim.step(pose_at(c.brush, 128.f, 156.f, 0.f, false), 1.f / 60.f);
   sim.settle();
   EXPECT_LT(std::abs(sim.books().max_drift()), 1e-4);

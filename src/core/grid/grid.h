@@ -62,6 +62,7 @@ class Grid {
   GridParams& params() { return params_; }
   const GridParams& params() const { return params_; }
   ActiveWindow& window() { return window_; }
+  const ActiveWindow& window() const { return window_; }
   const Device& device() const { return window_.device(); }
   GridDims dims() const { return window_.grid_dims(); }
   GridView view();

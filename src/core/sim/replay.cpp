@@ -59,9 +59,9 @@ bool Replay::advance() {
     contacts_.grow_keep(size_t(recorded_) + 1);
     stretch_.grow_keep(size_t(recorded_) + 1);
   }
-  sim_.brush().mark_contacts_into(trace_.data(), region_.width, region_.height, region_.x0, region_.y0, 1.0f,
+  sim_.brush_->mark_contacts_into(trace_.data(), region_.width, region_.height, region_.x0, region_.y0, 1.0f,
                                   sim_.solid_field(), contacts_.data() + recorded_);
-  sim_.brush().max_stretch_into(stretch_.data() + recorded_);
+  sim_.brush_->max_stretch_into(stretch_.data() + recorded_);
   ++recorded_;
   last_t_ = step.t;
   return true;

@@ -71,17 +71,17 @@ class Simulator {
 
   const SimConfig& config() const { return config_; }
   const Device& device() const { return config_.device; }
+  /// The painting. The stages' own objects are private: read them through the const views
+  /// below; what changes them is this class's API (the replay driver and tests aside).
   TileStore& canvas() { return *canvas_; }
-  Brush& brush() { return *brush_; }
-  Grid& grid() { return *grid_; }
-  ParticleStore& particles() { return particles_; }
-  BristleLoad& load() { return *load_; }
-  Transfer& transfer() { return *transfer_; }
+  const Brush& brush() const { return *brush_; }
+  const Grid& grid() const { return *grid_; }
+  const ParticleStore& particles() const { return particles_; }
+  const BristleLoad& load() const { return *load_; }
   const PaintBooks& books() const { return books_; }
   Profiler& profiler() { return profiler_; }
   const Profiler& profiler() const { return profiler_; }
   const SimCounters& counters() const { return counters_; }
-  Workspace& workspace() { return ws_; }
 
   /// One time step of length dt (Figure 4): the brush runs `substeps` sub-steps ending at
   /// poses[0..substeps), then the paint (window, particles, joint fields, grid, FLIP/PIC,
@@ -133,6 +133,8 @@ class Simulator {
   SolidField solid_field();
 
  private:
+  friend class Replay;               // the contact trace and stretch of the replay's report
+  friend struct SimulatorTestAccess;  // tests poison and inspect the stages' state (tests/sim)
   void brush_stage(const BrushPose* poses, int substeps, float dt);
   void particle_stage(float dt);
   void deposit_leaving_particles(Int3 next_origin);
