@@ -39,9 +39,8 @@ struct FilmColumn {
   float height;                    ///< sum of the column's densities, cells
   uint16_t r, y, b, oil, dryness;  ///< unorm16, as in the tiles: the film's paint, or the coat's
   uint16_t thin;                   ///< column_thinness of its densest cell, unorm16
-  uint16_t coated;                 ///< 1: a thick column with paint above its top thick cell
   float coat;                      ///< thick columns: the paint stacked from the bottom of the top thick cell, cells
-  float coat_thick;                ///< coated columns: the coat's own paint, cells
+  float coat_thick;                ///< a coat's own paint, cells (0: no coat)
 };
 
 /// Everything the ray caster reads: tiles, the optional live window and particle splat
@@ -206,7 +205,7 @@ WB_HD WB_INLINE PaintSample sample_paint(const RenderVolume& v, Vec3 p) {
 /// Film record of column (x, y); none off the map (no ray of the rendered tiles samples there).
 WB_HD WB_INLINE FilmColumn column_film(const RenderVolume& v, int x, int y) {
   const int lx = x - v.top_x0, ly = y - v.top_y0;
-  if (!v.film || lx < 0 || ly < 0 || lx >= v.top_w || ly >= v.top_h) return FilmColumn{0.f, 0, 0, 0, 0, 0, 0, 0, 0.f, 0.f};
+  if (!v.film || lx < 0 || ly < 0 || lx >= v.top_w || ly >= v.top_h) return FilmColumn{0.f, 0, 0, 0, 0, 0, 0, 0.f, 0.f};
   return v.film[int64_t(ly) * v.top_w + lx];
 }
 
@@ -248,7 +247,7 @@ WB_HD WB_INLINE FilmSample film_at(const RenderVolume& v, float x, float y, bool
     if (w <= 0.f) continue;
     const FilmColumn k = column_film(v, ix + (c & 1), iy + (c >> 1));
     stack += w * (k.coat > 0.f ? k.coat : (k.thin != 0 ? k.height : 0.f));
-    if (k.coated) {
+    if (k.coat_thick > 0.f) {
       coated = true;
       wc += w;
       f.coat_paint.density += k.coat_thick * w;

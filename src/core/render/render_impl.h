@@ -44,7 +44,7 @@ void render_top_map(RenderVolume v, RenderParams P, int x0, int y0, int w, int h
         dmax = d > dmax ? d : dmax;
       }
     }
-    FilmColumn f{sum, 0, 0, 0, 0, 0, 0, 0, 0.f, 0.f};
+    FilmColumn f{sum, 0, 0, 0, 0, 0, 0, 0.f, 0.f};
     const float thin = column_thinness(P, dmax);
     // A thick column: its top thick cell (density at the threshold or more) and the paint above it.
     int kt = -1;
@@ -95,8 +95,8 @@ void render_top_map(RenderVolume v, RenderParams P, int x0, int y0, int w, int h
       }
       const float s = 1.f / total;
       f = FilmColumn{sum, encode_unorm16(r * s), encode_unorm16(yy * s), encode_unorm16(b * s),
-                     encode_unorm16(oil * s), encode_unorm16(dry * s), encode_unorm16(thin), 0, 0.f, 0.f};
-      if (coat) f.coated = 1, f.coat_thick = above;
+                     encode_unorm16(oil * s), encode_unorm16(dry * s), encode_unorm16(thin), 0.f, 0.f};
+      if (coat) f.coat_thick = above;
     }
     // Every thick column's stack (the paint from the bottom of its top thick cell): a coat's
     // neighbours give its edge their own height.
@@ -127,7 +127,7 @@ void render_block_top(const uint16_t* top, const FilmColumn* film, int w, int h,
       for (int x = bx * kTopBlock - 1; x <= (bx + 1) * kTopBlock; ++x) {
         if (x < 0 || y < 0 || x >= w || y >= h) continue;
         const FilmColumn& f = film[int64_t(y) * w + x];
-        if ((f.thin != 0 && f.height > 0.f) || f.coat > 0.f) {
+        if ((f.thin != 0 && f.height > 0.f) || f.coat_thick > 0.f) {
           any = 1;
           break;
         }
