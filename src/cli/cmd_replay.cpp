@@ -360,7 +360,7 @@ int run_soak(const SoakArgs& s) {
     int cycle;
     size_t stroke;
     int64_t steps;
-    double step_ms, drift, rss, held;
+    double step_ms, drift, rss, heap, held;
     int64_t nonfinite;
   };
   std::vector<Run> runs;
@@ -371,7 +371,7 @@ int run_soak(const SoakArgs& s) {
     for (size_t i = 0; i < strokes.size(); ++i) {
       ReplayArgs a;
       a.device = s.device;
-      Run r{cycle, i, 0, 0, 0, 0, 0, 0};
+      Run r{cycle, i, 0, 0, 0, 0, 0, 0, 0};
       {
         const SimConfig cfg = replay_config(a, strokes[i], device);
         StrokePlayer player(strokes[i]);
@@ -404,12 +404,14 @@ int run_soak(const SoakArgs& s) {
       // first makes the resident figure what is live, so a leak shows as growth.
       malloc_trim(0);
       r.rss = resident_bytes();
+      const struct mallinfo2 mi = mallinfo2();
+      r.heap = double(mi.uordblks + mi.hblkhd);  // live C-library allocations, the process's own data
       r.held = double(mem::usage(!device.is_cpu()).in_use);
       runs.push_back(r);
       if (tty) std::fprintf(stderr, "\r");
-      std::printf("cycle %d  %-28s %5lld steps  %8.2f ms/step  drift %.1e  resident %7.1f MiB  held %6.1f MiB  %.0f s\n",
+      std::printf("cycle %d  %-28s %5lld steps  %8.2f ms/step  drift %.1e  resident %7.1f MiB  heap %8.1f KiB  held %6.1f MiB  %.0f s\n",
                   cycle, s.strokes[i].c_str(), static_cast<long long>(r.steps), r.step_ms, r.drift, r.rss / 1048576.0,
-                  r.held / 1048576.0, elapsed());
+                  r.heap / 1024.0, r.held / 1048576.0, elapsed());
       std::fflush(stdout);
     }
   }
