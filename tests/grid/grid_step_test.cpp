@@ -77,6 +77,97 @@ TEST_F(GridStepTest, PlatePushesPaintAndPilesItUp) {
   EXPECT_NEAR(sum(rho1), m0, 1e-4 * m0);
 }
 
+// The stages after the joint fields visit only the layers that hold paint or particles
+// (GridExtent). A plate sweeps a paint layer with a 6-cell column on it; for the first 10 steps
+// particles in flight fill layers 10 to 16 above the column (their rasterised density joins the
+// grid's), then they are gone and the extent falls to the paint's. After every step the state is
+// what a full-window pass gives: the classes, open fractions and fluid faces equal a
+// classification of the whole window, and the pressure, the apparent viscosity and the
+// projection's right-hand side are 0 in every cell without liquid (the layers the last step used
+// are visited once more to clear them).
+TEST_F(GridStepTest, StagesVisitOnlyThePaintsLayersAndLeaveTheRestAsTheWholeWindowWould) {
+  TileStore canvas(device_, CanvasDims{256, 256, 64});
+  GridParams p;
+  Grid g(canvas, p, Int3{48, 32, 24}, Int3{32, 32, 0});
+  const GridDims d = g.dims();
+  paint_cells(g, [](int i, int j, int k) {
+    return (i >= 20 && i < 26 && j >= 12 && j < 18 && k < 6) || (k < 2 && i >= 8 && i < 40) ? 1.f : 0.f;
+  });
+  std::vector<float> flight(size_t(d.cells()), 0.f);
+  for (int k = 10; k < 16; ++k)
+    for (int j = 10; j < 20; ++j)
+      for (int i = 18; i < 28; ++i) flight[size_t(d.cell(i, j, k))] = 1.f;
+  DeviceBuffer<float> particle_density(device_, size_t(d.cells()));
+  particle_density.copy_from_host(flight);
+  HostBristles br(device_, d.cells());
+  auto copy_u8 = [&](const uint8_t* src, int64_t n) {
+    std::vector<uint8_t> out(static_cast<size_t>(n));
+    mem::copy_to_host(device_, out.data(), src, size_t(n));
+    return out;
+  };
+  auto copy_f = [&](const float* src, int64_t n) {
+    std::vector<float> out(static_cast<size_t>(n));
+    mem::copy_to_host(device_, out.data(), src, size_t(n) * sizeof(float));
+    return out;
+  };
+  int first_layers = 0, last_layers = 0, checked = 0;
+  float x0 = 4.f;
+  for (int s = 0; s < 30; ++s) {
+    br.plate(d, x0, x0 + 2.f, 4, 28, 6, 30.f);
+    g.set_bristles(br.field());
+    g.set_particle_density(s < 10 ? particle_density.data() : nullptr);
+    g.step(p.dt);
+    x0 += 0.5f;
+    GridExtent e{};
+    g.extent().copy_to_host(&e, 1);
+    if (s == 0) first_layers = e.layers;
+    last_layers = e.layers;
+    // The extent covers the paint and the layer above it, and no more once the first step
+    // has cleared the window.
+    const auto rho = host_density(g);
+    int top = s < 10 ? 16 : 0;
+    for (int64_t c = 0; c < d.cells(); ++c)
+      if (rho[size_t(c)] > 0.f) top = std::max(top, int(c / (int64_t(d.nx) * d.ny)) + 1);
+    ASSERT_GE(e.layers, std::min(d.nz, top + 1)) << "step " << s;
+    if (s > 1 && s != 10) ASSERT_LE(e.layers, top + 2) << "step " << s;
+    if (s == 9) EXPECT_GE(e.layers, 17);
+    GridView v = g.view();
+    const auto cls = copy_u8(v.cls, d.cells());
+    std::vector<std::vector<float>> theta, solid;
+    std::vector<std::vector<uint8_t>> fluid;
+    for (int c = 0; c < 3; ++c) {
+      theta.push_back(copy_f(v.theta[c], d.faces(c)));
+      solid.push_back(copy_f(v.solid_vel[c], d.faces(c)));
+      fluid.push_back(copy_u8(v.fluid[c], d.faces(c)));
+    }
+    const auto pressure = g.pressure().to_host(), mu = g.apparent_viscosity().to_host(), rhs = g.rhs().to_host();
+    int liquid_above = 0;
+    for (int64_t c = 0; c < d.cells(); ++c) {
+      if (cls[size_t(c)] == kCellLiquid) {
+        liquid_above += c >= int64_t(d.nx) * d.ny * e.layers;
+        continue;
+      }
+      ASSERT_EQ(pressure[size_t(c)], 0.f) << "step " << s << " cell " << c;
+      ASSERT_EQ(mu[size_t(c)], 0.f) << "step " << s << " cell " << c;
+      ASSERT_EQ(rhs[size_t(c)], 0.f) << "step " << s << " cell " << c;
+    }
+    EXPECT_EQ(liquid_above, 0) << "step " << s;
+    g.classify();  // the whole window, as the step would have without the extent
+    EXPECT_EQ(copy_u8(v.cls, d.cells()), cls) << "step " << s;
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(copy_f(v.theta[c], d.faces(c)), theta[size_t(c)]) << "step " << s << " component " << c;
+      EXPECT_EQ(copy_f(v.solid_vel[c], d.faces(c)), solid[size_t(c)]) << "step " << s << " component " << c;
+      EXPECT_EQ(copy_u8(v.fluid[c], d.faces(c)), fluid[size_t(c)]) << "step " << s << " component " << c;
+    }
+    ++checked;
+  }
+  std::printf("[ extent ] layers visited: %d at the first step, %d at the last (of %d)\n", first_layers, last_layers,
+              d.nz);
+  EXPECT_EQ(checked, 30);
+  EXPECT_EQ(first_layers, d.nz) << "the first step visits every layer once";
+  EXPECT_LT(last_layers, 12) << "the extent follows the paint down when the particles are gone";
+}
+
 TEST_F(GridStepTest, DriedCellsNeverMove) {
   TileStore canvas(device_, CanvasDims{256, 256, 64});
   GridParams p;

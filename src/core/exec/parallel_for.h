@@ -25,6 +25,12 @@ __global__ void parallel_for_kernel(int64_t n, F fn) {
   const int64_t stride = int64_t(blockDim.x) * gridDim.x;
   for (int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x; i < n; i += stride) fn(i);
 }
+template <typename F>
+__global__ void parallel_for_count_kernel(const int64_t* count, int64_t capacity, F fn) {
+  const int64_t n = *count < capacity ? *count : capacity;
+  const int64_t stride = int64_t(blockDim.x) * gridDim.x;
+  for (int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x; i < n; i += stride) fn(i);
+}
 }  // namespace detail
 #endif
 
@@ -48,6 +54,25 @@ void parallel_for(int64_t n, F fn, int64_t serial_below = kMinParallelSize) {
   }
 #pragma omp parallel for schedule(static)
   for (int64_t i = 0; i < n; ++i) fn(i);
+#endif
+}
+
+/// parallel_for over the first *count of `capacity` elements, where *count is device memory a
+/// kernel wrote: the host never waits for it. CUDA launches over the capacity and the threads
+/// past *count return; the CPU backend, whose device memory is the host's, loops to *count.
+template <typename F>
+void parallel_for_count(const int64_t* count, int64_t capacity, F fn, int64_t serial_below = kMinParallelSize) {
+  if (capacity <= 0) return;
+#if defined(__CUDACC__)
+  static_assert(__nv_is_extended_host_device_lambda_closure_type(F) || !__nv_is_extended_device_lambda_closure_type(F),
+                "parallel_for_count takes __host__ __device__ (WB_HD) lambdas or functors");
+  constexpr int kBlock = 256;
+  int64_t blocks = (capacity + kBlock - 1) / kBlock;
+  if (blocks > (int64_t(1) << 20)) blocks = int64_t(1) << 20;
+  detail::parallel_for_count_kernel<<<unsigned(blocks), kBlock, 0, ::wb::cuda_stream()>>>(count, capacity, fn);
+  WB_CUDA_CHECK_LAUNCH();
+#else
+  parallel_for(*count < capacity ? *count : capacity, fn, serial_below);
 #endif
 }
 

@@ -81,6 +81,12 @@ void apply_all_d(const Device& d, PoissonView s, const float* x, float* out) {
 }
 void apply_pressure_d(const Device& d, GridView g, const float* p) { WB_DISPATCH(d, grid_apply_pressure(g, p)); }
 void extrapolate_d(const Device& d, GridView g) { WB_DISPATCH(d, grid_extrapolate(g)); }
+void layer_top_d(const Device& d, GridDims g, const float* rho, const float* pd, float* top) {
+  WB_DISPATCH(d, grid_layer_top(g, rho, pd, top));
+}
+void extent_d(const Device& d, GridDims g, const float* before, const float* after, GridExtent* e) {
+  WB_DISPATCH(d, grid_extent(g, before, after, e));
+}
 void dry_d(const Device& d, PaintWindowView pw, float amount) { WB_DISPATCH(d, grid_dry(pw, amount)); }
 void max_speed_d(const Device& d, GridView g, float* out) { WB_DISPATCH(d, grid_max_abs_fluid_velocity(g, out)); }
 void square_d(const Device& d, const float* x, float* out, int64_t n) { WB_DISPATCH(d, grid_square(x, out, n)); }
@@ -254,7 +260,11 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   cg_sums_.set_device(d);
   cg_sums_.resize(4);
   advect_max_.set_device(d);
-  advect_max_.resize(3);
+  advect_max_.resize(4);
+  // Every layer until the first step has found the paint's (its stages then visit them all once).
+  const GridExtent all{g.cells(), g.nu() + g.nv() + g.nw(), g.nz, g.nz};
+  extent_.set_device(d);
+  extent_.copy_from_host(&all, 1);
   paint_tmp_ = PaintWindow(d, dims);
   scratch_.reserve(d, g.cells());
   classify();
@@ -271,6 +281,7 @@ GridView Grid::view() {
   }
   v.cls = cls_.data();
   v.pressure = pressure_.data();
+  v.extent = stage_extent_;
   return v;
 }
 
@@ -343,6 +354,13 @@ void Grid::advect(float dt) {
   v = view();
   advect_vel_d(d, v, vel_tmp_[0].data(), vel_tmp_[1].data(), vel_tmp_[2].data(), dt,
                std::min(g.nz, joint_top + n + 2));
+}
+
+void Grid::find_extent() {
+  const GridDims g = dims();
+  layer_top_d(device(), g, window_.paint().density.data(), particle_density_, cell_tmp_.data());
+  reduce_max_into(device(), cell_tmp_.data(), g.cells(), advect_max_.data() + 3, ws_);
+  extent_d(device(), g, advect_max_.data() + 2, advect_max_.data() + 3, extent_.data());
 }
 
 void Grid::rheology() {
@@ -475,11 +493,20 @@ void Grid::step(float dt, const std::function<void()>& after_advection) {
   classify();  // solids for the backtrace (dried paint is never moved)
   advect(dt);
   if (after_advection) after_advection();  // the simulator joins the particles' fields here
+  // From here on the stages visit only the layers that can hold liquid (docs/GRID.md "Work in
+  // proportion to the paint"): above them the first classification stands and nothing moves.
+  find_extent();
+  struct Bounded {
+    const GridExtent*& at;
+    ~Bounded() { at = nullptr; }
+  } bounded{stage_extent_};
+  stage_extent_ = extent_.data();
   classify();  // liquid where the paint now is
   rheology();
   add_external_forces(dt);
   apply_viscosity(dt);
   project(dt);
+  stage_extent_ = nullptr;
   dry(dt);
 }
 

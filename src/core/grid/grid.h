@@ -117,6 +117,8 @@ class Grid {
 
   // --- diagnostics ---
   const GridStats& stats() const { return stats_; }
+  /// The layers the last step's stages after the joint fields visited (device; docs/GRID.md).
+  const DeviceBuffer<GridExtent>& extent() const { return extent_; }
   /// ||div||_2 of the current velocity over liquid cells, against the compression source of
   /// packed paint when dt > 0 (as the projection of that step measures it).
   double divergence_norm(float dt = 0.f);
@@ -145,7 +147,13 @@ class Grid {
   DeviceBuffer<float> cg_nu_, cg_x_, cg_b_, cg_r_, cg_z_, cg_p_, cg_q_, cg_diag_, cg_dot_a_, cg_dot_b_;
   /// The CG's scalars on the device: r.z of the two latest iterations, p.Ap, b.D^-1 b.
   DeviceBuffer<double> cg_sums_;
-  DeviceBuffer<float> advect_max_;  ///< the advection's outflow rate and top layers (paint, joint), one copy
+  /// The advection's outflow rate and top layers (paint, joint) in one copy, then the joint
+  /// top after the particles joined (find_extent).
+  DeviceBuffer<float> advect_max_;
+  DeviceBuffer<GridExtent> extent_;  ///< the layers the stages after the joint fields visit (device)
+  const GridExtent* stage_extent_ = nullptr;  ///< extent_ while step() runs those stages, else null
+  /// The layers holding paint or particles now, or liquid before the advection: extent_.
+  void find_extent();
   PaintWindow paint_tmp_;
   SolverScratch scratch_;
   Workspace ws_;
@@ -184,6 +192,8 @@ class Grid {
   void poisson_apply_all(PoissonView s, const float* x, float* out);                                                 \
   void grid_apply_pressure(GridView g, const float* p);                                                              \
   void grid_extrapolate(GridView g);                                                                                 \
+  void grid_layer_top(GridDims d, const float* rho, const float* particle_density, float* top);                     \
+  void grid_extent(GridDims d, const float* top_before, const float* top_after, GridExtent* e);                      \
   void grid_dry(PaintWindowView pw, float amount);                                                                   \
   void grid_shift_lattice(const float* src, float* dst, int ex, int ey, int ez, int dx, int dy, int dz);            \
   void grid_max_abs_fluid_velocity(GridView g, float* out);                                                          \

@@ -66,12 +66,33 @@ struct GridDims {
   }
 };
 
+/// The layers of the window the grid's stages visit after the joint fields (device memory,
+/// written each step by grid_extent; docs/GRID.md "Work in proportion to the paint"). Cells at
+/// k < layers may hold paint, particles or liquid; above them every cell is air or solid as the
+/// step's first classification found it, and every face there is non-fluid. Stages over this
+/// extent leave the rest as it was, and the layers the last step used (`dirty`) are visited once
+/// more, so that what they held goes back to its value for cells without liquid.
+struct GridExtent {
+  int64_t cells;   ///< nx ny layers
+  int64_t faces;   ///< the faces of those cells: u and v below `layers`, w up to layer `layers`
+  int32_t layers;  ///< cells with k < layers
+  int32_t dirty;   ///< the layers holding liquid at the last step
+};
+
+/// Faces of the cells below `layers`, as one list u | v | w: each a prefix of its component's
+/// array (z is the slowest index). With layers = nz, every face.
+WB_HD WB_INLINE int64_t faces_below(int nx, int ny, int nz, int layers) {
+  const int w_layers = layers < nz ? layers + 1 : nz + 1;
+  return int64_t(nx + 1) * ny * layers + int64_t(nx) * (ny + 1) * layers + int64_t(nx) * ny * w_layers;
+}
+
 /// The pressure system A p = b on liquid cells (Batty et al. 2007 face fractions):
 /// (A p)_i = sum_f theta_f (p_i - p_nb(f)), p = 0 outside liquid, theta = open fraction.
 struct PoissonView {
   GridDims d;
   const uint8_t* cls;      ///< CellClass per cell
   const float* theta[3];   ///< open face fractions per component (u, v, w)
+  const GridExtent* extent = nullptr;  ///< the cells the solver visits (device); null: every cell
 };
 
 /// Everything the grid kernels read and write, by value.
@@ -83,6 +104,7 @@ struct GridView {
   uint8_t* cls;          ///< CellClass per cell
   uint8_t* fluid[3];     ///< 1 where the face is open and touches a liquid cell (set by classify)
   float* pressure;       ///< projected pressure (scaled so that u -= grad p), cells^2/s
+  const GridExtent* extent = nullptr;  ///< the layers the stages visit (device); null: the whole window
   WB_HD PoissonView poisson() const {
     PoissonView p;
     p.d = d;
@@ -90,6 +112,7 @@ struct GridView {
     p.theta[0] = theta[0];
     p.theta[1] = theta[1];
     p.theta[2] = theta[2];
+    p.extent = extent;
     return p;
   }
 };

@@ -27,12 +27,57 @@ WB_HD WB_INLINE void split_face(const GridDims& d, int64_t t, int& c, int64_t& f
   }
 }
 WB_HD WB_INLINE int64_t all_faces(const GridDims& d) { return d.nu() + d.nv() + d.nw(); }
+/// Face t of the faces of the cells below `layers` (faces_below): its component c and index f.
+WB_HD WB_INLINE void split_face_below(const GridDims& d, int layers, int64_t t, int& c, int64_t& f) {
+  const int64_t nu = int64_t(d.nx + 1) * d.ny * layers, nv = int64_t(d.nx) * (d.ny + 1) * layers;
+  if (t < nu) {
+    c = 0;
+    f = t;
+  } else if (t < nu + nv) {
+    c = 1;
+    f = t - nu;
+  } else {
+    c = 2;
+    f = t - nu - nv;
+  }
+}
+template <class F>
+struct FacesBelow {
+  GridDims d;
+  const GridExtent* e;
+  F fn;
+  WB_HD void operator()(int64_t t) const {
+    int c;
+    int64_t f;
+    split_face_below(d, e ? e->layers : d.nz, t, c, f);
+    fn(c, f);
+  }
+};
 }  // namespace detail
+
+/// fn(c) for every cell a stage visits: those below the extent's layers, or all.
+template <class F>
+void for_cells(const GridDims& d, const GridExtent* e, F fn) {
+  if (e)
+    parallel_for_count(&e->cells, d.cells(), fn);
+  else
+    parallel_for(d.cells(), fn);
+}
+/// fn(c, f) (component, index) for every face a stage visits: those of the cells below the
+/// extent's layers, or all.
+template <class F>
+void for_faces(const GridDims& d, const GridExtent* e, F fn) {
+  const detail::FacesBelow<F> loop{d, e, fn};
+  if (e)
+    parallel_for_count(&e->faces, detail::all_faces(d), loop);
+  else
+    parallel_for(detail::all_faces(d), loop);
+}
 
 void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float* particle_density, int canvas_w,
                    int canvas_h, int canvas_d, float liquid_threshold, float dry_threshold) {
   const GridDims d = g.d;
-  parallel_for(d.cells(), [=] WB_HD(int64_t c) {
+  for_cells(d, g.extent, [=] WB_HD(int64_t c) {
     int i, j, k;
     d.decompose_cell(c, i, j, k);
     const int cx = i + pw.ox, cy = j + pw.oy, cz = k + pw.oz;
@@ -41,20 +86,16 @@ void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float*
     const float joint = pw.density[c] + (particle_density ? particle_density[c] : 0.f);
     g.cls[c] = classify_cell(joint, pw.dryness[c], on, liquid_threshold, dry_threshold);
   });
-  parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
-    int c, i, j, k;
-    int64_t f;
-    detail::split_face(d, t, c, f);
+  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f) {
+    int i, j, k;
     d.decompose_face(c, f, i, j, k);
     float theta, us;
     face_fraction(d, g.cls, br, c, i, j, k, theta, us);
     g.theta[c][f] = theta;
     g.solid_vel[c][f] = us;
   });
-  parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
-    int c, i, j, k;
-    int64_t f;
-    detail::split_face(d, t, c, f);
+  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f) {
+    int i, j, k;
     d.decompose_face(c, f, i, j, k);
     g.fluid[c][f] = face_is_fluid(d, g.cls, g.theta[c], c, i, j, k) ? 1 : 0;
   });
@@ -140,20 +181,19 @@ void grid_advect_velocity(GridView g, const float* u, const float* v, const floa
 void grid_gravity(GridView g, float* ph, float g_dt) {
   const GridDims d = g.d;
   // Hydrostatic head of each liquid cell: contiguous liquid cells from it to the surface.
+  const GridExtent* e = g.extent;
   parallel_for(int64_t(d.nx) * d.ny, [=] WB_HD(int64_t col) {
     const int i = int(col % d.nx), j = int(col / d.nx);
     float head = 0.f;
-    for (int k = d.nz - 1; k >= 0; --k) {
+    for (int k = (e ? e->layers : d.nz) - 1; k >= 0; --k) {
       const int64_t c = d.cell(i, j, k);
       head = g.cls[c] == kCellLiquid ? head + g_dt : 0.f;
       ph[c] = head;
     }
   });
-  parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
-    int c, i, j, k;
-    int64_t f;
-    detail::split_face(d, t, c, f);
+  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f) {
     if (g.theta[c][f] <= 0.f) return;
+    int i, j, k;
     d.decompose_face(c, f, i, j, k);
     int64_t a, b;
     bool ha, hb;
@@ -167,7 +207,7 @@ void grid_gravity(GridView g, float* ph, float g_dt) {
 void grid_effective_viscosity(GridView g, const float* oil, HerschelBulkley stiff, HerschelBulkley oily, float m,
                               float* mu) {
   const GridDims d = g.d;
-  parallel_for(d.cells(), [=] WB_HD(int64_t c) {
+  for_cells(d, g.extent, [=] WB_HD(int64_t c) {
     if (g.cls[c] != kCellLiquid) {
       mu[c] = 0.f;
       return;
@@ -190,11 +230,11 @@ void grid_viscous_flags(GridView g, uint32_t* flag) {
 
 void grid_viscous_list(GridView g, const uint32_t* idx, uint32_t* list) {
   const GridDims d = g.d;
-  parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
-    int c;
-    int64_t f;
-    detail::split_face(d, t, c, f);
-    if (g.fluid[c][f]) list[idx[t]] = uint32_t(t);
+  // Fluid faces lie below the extent's layers; the list and idx are of every face.
+  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f) {
+    if (!g.fluid[c][f]) return;
+    const int64_t t = global_face(d, c, f);
+    list[idx[t]] = uint32_t(t);
   });
 }
 
@@ -276,7 +316,7 @@ void grid_viscous_write(GridView g, const uint32_t* list, int64_t n, const float
 
 void grid_rhs(GridView g, const float* rho, float inv_dt, float* b) {
   const GridDims d = g.d;
-  parallel_for(d.cells(), [=] WB_HD(int64_t c) {
+  for_cells(d, g.extent, [=] WB_HD(int64_t c) {
     if (g.cls[c] != kCellLiquid) {
       b[c] = 0.f;
       return;
@@ -288,17 +328,17 @@ void grid_rhs(GridView g, const float* rho, float inv_dt, float* b) {
 }
 
 void poisson_jacobi(PoissonView s, const float* b, const float* x, float* out, float omega) {
-  parallel_for(s.d.cells(), [=] WB_HD(int64_t c) { out[c] = jacobi_update(s, b, x, c, omega); });
+  for_cells(s.d, s.extent, [=] WB_HD(int64_t c) { out[c] = jacobi_update(s, b, x, c, omega); });
 }
 
 void poisson_residual(PoissonView s, const float* b, const float* x, float* r) {
-  parallel_for(s.d.cells(), [=] WB_HD(int64_t c) {
+  for_cells(s.d, s.extent, [=] WB_HD(int64_t c) {
     r[c] = s.cls[c] == kCellLiquid ? b[c] - poisson_apply(s, x, c) : 0.f;
   });
 }
 
 void poisson_chebyshev(PoissonView s, const float* b, const float* x, const float* x_prev, float* out, float omega_k) {
-  parallel_for(s.d.cells(), [=] WB_HD(int64_t c) {
+  for_cells(s.d, s.extent, [=] WB_HD(int64_t c) {
     const float xj = jacobi_update(s, b, x, c, 1.f);
     out[c] = s.cls[c] == kCellLiquid ? omega_k * (xj - x_prev[c]) + x_prev[c] : 0.f;
   });
@@ -306,7 +346,7 @@ void poisson_chebyshev(PoissonView s, const float* b, const float* x, const floa
 
 void poisson_fixed_point_first(PoissonView s, const float* r, const float* y, float* out, float alpha) {
   // One Jacobi sweep on the residual r started from alpha * y (Eq. 3, inner term).
-  parallel_for(s.d.cells(), [=] WB_HD(int64_t c) {
+  for_cells(s.d, s.extent, [=] WB_HD(int64_t c) {
     if (s.cls[c] != kCellLiquid) {
       out[c] = 0.f;
       return;
@@ -321,7 +361,7 @@ void poisson_fixed_point_first(PoissonView s, const float* r, const float* y, fl
 
 void poisson_fixed_point_second(PoissonView s, const float* r, const float* z, float* y_out, float* x) {
   // Second Jacobi sweep, then x += y (the pressure applied is the sum of the corrections).
-  parallel_for(s.d.cells(), [=] WB_HD(int64_t c) {
+  for_cells(s.d, s.extent, [=] WB_HD(int64_t c) {
     const float y = jacobi_update(s, r, z, c, 1.f);
     y_out[c] = y;
     x[c] += y;
@@ -329,15 +369,13 @@ void poisson_fixed_point_second(PoissonView s, const float* r, const float* z, f
 }
 
 void poisson_apply_all(PoissonView s, const float* x, float* out) {
-  parallel_for(s.d.cells(), [=] WB_HD(int64_t c) { out[c] = poisson_apply(s, x, c); });
+  for_cells(s.d, s.extent, [=] WB_HD(int64_t c) { out[c] = poisson_apply(s, x, c); });
 }
 
 void grid_apply_pressure(GridView g, const float* p) {
   const GridDims d = g.d;
-  parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
-    int c, i, j, k;
-    int64_t f;
-    detail::split_face(d, t, c, f);
+  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f) {
+    int i, j, k;
     d.decompose_face(c, f, i, j, k);
     g.vel[c][f] = projected_face_velocity(g, p, c, i, j, k);
   });
@@ -346,10 +384,8 @@ void grid_apply_pressure(GridView g, const float* p) {
 void grid_extrapolate(GridView g) {
   const GridDims d = g.d;
   // Writes only faces that touch no liquid, reads only faces that do: safe in place.
-  parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
-    int c, i, j, k;
-    int64_t f;
-    detail::split_face(d, t, c, f);
+  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f) {
+    int i, j, k;
     if (g.theta[c][f] <= 0.f) {
       g.vel[c][f] = g.solid_vel[c][f];
       return;
@@ -357,6 +393,26 @@ void grid_extrapolate(GridView g) {
     if (g.fluid[c][f]) return;
     d.decompose_face(c, f, i, j, k);
     g.vel[c][f] = extrapolated_face_velocity(g, c, i, j, k);
+  });
+}
+
+void grid_layer_top(GridDims d, const float* rho, const float* particle_density, float* top) {
+  parallel_for(d.cells(), [=] WB_HD(int64_t c) {
+    const bool paint = rho[c] > 0.f || (particle_density && particle_density[c] > 0.f);
+    top[c] = paint ? float(c / (int64_t(d.nx) * d.ny) + 1) : 0.f;
+  });
+}
+
+void grid_extent(GridDims d, const float* top_before, const float* top_after, GridExtent* e) {
+  parallel_for(1, [=] WB_HD(int64_t) {
+    // The liquid's layers, and the one above them, whose faces extrapolation writes.
+    const float top = maxf(maxf(*top_before, *top_after), 0.f);
+    const int now = top + 1.f < float(d.nz) ? int(top) + 1 : d.nz;
+    const int layers = now > e->dirty ? now : e->dirty;
+    e->layers = layers;
+    e->dirty = now;
+    e->cells = int64_t(d.nx) * d.ny * layers;
+    e->faces = faces_below(d.nx, d.ny, d.nz, layers);
   });
 }
 

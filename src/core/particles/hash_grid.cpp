@@ -11,8 +11,8 @@
 namespace wb {
 namespace {
 void keys(const Device& d, const Vec3* x, const Vec3* v, float rw, int64_t n, float inv_h, uint32_t mask, uint32_t* k,
-          uint32_t* idx, int32_t* bounds) {
-  WB_DISPATCH(d, hash_grid_keys(x, v, rw, n, inv_h, mask, k, idx, bounds));
+          uint32_t* idx, int32_t* bounds, int32_t* coarse) {
+  WB_DISPATCH(d, hash_grid_keys(x, v, rw, n, inv_h, mask, k, idx, bounds, coarse));
 }
 void ranges(const Device& d, const uint32_t* k, const uint32_t* idx, const Vec3* x, const Vec3* v, float rw, int64_t n,
             uint32_t* s, uint32_t* e, Vec3* sx) {
@@ -28,6 +28,7 @@ SampleHashGrid::SampleHashGrid(const Device& device) : device_(device) {
   end_.set_device(device);
   sorted_x_.set_device(device);
   bounds_.set_device(device);
+  coarse_.set_device(device);
 }
 
 void SampleHashGrid::build(const SampleView& s, float cell_size, Workspace& ws, float rewind_dt) {
@@ -49,9 +50,11 @@ void SampleHashGrid::build(const SampleView& s, float cell_size, Workspace& ws, 
   if (start_.size() < buckets) {
     start_.grow_keep(buckets);
     end_.grow_keep(buckets);
+    coarse_.grow_keep(buckets);
   }
   start_.fill_zero();
   end_.fill_zero();
+  coarse_.fill_zero();
   // Empty box (lo > hi) until the key pass widens it with integer atomics.
   const int32_t empty_box[6] = {INT32_MAX, INT32_MAX, INT32_MAX, INT32_MIN, INT32_MIN, INT32_MIN};
   bounds_.copy_from_host(empty_box, 6);
@@ -61,13 +64,15 @@ void SampleHashGrid::build(const SampleView& s, float cell_size, Workspace& ws, 
     index_.grow_keep(size_t(n));
     sorted_x_.grow_keep(size_t(n));
   }
-  keys(device_, s.x, s.v, rewind_dt, n, 1.f / h_, mask_, keys_.data(), index_.data(), bounds_.data());
+  keys(device_, s.x, s.v, rewind_dt, n, 1.f / h_, mask_, keys_.data(), index_.data(), bounds_.data(),
+       coarse_.data());
   sort_by_key(device_, keys_.data(), index_.data(), n, bits, ws);
   ranges(device_, keys_.data(), index_.data(), s.x, s.v, rewind_dt, n, start_.data(), end_.data(), sorted_x_.data());
 }
 
 HashGridView SampleHashGrid::view() const {
-  return HashGridView{start_.data(), end_.data(), index_.data(), sorted_x_.data(), count_, h_, mask_, bounds_.data()};
+  return HashGridView{start_.data(), end_.data(), index_.data(), sorted_x_.data(), count_, h_, mask_, bounds_.data(),
+                      coarse_.data()};
 }
 
 void SampleHashGrid::query_nearest(const ParticleView& p, float max_range) const {

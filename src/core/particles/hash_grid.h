@@ -2,8 +2,8 @@
 // queried from the particles for the nearest sample and the distance to it, within the
 // range its user needs (d_B of Eq. 10 within D1; Eq. 14's absorber within the load sphere).
 // "Within D0" of §5.2 is the coarse distance field of the transfer stage, not this query.
-// Three launches to build: bucket keys, radix sort, bucket ranges; one to gather the sorted
-// positions.
+// Three launches to build: bucket keys (and the coarse occupancy), radix sort, bucket ranges;
+// one to gather the sorted positions.
 #pragma once
 #include <cstdint>
 
@@ -43,7 +43,7 @@ class SampleHashGrid {
   uint32_t mask_ = 0;
   DeviceBuffer<uint32_t> keys_, index_, start_, end_;
   DeviceBuffer<Vec3> sorted_x_;
-  DeviceBuffer<int32_t> bounds_;
+  DeviceBuffer<int32_t> bounds_, coarse_;  ///< the samples' cell box; coarse occupancy per bucket
 };
 
 /// Reference for tests: the nearest sample to p among all n (host arrays), within max_range.
@@ -51,14 +51,14 @@ NearestSample nearest_sample_brute_force(const Vec3* samples, int64_t n, Vec3 p,
 
 namespace cpu {
 void hash_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, uint32_t mask,
-                    uint32_t* keys, uint32_t* index, int32_t* bounds);
+                    uint32_t* keys, uint32_t* index, int32_t* bounds, int32_t* coarse);
 void hash_grid_ranges(const uint32_t* sorted_keys, const uint32_t* index, const Vec3* x, const Vec3* v, float rewind_dt,
                       int64_t n, uint32_t* start, uint32_t* end, Vec3* sorted_x);
 void hash_grid_query(HashGridView g, ParticleView p, float max_range);
 }  // namespace cpu
 namespace cuda {
 void hash_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, uint32_t mask,
-                    uint32_t* keys, uint32_t* index, int32_t* bounds);
+                    uint32_t* keys, uint32_t* index, int32_t* bounds, int32_t* coarse);
 void hash_grid_ranges(const uint32_t* sorted_keys, const uint32_t* index, const Vec3* x, const Vec3* v, float rewind_dt,
                       int64_t n, uint32_t* start, uint32_t* end, Vec3* sorted_x);
 void hash_grid_query(HashGridView g, ParticleView p, float max_range);

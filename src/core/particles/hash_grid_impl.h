@@ -12,7 +12,7 @@ WB_HD WB_INLINE Vec3 hashed_position(const Vec3* x, const Vec3* v, float rewind_
 }
 
 void hash_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, uint32_t mask,
-                    uint32_t* keys, uint32_t* index, int32_t* bounds) {
+                    uint32_t* keys, uint32_t* index, int32_t* bounds, int32_t* coarse) {
   parallel_for(n, [=] WB_HD(int64_t i) {
     int cx, cy, cz;
     hash_cell_of(hashed_position(x, v, rewind_dt, i), inv_h, cx, cy, cz);
@@ -23,6 +23,7 @@ void hash_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, fl
     atomic_max(&bounds[4], int32_t(cy));
     atomic_max(&bounds[5], int32_t(cz));
     keys[i] = hash_bucket(cx, cy, cz, mask);
+    atomic_or(&coarse[hash_bucket(cx >> kCoarseShift, cy >> kCoarseShift, cz >> kCoarseShift, mask)], 1);
     index[i] = uint32_t(i);
   });
 }
