@@ -12,22 +12,9 @@
 namespace wb::WB_BACKEND_NS {
 
 namespace detail {
-/// Face t of the concatenated u | v | w list: its component c and index f within it.
-WB_HD WB_INLINE void split_face(const GridDims& d, int64_t t, int& c, int64_t& f) {
-  const int64_t nu = d.nu(), nv = d.nv();
-  if (t < nu) {
-    c = 0;
-    f = t;
-  } else if (t < nu + nv) {
-    c = 1;
-    f = t - nu;
-  } else {
-    c = 2;
-    f = t - nu - nv;
-  }
-}
 WB_HD WB_INLINE int64_t all_faces(const GridDims& d) { return d.nu() + d.nv() + d.nw(); }
-/// Face t of the faces of the cells below `layers` (faces_below): its component c and index f.
+/// Face t of the faces of the cells below `layers` (faces_below) as one list u | v | w: its
+/// component c and index f within it (layers = nz: every face).
 WB_HD WB_INLINE void split_face_below(const GridDims& d, int layers, int64_t t, int& c, int64_t& f) {
   const int64_t nu = int64_t(d.nx + 1) * d.ny * layers, nv = int64_t(d.nx) * (d.ny + 1) * layers;
   if (t < nu) {
@@ -223,7 +210,7 @@ void grid_viscous_flags(GridView g, uint32_t* flag) {
   parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
     int c;
     int64_t f;
-    detail::split_face(d, t, c, f);
+    detail::split_face_below(d, d.nz, t, c, f);
     flag[t] = g.fluid[c][f] ? 1u : 0u;
   });
 }
@@ -243,7 +230,7 @@ namespace detail {
 WB_HD WB_INLINE int64_t list_face(const GridDims& d, const uint32_t* list, int64_t e, int& c, int& i, int& j,
                                   int& k) {
   int64_t f;
-  split_face(d, int64_t(list[e]), c, f);
+  split_face_below(d, d.nz, int64_t(list[e]), c, f);
   d.decompose_face(c, f, i, j, k);
   return f;
 }
@@ -309,7 +296,7 @@ void grid_viscous_write(GridView g, const uint32_t* list, int64_t n, const float
   parallel_for(n, [=] WB_HD(int64_t e) {
     int c;
     int64_t f;
-    detail::split_face(d, int64_t(list[e]), c, f);
+    detail::split_face_below(d, d.nz, int64_t(list[e]), c, f);
     g.vel[c][f] = x[e];
   });
 }
@@ -436,7 +423,7 @@ void grid_max_abs_fluid_velocity(GridView g, float* out) {
   parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
     int c;
     int64_t f;
-    detail::split_face(d, t, c, f);
+    detail::split_face_below(d, d.nz, t, c, f);
     out[t] = g.fluid[c][f] ? fabsf(g.vel[c][f]) : 0.f;
   });
 }
