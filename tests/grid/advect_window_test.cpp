@@ -131,4 +131,79 @@ TEST_F(AdvectWindowTest, RecentreSnapsToTheGrid) {
   EXPECT_FALSE(w.recentre_on(Vec3(502.f, 301.f, 0.f), 8));  // less than the snap: no gather/scatter
 }
 
+// The paint's advection visits only the tiles of columns within its reach of the paint
+// (docs/GRID.md "Work in proportion to the paint"). The same paint and velocity in a window whose
+// sides are not multiples of the tile, and in a larger window holding it at an offset that puts
+// the tiles elsewhere, advect to the same cells bit for bit: at 10 cells a step (11 sub-steps,
+// a reach of two tiles) the paint crosses tiles, rises over its top and leaves columns empty.
+// The flow runs away from the small window's low walls and its traces (one cell a pass) stop
+// short of the high ones, so the walls, where the two windows differ, see no paint.
+TEST_F(AdvectWindowTest, TiledAdvectionEqualsAnyTilingOfTheSameCells) {
+  const Int3 small{141, 45, 14}, large{160, 56, 14};
+  const int ox = 5, oy = 3;  // the small window's cell (0, 0) in the large one
+  auto paint_at = [](int i, int j, int k) {  // small-window cells
+    const bool blob = i >= 10 && i < 18 && j >= 8 && j < 16 && k < 6;
+    return blob ? (k == 5 ? 0.4f : 1.f) : 0.f;
+  };
+  // p in small-window cells; across y only in the first two steps (4 steps carry the paint past
+  // tiles it left, whose scratch cells keep what the passes wrote there).
+  auto velocity_at = [](int c, Vec3 p, int step) {
+    return c == 0 ? 600.f
+                  : (c == 1 ? (step < 2 ? 40.f * (1.f + std::sin(p.x / 7.f)) : 0.f)
+                            : (p.z > 0.5f ? 15.f * (1.f + std::cos(p.y / 5.f)) : 0.f));
+  };
+  std::vector<std::vector<float>> result[2];
+  int substeps = 0;
+  for (int w = 0; w < 2; ++w) {
+    TileStore canvas(device_, CanvasDims{256, 256, 64});
+    const Int3 dims = w == 0 ? small : large;
+    const int sx = w == 0 ? 0 : ox, sy = w == 0 ? 0 : oy;
+    Grid g(canvas, GridParams{}, dims, Int3{32, 32, 0});
+    const GridDims d = g.dims();
+    paint_cells(g, [&](int i, int j, int k) { return paint_at(i - sx, j - sy, k); });
+    for (int s = 0; s < 4; ++s) {
+      for (int c = 0; c < 3; ++c) {
+        std::vector<float> v(size_t(d.faces(c)));
+        int ex, ey, ez;
+        d.face_extent(c, ex, ey, ez);
+        for (int k = 0; k < ez; ++k)
+          for (int j = 0; j < ey; ++j)
+            for (int i = 0; i < ex; ++i)
+              v[size_t(d.fidx(c, i, j, k))] = velocity_at(c, face_position(c, i, j, k) - Vec3(float(sx), float(sy), 0.f), s);
+        g.window().velocity(c).copy_from_host(v);
+      }
+      g.classify();
+      g.advect(g.params().dt);
+      substeps = std::max(substeps, g.stats().advect_substeps);
+    }
+    // Back to small-window cells.
+    const auto f = g.window().paint().to_host();
+    result[w].assign(size_t(kPaintFieldCount), std::vector<float>(size_t(small.x) * small.y * small.z, 0.f));
+    for (int q = 0; q < kPaintFieldCount; ++q)
+      for (int k = 0; k < small.z; ++k)
+        for (int j = 0; j < small.y; ++j)
+          for (int i = 0; i < small.x; ++i)
+            result[w][size_t(q)][(size_t(k) * small.y + size_t(j)) * small.x + size_t(i)] =
+                f[size_t(q)][size_t(d.cell(i + sx, j + sy, k))];
+    if (w == 1) {
+      // Nothing outside the small window's cells.
+      double outside = 0;
+      for (int k = 0; k < d.nz; ++k)
+        for (int j = 0; j < d.ny; ++j)
+          for (int i = 0; i < d.nx; ++i)
+            if (i < sx || j < sy || i >= sx + small.x || j >= sy + small.y) outside += f[0][size_t(d.cell(i, j, k))];
+      EXPECT_EQ(outside, 0.0);
+    }
+  }
+  std::printf("[ tiles ] %d sub-steps a step\n", substeps);
+  EXPECT_GE(substeps, 9) << "the reach must span more than one tile";
+  double moved = 0;
+  for (int k = 0; k < small.z; ++k)
+    for (int j = 0; j < small.y; ++j)
+      for (int i = 0; i < small.x; ++i)
+        if (i >= 40) moved += result[0][0][(size_t(k) * small.y + size_t(j)) * small.x + size_t(i)];
+  EXPECT_GT(moved, 100.0) << "the blob must have crossed tiles";
+  for (int q = 0; q < kPaintFieldCount; ++q) EXPECT_EQ(result[0][size_t(q)], result[1][size_t(q)]) << "field " << q;
+}
+
 }  // namespace wb::test

@@ -22,8 +22,17 @@ void classify_d(const Device& d, GridView g, PaintWindowView pw, BristleField br
 void outflow_d(const Device& d, GridView g, const float* rho, const float* pd, float* out, float* top, float* jt) {
   WB_DISPATCH(d, grid_paint_outflow(g, rho, pd, out, top, jt));
 }
-void advect_axis_d(const Device& d, GridView g, PaintWindowView s, PaintWindowView t, int axis, float dt, int layers) {
-  WB_DISPATCH(d, grid_advect_paint_axis(g, s, t, axis, dt, layers));
+void advect_axis_d(const Device& d, GridView g, PaintWindowView s, PaintWindowView t, int axis, float dt,
+                   PaintTiles tiles) {
+  WB_DISPATCH(d, grid_advect_paint_axis(g, s, t, axis, dt, tiles));
+}
+void paint_tiles_d(const Device& d, GridDims g, const float* rho, int layers, int reach, int32_t* mark, int32_t* a,
+                   int32_t* h, int64_t* counts) {
+  WB_DISPATCH(d, grid_paint_tiles(g, rho, layers, reach, mark, a, h, counts));
+}
+void copy_tiles_d(const Device& d, GridDims g, PaintTiles t, PaintWindowView s, PaintWindowView dst, bool halo,
+                  int layers) {
+  WB_DISPATCH(d, grid_copy_paint_tiles(g, t, s, dst, halo, layers));
 }
 void advect_vel_d(const Device& d, GridView g, const float* u, const float* v, const float* w, float dt, int layers) {
   WB_DISPATCH(d, grid_advect_velocity(g, u, v, w, dt, layers));
@@ -261,6 +270,13 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   cg_sums_.resize(4);
   advect_max_.set_device(d);
   advect_max_.resize(4);
+  const size_t tiles = size_t((g.nx + kPaintTile - 1) / kPaintTile) * size_t((g.ny + kPaintTile - 1) / kPaintTile);
+  for (auto* b : {&tile_mark_, &tile_active_, &tile_halo_}) {
+    b->set_device(d);
+    b->resize(tiles);
+  }
+  tile_counts_.set_device(d);
+  tile_counts_.resize(5);
   // Every layer until the first step has found the paint's (its stages then visit them all once).
   const GridExtent all{g.cells(), g.nu() + g.nv() + g.nw(), g.nz, g.nz};
   extent_.set_device(d);
@@ -324,27 +340,39 @@ void Grid::advect(float dt) {
   const int n = std::clamp(int(std::ceil(courant / params_.advect_courant)), 1, params_.advect_max_substeps);
   stats_.advect_substeps = n;
   stats_.advect_courant = courant / float(n);
-  // Work in proportion to the paint's height: a z pass moves paint at most one cell up, so above
-  // top + n layers nothing changes. Those layers of the scratch copy are made equal to the paint
-  // once, since the passes swap the two.
+  // Work in proportion to the paint: a pass moves paint at most one cell along its axis, so in
+  // this step's n passes per axis the paint reaches at most n cells from where it is, and no
+  // cell beyond n + 1 cells of it computes a flux. The passes visit the columns of the tiles
+  // within that reach (and the layers below top + n); the advected cells read at most two cells
+  // further (donor and slope), in the ring of halo tiles and the two layers above, which the
+  // scratch copy takes from the paint once (docs/GRID.md "Work in proportion to the paint").
   const int layers = std::min(g.nz, top + n);
-  const int64_t above = int64_t(layers) * g.nx * g.ny;
-  if (above < g.cells()) {
-#define WB_X(name, doc)                                                                     \
-  mem::copy_on_device(d, paint_tmp_.name.data() + above, paint.name.data() + above,         \
-                      size_t(g.cells() - above) * sizeof(float));
-    WB_PAINT_FIELDS(WB_X)
-#undef WB_X
-  }
+  const int reach = (n + 1 + kPaintTile - 1) / kPaintTile;
+  const int deep = std::min(g.nz, layers + 2);
+  tile_counts_.fill_zero();
+  paint_tiles_d(d, g, paint.density.data(), layers, reach, tile_mark_.data(), tile_active_.data(),
+                tile_halo_.data(), tile_counts_.data());
+  const int tiles_x = (g.nx + kPaintTile - 1) / kPaintTile, tiles_y = (g.ny + kPaintTile - 1) / kPaintTile;
+  const PaintTiles tiles{tile_active_.data(), tile_halo_.data(), tile_counts_.data(), layers, tiles_x,
+                         int64_t(tiles_x) * tiles_y * kPaintTile * kPaintTile * g.nz};
+  copy_tiles_d(d, g, tiles, paint.view(), paint_tmp_.view(), true, deep);
   const float h = dt / float(n);
   for (int s = 0; s < n; ++s)
     for (int a = 0; a < 3; ++a) {
       const int axis = (s % 2 == 0) ? a : 2 - a;
-      advect_axis_d(d, v, paint.view(), paint_tmp_.view(), axis, h, layers);
+      advect_axis_d(d, v, paint.view(), paint_tmp_.view(), axis, h, tiles);
 #define WB_X(name, doc) paint.name.swap(paint_tmp_.name);
       WB_PAINT_FIELDS(WB_X)
 #undef WB_X
     }
+  if (n % 2 == 1) {
+    // An odd number of passes left the result in the scratch buffers, complete only where the
+    // passes wrote: the paint's own buffers are complete elsewhere, so they take the tiles back.
+#define WB_X(name, doc) paint.name.swap(paint_tmp_.name);
+    WB_PAINT_FIELDS(WB_X)
+#undef WB_X
+    copy_tiles_d(d, g, tiles, paint_tmp_.view(), paint.view(), false, layers);
+  }
   // Velocity: backtrace every open face through a copy of the field, up to the layers that can
   // hold liquid in this step (paint or particles, the paint moved up by at most n cells) and the
   // stencils that reach them. Above, no face is fluid before the projection's extrapolation

@@ -150,6 +150,8 @@ class Grid {
   /// The advection's outflow rate and top layers (paint, joint) in one copy, then the joint
   /// top after the particles joined (find_extent).
   DeviceBuffer<float> advect_max_;
+  DeviceBuffer<int32_t> tile_mark_, tile_active_, tile_halo_;  ///< the advection's tiles (PaintTiles)
+  DeviceBuffer<int64_t> tile_counts_;
   DeviceBuffer<GridExtent> extent_;  ///< the layers the stages after the joint fields visit (device)
   const GridExtent* stage_extent_ = nullptr;  ///< extent_ while step() runs those stages, else null
   /// The layers holding paint or particles now, or liquid before the advection: extent_.
@@ -165,7 +167,11 @@ class Grid {
                      float liquid_threshold, float dry_threshold);                                                   \
   void grid_paint_outflow(GridView g, const float* rho, const float* pd, float* out, float* top, float* jt);                                     \
   void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt,             \
-                              int layers);                                                                           \
+                              PaintTiles tiles);                                                                     \
+  void grid_paint_tiles(GridDims d, const float* rho, int layers, int reach, int32_t* mark, int32_t* active,        \
+                        int32_t* halo, int64_t* counts);                                                             \
+  void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst, bool halo_too, \
+                             int layers);                                                                            \
   void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt, int layers);                  \
   void grid_gravity(GridView g, float* ph, float g_dt);                                                              \
   void grid_effective_viscosity(GridView g, const float* oil, HerschelBulkley stiff, HerschelBulkley oily, float m,  \

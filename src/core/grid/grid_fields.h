@@ -79,6 +79,21 @@ struct GridExtent {
   int32_t dirty;   ///< the layers holding liquid at the last step
 };
 
+/// Columns of the window in tiles of kPaintTile x kPaintTile: the paint's advection visits the
+/// tiles within its reach of the paint (docs/GRID.md "Work in proportion to the paint").
+constexpr int kPaintTile = 8;
+/// The tiles the advection visits (device lists and counts, grid.cpp). counts: the active tiles,
+/// the halo tiles around them, then the cells of the active tiles below `layers`, of the active
+/// tiles below `layers + 2` and of the halo tiles below `layers + 2`.
+struct PaintTiles {
+  const int32_t* active;
+  const int32_t* halo;
+  const int64_t* counts;
+  int layers;  ///< the advection's layers
+  int tiles_x;
+  int64_t capacity;  ///< every tile's cells, the window's depth deep (tiles overhang its edges)
+};
+
 /// Faces of the cells below `layers`, as one list u | v | w: each a prefix of its component's
 /// array (z is the slowest index). With layers = nz, every face.
 WB_HD WB_INLINE int64_t faces_below(int nx, int ny, int nz, int layers) {

@@ -2,6 +2,7 @@
 // source (grid_cpu.cpp, grid_cuda.cu). Each function is one or two launches over
 // cells or faces; the physics is in advect_/viscosity_/project_kernels.h.
 #pragma once
+#include "core/exec/atomics.h"
 #include "core/exec/parallel_for.h"
 #include "core/grid/advect_kernels.h"
 #include "core/grid/grid.h"
@@ -106,9 +107,90 @@ void grid_paint_outflow(GridView g, const float* rho, const float* particle_dens
   });
 }
 
-void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt, int layers) {
+namespace detail {
+/// Cell index of element q of the tiles in `list`, `layers` deep (tile-major, then k, then the
+/// tile's columns); -1 past the window's edge.
+WB_HD WB_INLINE int64_t tile_cell(const GridDims& d, const int32_t* list, int tiles_x, int layers, int64_t q) {
+  constexpr int kCols = kPaintTile * kPaintTile;
+  const int64_t per_tile = int64_t(kCols) * layers;
+  const int32_t t = list[q / per_tile];
+  const int64_t r = q % per_tile;
+  const int k = int(r / kCols), l = int(r % kCols);
+  const int i = (t % tiles_x) * kPaintTile + l % kPaintTile, j = (t / tiles_x) * kPaintTile + l / kPaintTile;
+  return i < d.nx && j < d.ny ? d.cell(i, j, k) : -1;
+}
+template <class F>
+struct TileCells {
+  GridDims d;
+  const int32_t* list;
+  int tiles_x, layers;
+  F fn;
+  WB_HD void operator()(int64_t q) const {
+    const int64_t c = tile_cell(d, list, tiles_x, layers, q);
+    if (c >= 0) fn(c);
+  }
+};
+}  // namespace detail
+
+void grid_paint_tiles(GridDims d, const float* rho, int layers, int reach, int32_t* mark, int32_t* active,
+                      int32_t* halo, int64_t* counts) {
+  const int tx = (d.nx + kPaintTile - 1) / kPaintTile, ty = (d.ny + kPaintTile - 1) / kPaintTile;
+  parallel_for(int64_t(tx) * ty, [=] WB_HD(int64_t t) {
+    const int i0 = int(t % tx) * kPaintTile, j0 = int(t / tx) * kPaintTile;
+    int32_t any = 0;
+    for (int k = 0; k < layers && !any; ++k)
+      for (int j = j0; j < j0 + kPaintTile && j < d.ny && !any; ++j)
+        for (int i = i0; i < i0 + kPaintTile && i < d.nx; ++i)
+          if (rho[d.cell(i, j, k)] > 0.f) {
+            any = 1;
+            break;
+          }
+    mark[t] = any;
+  }, 1);
+  // A tile within `reach` tiles of paint is advected; the ring beyond it is the halo the
+  // advected cells read (at most two cells away: the donor and its slope).
+  parallel_for(int64_t(tx) * ty, [=] WB_HD(int64_t t) {
+    const int x = int(t % tx), y = int(t / tx);
+    int best = reach + 2;
+    for (int b = y - reach - 1; b <= y + reach + 1; ++b)
+      for (int a = x - reach - 1; a <= x + reach + 1; ++a) {
+        if (a < 0 || b < 0 || a >= tx || b >= ty || !mark[int64_t(b) * tx + a]) continue;
+        const int dx = a > x ? a - x : x - a, dy = b > y ? b - y : y - b;
+        const int dist = dx > dy ? dx : dy;
+        best = best < dist ? best : dist;
+      }
+    if (best <= reach) active[atomic_add(&counts[0], int64_t(1))] = int32_t(t);
+    else if (best == reach + 1) halo[atomic_add(&counts[1], int64_t(1))] = int32_t(t);
+  }, 1);
+  const int deep = layers + 2 < d.nz ? layers + 2 : d.nz;
+  parallel_for(1, [=] WB_HD(int64_t) {
+    constexpr int64_t kCols = kPaintTile * kPaintTile;
+    counts[2] = counts[0] * kCols * layers;
+    counts[3] = counts[0] * kCols * deep;
+    counts[4] = counts[1] * kCols * deep;
+  });
+}
+
+void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst, bool halo_too,
+                           int layers) {
+  auto copy = [=] WB_HD(int64_t c) {
+#define WB_X(name, doc) dst.name[c] = src.name[c];
+    WB_PAINT_FIELDS(WB_X)
+#undef WB_X
+  };
+  const int64_t capacity = tiles.capacity;
+  const int at = layers == tiles.layers ? 2 : 3;
+  parallel_for_count(tiles.counts + at, capacity,
+                     detail::TileCells<decltype(copy)>{d, tiles.active, tiles.tiles_x, layers, copy});
+  if (halo_too)
+    parallel_for_count(tiles.counts + 4, capacity,
+                       detail::TileCells<decltype(copy)>{d, tiles.halo, tiles.tiles_x, layers, copy});
+}
+
+void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt,
+                            PaintTiles tiles) {
   const GridDims d = g.d;
-  parallel_for(int64_t(layers) * d.nx * d.ny, [=] WB_HD(int64_t c) {
+  auto cell = [=] WB_HD(int64_t c) {
     int i, j, k;
     d.decompose_cell(c, i, j, k);
     // Paint can only come from the cell or its two neighbours along the axis: air stays air.
@@ -143,7 +225,9 @@ void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst
     carry(src.pigment_b, dst.pigment_b);
     carry(src.oil, dst.oil);
     carry(src.dryness, dst.dryness);
-  });
+  };
+  parallel_for_count(tiles.counts + 2, tiles.capacity,
+                     detail::TileCells<decltype(cell)>{d, tiles.active, tiles.tiles_x, tiles.layers, cell});
 }
 
 void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt, int layers) {
