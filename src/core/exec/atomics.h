@@ -87,6 +87,15 @@ WB_HD WB_INLINE float atomic_max(float* addr, float v) {
 #endif
 }
 
+/// A load that may race with the atomics above (relaxed: a flag read before setting it).
+WB_HD WB_INLINE int32_t atomic_load(const int32_t* addr) {
+#if defined(__CUDA_ARCH__)
+  return *reinterpret_cast<const volatile int*>(addr);
+#else
+  return std::atomic_ref<int32_t>(*const_cast<int32_t*>(addr)).load(std::memory_order_relaxed);
+#endif
+}
+
 WB_HD WB_INLINE int32_t atomic_or(int32_t* addr, int32_t v) {
 #if defined(__CUDA_ARCH__)
   return atomicOr(reinterpret_cast<int*>(addr), v);

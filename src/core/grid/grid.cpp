@@ -23,8 +23,11 @@ void outflow_d(const Device& d, GridView g, const float* rho, const float* pd, f
   WB_DISPATCH(d, grid_paint_outflow(g, rho, pd, out, top, jt));
 }
 void advect_axis_d(const Device& d, GridView g, PaintWindowView s, PaintWindowView t, int axis, float dt,
-                   PaintTiles tiles) {
-  WB_DISPATCH(d, grid_advect_paint_axis(g, s, t, axis, dt, tiles));
+                   PaintTiles tiles, const int32_t* process, int32_t* painted) {
+  WB_DISPATCH(d, grid_advect_paint_axis(g, s, t, axis, dt, tiles, process, painted));
+}
+void tiles_pass_d(const Device& d, GridDims g, PaintTiles tiles, const int32_t* before, int32_t* p) {
+  WB_DISPATCH(d, grid_paint_tiles_pass(g, tiles, before, p));
 }
 void paint_tiles_d(const Device& d, GridDims g, const float* rho, int layers, int reach, int32_t* mark, int32_t* a,
                    int32_t* h, int64_t* counts) {
@@ -271,7 +274,7 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   advect_max_.set_device(d);
   advect_max_.resize(4);
   const size_t tiles = size_t((g.nx + kPaintTile - 1) / kPaintTile) * size_t((g.ny + kPaintTile - 1) / kPaintTile);
-  for (auto* b : {&tile_mark_, &tile_active_, &tile_halo_}) {
+  for (auto* b : {&tile_mark_, &tile_active_, &tile_halo_, &tile_painted_[0], &tile_painted_[1], &tile_process_}) {
     b->set_device(d);
     b->resize(tiles);
   }
@@ -354,13 +357,20 @@ void Grid::advect(float dt) {
                 tile_halo_.data(), tile_counts_.data());
   const int tiles_x = (g.nx + kPaintTile - 1) / kPaintTile, tiles_y = (g.ny + kPaintTile - 1) / kPaintTile;
   const PaintTiles tiles{tile_active_.data(), tile_halo_.data(), tile_counts_.data(), layers, tiles_x,
-                         int64_t(tiles_x) * tiles_y * kPaintTile * kPaintTile * g.nz};
+                         int64_t(tiles_x) * tiles_y * kPaintTile * g.nz};
   copy_tiles_d(d, g, tiles, paint.view(), paint_tmp_.view(), true, deep);
+  // Which tiles held paint after the last pass (before the first: the paint's) and after this one.
+  int32_t* painted[2] = {tile_painted_[0].data(), tile_painted_[1].data()};
+  const size_t tile_bytes = tile_mark_.size() * sizeof(int32_t);
+  mem::copy_on_device(d, painted[0], tile_mark_.data(), tile_bytes);
   const float h = dt / float(n);
   for (int s = 0; s < n; ++s)
     for (int a = 0; a < 3; ++a) {
       const int axis = (s % 2 == 0) ? a : 2 - a;
-      advect_axis_d(d, v, paint.view(), paint_tmp_.view(), axis, h, tiles);
+      tiles_pass_d(d, g, tiles, painted[0], tile_process_.data());
+      mem::fill_zero(d, painted[1], tile_bytes);
+      advect_axis_d(d, v, paint.view(), paint_tmp_.view(), axis, h, tiles, tile_process_.data(), painted[1]);
+      std::swap(painted[0], painted[1]);
 #define WB_X(name, doc) paint.name.swap(paint_tmp_.name);
       WB_PAINT_FIELDS(WB_X)
 #undef WB_X

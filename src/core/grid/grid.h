@@ -151,6 +151,9 @@ class Grid {
   /// top after the particles joined (find_extent).
   DeviceBuffer<float> advect_max_;
   DeviceBuffer<int32_t> tile_mark_, tile_active_, tile_halo_;  ///< the advection's tiles (PaintTiles)
+  /// Per tile: whether it held paint after the last pass and after this one (swapped each
+  /// pass), and whether this pass visits it.
+  DeviceBuffer<int32_t> tile_painted_[2], tile_process_;
   DeviceBuffer<int64_t> tile_counts_;
   DeviceBuffer<GridExtent> extent_;  ///< the layers the stages after the joint fields visit (device)
   const GridExtent* stage_extent_ = nullptr;  ///< extent_ while step() runs those stages, else null
@@ -167,7 +170,8 @@ class Grid {
                      float liquid_threshold, float dry_threshold);                                                   \
   void grid_paint_outflow(GridView g, const float* rho, const float* pd, float* out, float* top, float* jt);                                     \
   void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt,             \
-                              PaintTiles tiles);                                                                     \
+                              PaintTiles tiles, const int32_t* process, int32_t* painted);                           \
+  void grid_paint_tiles_pass(GridDims d, PaintTiles tiles, const int32_t* before, int32_t* process);                \
   void grid_paint_tiles(GridDims d, const float* rho, int layers, int reach, int32_t* mark, int32_t* active,        \
                         int32_t* halo, int64_t* counts);                                                             \
   void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst, bool halo_too, \

@@ -108,26 +108,27 @@ void grid_paint_outflow(GridView g, const float* rho, const float* particle_dens
 }
 
 namespace detail {
-/// Cell index of element q of the tiles in `list`, `layers` deep (tile-major, then k, then the
-/// tile's columns); -1 past the window's edge.
-WB_HD WB_INLINE int64_t tile_cell(const GridDims& d, const int32_t* list, int tiles_x, int layers, int64_t q) {
-  constexpr int kCols = kPaintTile * kPaintTile;
-  const int64_t per_tile = int64_t(kCols) * layers;
-  const int32_t t = list[q / per_tile];
-  const int64_t r = q % per_tile;
-  const int k = int(r / kCols), l = int(r % kCols);
-  const int i = (t % tiles_x) * kPaintTile + l % kPaintTile, j = (t / tiles_x) * kPaintTile + l / kPaintTile;
-  return i < d.nx && j < d.ny ? d.cell(i, j, k) : -1;
-}
+/// Row q of the tiles in `list`, `layers` deep: each element is a row of kPaintTile cells along x
+/// (tile-major, then k, then the tile's rows), so the index arithmetic is paid once a row and the
+/// row's cells are contiguous. fn(t, c) for each of its cells inside the window (t its tile);
+/// with `process`, only in the tiles it flags.
 template <class F>
 struct TileCells {
   GridDims d;
   const int32_t* list;
   int tiles_x, layers;
   F fn;
+  const int32_t* process = nullptr;
   WB_HD void operator()(int64_t q) const {
-    const int64_t c = tile_cell(d, list, tiles_x, layers, q);
-    if (c >= 0) fn(c);
+    const uint32_t per_tile = uint32_t(kPaintTile) * uint32_t(layers), e = uint32_t(q);
+    const int32_t t = list[e / per_tile];
+    if (process && !process[t]) return;
+    const uint32_t r = e % per_tile;
+    const int k = int(r / kPaintTile), j = (t / tiles_x) * kPaintTile + int(r % kPaintTile);
+    if (j >= d.ny) return;
+    const int i0 = (t % tiles_x) * kPaintTile, i1 = i0 + kPaintTile < d.nx ? i0 + kPaintTile : d.nx;
+    const int64_t row = d.cell(0, j, k);
+    for (int i = i0; i < i1; ++i) fn(t, row + i);
   }
 };
 }  // namespace detail
@@ -164,16 +165,15 @@ void grid_paint_tiles(GridDims d, const float* rho, int layers, int reach, int32
   }, 1);
   const int deep = layers + 2 < d.nz ? layers + 2 : d.nz;
   parallel_for(1, [=] WB_HD(int64_t) {
-    constexpr int64_t kCols = kPaintTile * kPaintTile;
-    counts[2] = counts[0] * kCols * layers;
-    counts[3] = counts[0] * kCols * deep;
-    counts[4] = counts[1] * kCols * deep;
+    counts[2] = counts[0] * kPaintTile * layers;  // rows of kPaintTile cells (TileCells)
+    counts[3] = counts[0] * kPaintTile * deep;
+    counts[4] = counts[1] * kPaintTile * deep;
   });
 }
 
 void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst, bool halo_too,
                            int layers) {
-  auto copy = [=] WB_HD(int64_t c) {
+  auto copy = [=] WB_HD(int32_t, int64_t c) {
 #define WB_X(name, doc) dst.name[c] = src.name[c];
     WB_PAINT_FIELDS(WB_X)
 #undef WB_X
@@ -187,10 +187,28 @@ void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, Pa
                        detail::TileCells<decltype(copy)>{d, tiles.halo, tiles.tiles_x, layers, copy});
 }
 
+void grid_paint_tiles_pass(GridDims d, PaintTiles tiles, const int32_t* before, int32_t* process) {
+  // A tile none of whose 3 x 3 tiles held paint after the last pass is quiet: paint moves at
+  // most a cell a pass, so it held none the pass before either, this pass would copy its cells,
+  // and the buffer it would write holds them already (written at the last pass that visited it,
+  // quiet since). It is skipped.
+  const int tx = tiles.tiles_x, ty = (d.ny + kPaintTile - 1) / kPaintTile;
+  const int32_t* active = tiles.active;
+  parallel_for_count(tiles.counts, tiles.capacity, [=] WB_HD(int64_t slot) {
+    const int32_t t = active[slot];
+    const int x = t % tx, y = t / tx;
+    int32_t busy = 0;
+    for (int b = y - 1; b <= y + 1; ++b)
+      for (int a = x - 1; a <= x + 1; ++a)
+        if (a >= 0 && b >= 0 && a < tx && b < ty) busy |= before[b * tx + a];
+    process[t] = busy;
+  });
+}
+
 void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt,
-                            PaintTiles tiles) {
+                            PaintTiles tiles, const int32_t* process, int32_t* painted) {
   const GridDims d = g.d;
-  auto cell = [=] WB_HD(int64_t c) {
+  auto cell = [=] WB_HD(int32_t t, int64_t c) {
     int i, j, k;
     d.decompose_cell(c, i, j, k);
     // Paint can only come from the cell or its two neighbours along the axis: air stays air.
@@ -212,6 +230,7 @@ void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst
     const float rho = src.density[c];
     const float rho_new = add_rn(rho, sub_rn(lo, hi));
     dst.density[c] = rho_new;
+    if (rho_new > 0.f && !atomic_load(&painted[t])) atomic_or(&painted[t], 1);
     // Pigment, oil and dryness travel with the paint at their donor's value (mass-weighted),
     // so each stays a convex mix of what met in the cell.
     auto carry = [&](const float* q, float* out) {
@@ -227,7 +246,7 @@ void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst
     carry(src.dryness, dst.dryness);
   };
   parallel_for_count(tiles.counts + 2, tiles.capacity,
-                     detail::TileCells<decltype(cell)>{d, tiles.active, tiles.tiles_x, tiles.layers, cell});
+                     detail::TileCells<decltype(cell)>{d, tiles.active, tiles.tiles_x, tiles.layers, cell, process});
 }
 
 void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt, int layers) {
