@@ -203,6 +203,14 @@ TEST_F(AdvectWindowTest, TiledAdvectionEqualsAnyTilingOfTheSameCells) {
       for (int i = 0; i < small.x; ++i)
         if (i >= 40) moved += result[0][0][(size_t(k) * small.y + size_t(j)) * small.x + size_t(i)];
   EXPECT_GT(moved, 100.0) << "the blob must have crossed tiles";
+  // And risen: the upflow lifts it (passes skip the layers above the paint's top plus one).
+  int top = 0;
+  for (int k = 0; k < small.z; ++k)
+    for (int j = 0; j < small.y; ++j)
+      for (int i = 0; i < small.x; ++i)
+        if (result[0][0][(size_t(k) * small.y + size_t(j)) * small.x + size_t(i)] > 1e-6f) top = std::max(top, k + 1);
+  std::printf("[ tiles ] paint above 1e-6 up to layer %d (from 6)\n", top);
+  EXPECT_GE(top, 8) << "the paint must have risen";
   for (int q = 0; q < kPaintFieldCount; ++q) EXPECT_EQ(result[0][size_t(q)], result[1][size_t(q)]) << "field " << q;
 }
 

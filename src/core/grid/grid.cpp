@@ -23,15 +23,15 @@ void outflow_d(const Device& d, GridView g, const float* rho, const float* pd, f
   WB_DISPATCH(d, grid_paint_outflow(g, rho, pd, out, top, jt));
 }
 void advect_axis_d(const Device& d, GridView g, PaintWindowView s, PaintWindowView t, int axis, float dt,
-                   PaintTiles tiles, const int32_t* process, int32_t* painted) {
-  WB_DISPATCH(d, grid_advect_paint_axis(g, s, t, axis, dt, tiles, process, painted));
+                   PaintTiles tiles, const int32_t* process, int32_t* painted, const int32_t* below, int32_t* next) {
+  WB_DISPATCH(d, grid_advect_paint_axis(g, s, t, axis, dt, tiles, process, painted, below, next));
 }
 void tiles_pass_d(const Device& d, GridDims g, PaintTiles tiles, const int32_t* before, int32_t* p) {
   WB_DISPATCH(d, grid_paint_tiles_pass(g, tiles, before, p));
 }
 void paint_tiles_d(const Device& d, GridDims g, const float* rho, int layers, int reach, int32_t* mark, int32_t* a,
-                   int32_t* h, int64_t* counts) {
-  WB_DISPATCH(d, grid_paint_tiles(g, rho, layers, reach, mark, a, h, counts));
+                   int32_t* h, int64_t* counts, int32_t* below) {
+  WB_DISPATCH(d, grid_paint_tiles(g, rho, layers, reach, mark, a, h, counts, below));
 }
 void copy_tiles_d(const Device& d, GridDims g, PaintTiles t, PaintWindowView s, PaintWindowView dst, bool halo,
                   int layers) {
@@ -280,6 +280,8 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   }
   tile_counts_.set_device(d);
   tile_counts_.resize(5);
+  pass_below_.set_device(d);
+  pass_below_.resize(2);
   // Every layer until the first step has found the paint's (its stages then visit them all once).
   const GridExtent all{g.cells(), g.nu() + g.nv() + g.nw(), g.nz, g.nz};
   extent_.set_device(d);
@@ -354,13 +356,14 @@ void Grid::advect(float dt) {
   const int deep = std::min(g.nz, layers + 2);
   tile_counts_.fill_zero();
   paint_tiles_d(d, g, paint.density.data(), layers, reach, tile_mark_.data(), tile_active_.data(),
-                tile_halo_.data(), tile_counts_.data());
+                tile_halo_.data(), tile_counts_.data(), pass_below_.data());
   const int tiles_x = (g.nx + kPaintTile - 1) / kPaintTile, tiles_y = (g.ny + kPaintTile - 1) / kPaintTile;
   const PaintTiles tiles{tile_active_.data(), tile_halo_.data(), tile_counts_.data(), layers, tiles_x,
                          int64_t(tiles_x) * tiles_y * kPaintTile * g.nz};
   copy_tiles_d(d, g, tiles, paint.view(), paint_tmp_.view(), true, deep);
   // Which tiles held paint after the last pass (before the first: the paint's) and after this one.
   int32_t* painted[2] = {tile_painted_[0].data(), tile_painted_[1].data()};
+  int32_t* below[2] = {pass_below_.data(), pass_below_.data() + 1};
   const size_t tile_bytes = tile_mark_.size() * sizeof(int32_t);
   mem::copy_on_device(d, painted[0], tile_mark_.data(), tile_bytes);
   const float h = dt / float(n);
@@ -369,8 +372,11 @@ void Grid::advect(float dt) {
       const int axis = (s % 2 == 0) ? a : 2 - a;
       tiles_pass_d(d, g, tiles, painted[0], tile_process_.data());
       mem::fill_zero(d, painted[1], tile_bytes);
-      advect_axis_d(d, v, paint.view(), paint_tmp_.view(), axis, h, tiles, tile_process_.data(), painted[1]);
+      mem::fill_zero(d, below[1], sizeof(int32_t));
+      advect_axis_d(d, v, paint.view(), paint_tmp_.view(), axis, h, tiles, tile_process_.data(), painted[1], below[0],
+                    below[1]);
       std::swap(painted[0], painted[1]);
+      std::swap(below[0], below[1]);
 #define WB_X(name, doc) paint.name.swap(paint_tmp_.name);
       WB_PAINT_FIELDS(WB_X)
 #undef WB_X

@@ -154,6 +154,7 @@ class Grid {
   /// Per tile: whether it held paint after the last pass and after this one (swapped each
   /// pass), and whether this pass visits it.
   DeviceBuffer<int32_t> tile_painted_[2], tile_process_;
+  DeviceBuffer<int32_t> pass_below_;  ///< the layers the last pass and this one visit (two values, swapped)
   DeviceBuffer<int64_t> tile_counts_;
   DeviceBuffer<GridExtent> extent_;  ///< the layers the stages after the joint fields visit (device)
   const GridExtent* stage_extent_ = nullptr;  ///< extent_ while step() runs those stages, else null
@@ -170,10 +171,11 @@ class Grid {
                      float liquid_threshold, float dry_threshold);                                                   \
   void grid_paint_outflow(GridView g, const float* rho, const float* pd, float* out, float* top, float* jt);                                     \
   void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt,             \
-                              PaintTiles tiles, const int32_t* process, int32_t* painted);                           \
+                              PaintTiles tiles, const int32_t* process, int32_t* painted, const int32_t* below,      \
+                              int32_t* below_next);                                                                  \
   void grid_paint_tiles_pass(GridDims d, PaintTiles tiles, const int32_t* before, int32_t* process);                \
   void grid_paint_tiles(GridDims d, const float* rho, int layers, int reach, int32_t* mark, int32_t* active,        \
-                        int32_t* halo, int64_t* counts);                                                             \
+                        int32_t* halo, int64_t* counts, int32_t* below);                                             \
   void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst, bool halo_too, \
                              int layers);                                                                            \
   void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt, int layers);                  \

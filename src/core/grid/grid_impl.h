@@ -111,7 +111,7 @@ namespace detail {
 /// Row q of the tiles in `list`, `layers` deep: each element is a row of kPaintTile cells along x
 /// (tile-major, then k, then the tile's rows), so the index arithmetic is paid once a row and the
 /// row's cells are contiguous. fn(t, c) for each of its cells inside the window (t its tile);
-/// with `process`, only in the tiles it flags.
+/// with `process`, only in the tiles it flags; with `below`, only in the layers under *below.
 template <class F>
 struct TileCells {
   GridDims d;
@@ -119,13 +119,14 @@ struct TileCells {
   int tiles_x, layers;
   F fn;
   const int32_t* process = nullptr;
+  const int32_t* below = nullptr;
   WB_HD void operator()(int64_t q) const {
     const uint32_t per_tile = uint32_t(kPaintTile) * uint32_t(layers), e = uint32_t(q);
     const int32_t t = list[e / per_tile];
     if (process && !process[t]) return;
     const uint32_t r = e % per_tile;
     const int k = int(r / kPaintTile), j = (t / tiles_x) * kPaintTile + int(r % kPaintTile);
-    if (j >= d.ny) return;
+    if (j >= d.ny || (below && k >= *below)) return;
     const int i0 = (t % tiles_x) * kPaintTile, i1 = i0 + kPaintTile < d.nx ? i0 + kPaintTile : d.nx;
     const int64_t row = d.cell(0, j, k);
     for (int i = i0; i < i1; ++i) fn(t, row + i);
@@ -134,7 +135,7 @@ struct TileCells {
 }  // namespace detail
 
 void grid_paint_tiles(GridDims d, const float* rho, int layers, int reach, int32_t* mark, int32_t* active,
-                      int32_t* halo, int64_t* counts) {
+                      int32_t* halo, int64_t* counts, int32_t* below) {
   const int tx = (d.nx + kPaintTile - 1) / kPaintTile, ty = (d.ny + kPaintTile - 1) / kPaintTile;
   parallel_for(int64_t(tx) * ty, [=] WB_HD(int64_t t) {
     const int i0 = int(t % tx) * kPaintTile, j0 = int(t / tx) * kPaintTile;
@@ -168,6 +169,7 @@ void grid_paint_tiles(GridDims d, const float* rho, int layers, int reach, int32
     counts[2] = counts[0] * kPaintTile * layers;  // rows of kPaintTile cells (TileCells)
     counts[3] = counts[0] * kPaintTile * deep;
     counts[4] = counts[1] * kPaintTile * deep;
+    *below = layers;  // the first pass visits every layer of the advection
   });
 }
 
@@ -206,7 +208,8 @@ void grid_paint_tiles_pass(GridDims d, PaintTiles tiles, const int32_t* before, 
 }
 
 void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt,
-                            PaintTiles tiles, const int32_t* process, int32_t* painted) {
+                            PaintTiles tiles, const int32_t* process, int32_t* painted, const int32_t* below,
+                            int32_t* below_next) {
   const GridDims d = g.d;
   auto cell = [=] WB_HD(int32_t t, int64_t c) {
     int i, j, k;
@@ -230,7 +233,12 @@ void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst
     const float rho = src.density[c];
     const float rho_new = add_rn(rho, sub_rn(lo, hi));
     dst.density[c] = rho_new;
-    if (rho_new > 0.f && !atomic_load(&painted[t])) atomic_or(&painted[t], 1);
+    if (rho_new > 0.f) {
+      if (!atomic_load(&painted[t])) atomic_or(&painted[t], 1);
+      // The next pass visits the layers up to one above the highest holding paint: above
+      // them no cell nor its neighbours holds any.
+      if (k + 2 > atomic_load(below_next)) atomic_max(below_next, k + 2);
+    }
     // Pigment, oil and dryness travel with the paint at their donor's value (mass-weighted),
     // so each stays a convex mix of what met in the cell.
     auto carry = [&](const float* q, float* out) {
@@ -246,7 +254,8 @@ void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst
     carry(src.dryness, dst.dryness);
   };
   parallel_for_count(tiles.counts + 2, tiles.capacity,
-                     detail::TileCells<decltype(cell)>{d, tiles.active, tiles.tiles_x, tiles.layers, cell, process});
+                     detail::TileCells<decltype(cell)>{d, tiles.active, tiles.tiles_x, tiles.layers, cell, process,
+                                                       below});
 }
 
 void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt, int layers) {
