@@ -74,6 +74,8 @@ void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float*
     const float joint = pw.density[c] + (particle_density ? particle_density[c] : 0.f);
     g.cls[c] = classify_cell(joint, pw.dryness[c], on, liquid_threshold, dry_threshold);
   });
+  // Open fraction, solid velocity and fluid flag of each face in one pass: the flag reads only
+  // the face's own fraction and its two cells' classes.
   for_faces(d, g.extent, [=] WB_HD(int c, int64_t f) {
     int i, j, k;
     d.decompose_face(c, f, i, j, k);
@@ -81,10 +83,6 @@ void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float*
     face_fraction(d, g.cls, br, c, i, j, k, theta, us);
     g.theta[c][f] = theta;
     g.solid_vel[c][f] = us;
-  });
-  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f) {
-    int i, j, k;
-    d.decompose_face(c, f, i, j, k);
     g.fluid[c][f] = face_is_fluid(d, g.cls, g.theta[c], c, i, j, k) ? 1 : 0;
   });
 }
