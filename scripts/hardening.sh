@@ -13,10 +13,11 @@ ok=1
 
 if [ "$what" = all ] || [ "$what" = asan ]; then
   asan="$WB_ROOT/build-asan"
+  mkdir -p "$asan"  # its configure log lives inside it, with the other build outputs
   start=$(date +%s)
   cmake -S "$WB_ROOT" -B "$asan" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWB_SANITIZE=ON -DWB_CUDA=OFF \
-    -DWB_BUILD_STUDIO=OFF -DWB_BUILD_TESTS=ON -DWB_BUILD_BENCH=OFF > "$asan.configure.log" 2>&1 ||
-    { cat "$asan.configure.log"; exit 1; }
+    -DWB_BUILD_STUDIO=OFF -DWB_BUILD_TESTS=ON -DWB_BUILD_BENCH=OFF > "$asan/configure.log" 2>&1 ||
+    { cat "$asan/configure.log"; exit 1; }
   cmake --build "$asan" --parallel "$jobs"
   built=$(date +%s)
   # halt_on_error: the first report fails its test; LeakSanitizer is on (ASan's default).
@@ -40,9 +41,10 @@ if [ "$what" = all ] || [ "$what" = fuzz ]; then
   else
     rm -rf "$probe"
     fuzz="$WB_ROOT/build-fuzz"
+    mkdir -p "$fuzz"
     CC=clang CXX=clang++ cmake -S "$WB_ROOT" -B "$fuzz" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWB_FUZZ=ON \
-      -DWB_CUDA=OFF -DWB_BUILD_STUDIO=OFF -DWB_BUILD_TESTS=OFF -DWB_BUILD_BENCH=OFF > "$fuzz.configure.log" 2>&1 ||
-      { cat "$fuzz.configure.log"; exit 1; }
+      -DWB_CUDA=OFF -DWB_BUILD_STUDIO=OFF -DWB_BUILD_TESTS=OFF -DWB_BUILD_BENCH=OFF > "$fuzz/configure.log" 2>&1 ||
+      { cat "$fuzz/configure.log"; exit 1; }
     cmake --build "$fuzz" --target fuzzers --parallel "$jobs"
     seconds="${WB_FUZZ_SECONDS:-20}"
     for src in "$WB_ROOT"/tests/fuzz/fuzz_*.cpp; do
