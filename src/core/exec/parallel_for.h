@@ -31,6 +31,12 @@ __global__ void parallel_for_count_kernel(const int64_t* count, int64_t capacity
   const int64_t stride = int64_t(blockDim.x) * gridDim.x;
   for (int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x; i < n; i += stride) fn(i);
 }
+/// Blocks of kBlock threads for n elements, at most 2^20 (the kernels stride over the rest).
+constexpr int kBlock = 256;
+inline unsigned blocks_for(int64_t n) {
+  const int64_t blocks = (n + kBlock - 1) / kBlock;
+  return unsigned(blocks > (int64_t(1) << 20) ? (int64_t(1) << 20) : blocks);
+}
 }  // namespace detail
 #endif
 
@@ -42,10 +48,7 @@ void parallel_for(int64_t n, F fn, int64_t serial_below = kMinParallelSize) {
 #if defined(__CUDACC__)
   static_assert(__nv_is_extended_host_device_lambda_closure_type(F) || !__nv_is_extended_device_lambda_closure_type(F),
                 "parallel_for takes __host__ __device__ (WB_HD) lambdas or functors");
-  constexpr int kBlock = 256;
-  int64_t blocks = (n + kBlock - 1) / kBlock;
-  if (blocks > (int64_t(1) << 20)) blocks = int64_t(1) << 20;
-  detail::parallel_for_kernel<<<unsigned(blocks), kBlock, 0, ::wb::cuda_stream()>>>(n, fn);
+  detail::parallel_for_kernel<<<detail::blocks_for(n), detail::kBlock, 0, ::wb::cuda_stream()>>>(n, fn);
   WB_CUDA_CHECK_LAUNCH();
 #else
   if (n < serial_below) {
@@ -66,10 +69,8 @@ void parallel_for_count(const int64_t* count, int64_t capacity, F fn, int64_t se
 #if defined(__CUDACC__)
   static_assert(__nv_is_extended_host_device_lambda_closure_type(F) || !__nv_is_extended_device_lambda_closure_type(F),
                 "parallel_for_count takes __host__ __device__ (WB_HD) lambdas or functors");
-  constexpr int kBlock = 256;
-  int64_t blocks = (capacity + kBlock - 1) / kBlock;
-  if (blocks > (int64_t(1) << 20)) blocks = int64_t(1) << 20;
-  detail::parallel_for_count_kernel<<<unsigned(blocks), kBlock, 0, ::wb::cuda_stream()>>>(count, capacity, fn);
+  detail::parallel_for_count_kernel<<<detail::blocks_for(capacity), detail::kBlock, 0, ::wb::cuda_stream()>>>(
+      count, capacity, fn);
   WB_CUDA_CHECK_LAUNCH();
 #else
   parallel_for(*count < capacity ? *count : capacity, fn, serial_below);

@@ -33,9 +33,8 @@ void paint_tiles_d(const Device& d, GridDims g, const float* rho, int layers, in
                    int32_t* h, int64_t* counts, int32_t* below) {
   WB_DISPATCH(d, grid_paint_tiles(g, rho, layers, reach, mark, a, h, counts, below));
 }
-void copy_tiles_d(const Device& d, GridDims g, PaintTiles t, PaintWindowView s, PaintWindowView dst, bool halo,
-                  int layers) {
-  WB_DISPATCH(d, grid_copy_paint_tiles(g, t, s, dst, halo, layers));
+void copy_tiles_d(const Device& d, GridDims g, PaintTiles t, PaintWindowView s, PaintWindowView dst, bool reads) {
+  WB_DISPATCH(d, grid_copy_paint_tiles(g, t, s, dst, reads));
 }
 void advect_vel_d(const Device& d, GridView g, const float* u, const float* v, const float* w, float dt, int layers) {
   WB_DISPATCH(d, grid_advect_velocity(g, u, v, w, dt, layers));
@@ -353,14 +352,13 @@ void Grid::advect(float dt) {
   // scratch copy takes from the paint once (docs/GRID.md "Work in proportion to the paint").
   const int layers = std::min(g.nz, top + n);
   const int reach = (n + 1 + kPaintTile - 1) / kPaintTile;
-  const int deep = std::min(g.nz, layers + 2);
   tile_counts_.fill_zero();
   paint_tiles_d(d, g, paint.density.data(), layers, reach, tile_mark_.data(), tile_active_.data(),
                 tile_halo_.data(), tile_counts_.data(), pass_below_.data());
   const int tiles_x = (g.nx + kPaintTile - 1) / kPaintTile, tiles_y = (g.ny + kPaintTile - 1) / kPaintTile;
   const PaintTiles tiles{tile_active_.data(), tile_halo_.data(), tile_counts_.data(), layers, tiles_x,
                          int64_t(tiles_x) * tiles_y * kPaintTile * g.nz};
-  copy_tiles_d(d, g, tiles, paint.view(), paint_tmp_.view(), true, deep);
+  copy_tiles_d(d, g, tiles, paint.view(), paint_tmp_.view(), true);
   // Which tiles held paint after the last pass (before the first: the paint's) and after this one.
   int32_t* painted[2] = {tile_painted_[0].data(), tile_painted_[1].data()};
   int32_t* below[2] = {pass_below_.data(), pass_below_.data() + 1};
@@ -387,7 +385,7 @@ void Grid::advect(float dt) {
 #define WB_X(name, doc) paint.name.swap(paint_tmp_.name);
     WB_PAINT_FIELDS(WB_X)
 #undef WB_X
-    copy_tiles_d(d, g, tiles, paint_tmp_.view(), paint.view(), false, layers);
+    copy_tiles_d(d, g, tiles, paint_tmp_.view(), paint.view(), false);
   }
   // Velocity: backtrace every open face through a copy of the field, up to the layers that can
   // hold liquid in this step (paint or particles, the paint moved up by at most n cells) and the
@@ -540,7 +538,7 @@ void Grid::step(float dt, const std::function<void()>& after_advection) {
   // From here on the stages visit only the layers that can hold liquid (docs/GRID.md "Work in
   // proportion to the paint"): above them the first classification stands and nothing moves.
   find_extent();
-  struct Bounded {
+  struct Bounded {  // back to the whole window when the step ends, thrown out of or not
     const GridExtent*& at;
     ~Bounded() { at = nullptr; }
   } bounded{stage_extent_};
@@ -550,8 +548,7 @@ void Grid::step(float dt, const std::function<void()>& after_advection) {
   add_external_forces(dt);
   apply_viscosity(dt);
   project(dt);
-  stage_extent_ = nullptr;
-  dry(dt);
+  dry(dt);  // the window's paint, whatever the extent
 }
 
 double Grid::divergence_norm(float dt) {

@@ -176,8 +176,7 @@ class Grid {
   void grid_paint_tiles_pass(GridDims d, PaintTiles tiles, const int32_t* before, int32_t* process);                \
   void grid_paint_tiles(GridDims d, const float* rho, int layers, int reach, int32_t* mark, int32_t* active,        \
                         int32_t* halo, int64_t* counts, int32_t* below);                                             \
-  void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst, bool halo_too, \
-                             int layers);                                                                            \
+  void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst, bool reads);   \
   void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt, int layers);                  \
   void grid_gravity(GridView g, float* ph, float g_dt);                                                              \
   void grid_effective_viscosity(GridView g, const float* oil, HerschelBulkley stiff, HerschelBulkley oily, float m,  \

@@ -171,20 +171,20 @@ void grid_paint_tiles(GridDims d, const float* rho, int layers, int reach, int32
   });
 }
 
-void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst, bool halo_too,
-                           int layers) {
+void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst,
+                           bool reads) {
   auto copy = [=] WB_HD(int32_t, int64_t c) {
 #define WB_X(name, doc) dst.name[c] = src.name[c];
     WB_PAINT_FIELDS(WB_X)
 #undef WB_X
   };
-  const int64_t capacity = tiles.capacity;
-  const int at = layers == tiles.layers ? 2 : 3;
-  parallel_for_count(tiles.counts + at, capacity,
-                     detail::TileCells<decltype(copy)>{d, tiles.active, tiles.tiles_x, layers, copy});
-  if (halo_too)
-    parallel_for_count(tiles.counts + 4, capacity,
-                       detail::TileCells<decltype(copy)>{d, tiles.halo, tiles.tiles_x, layers, copy});
+  // reads: every cell the passes read (the listed and halo tiles, two layers above the
+  // advection's); else the cells they write.
+  const int deep = tiles.layers + 2 < d.nz ? tiles.layers + 2 : d.nz;
+  using Rows = detail::TileCells<decltype(copy)>;
+  parallel_for_count(tiles.counts + (reads ? 3 : 2), tiles.capacity,
+                     Rows{d, tiles.active, tiles.tiles_x, reads ? deep : tiles.layers, copy});
+  if (reads) parallel_for_count(tiles.counts + 4, tiles.capacity, Rows{d, tiles.halo, tiles.tiles_x, deep, copy});
 }
 
 void grid_paint_tiles_pass(GridDims d, PaintTiles tiles, const int32_t* before, int32_t* process) {
