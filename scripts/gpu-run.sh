@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Runs what scripts/bundle-gpu.sh built on a machine with a CUDA GPU: the test suite on the
-# CUDA backend, the benchmarks and the example replays, writing logs, stats and pictures to DIR.
-#   scripts/gpu-run.sh DIR [tests|bench|replay]...   (all three when none is named)
+# CUDA backend, the benchmarks, the step bench of the examples and their replays, writing logs,
+# stats and pictures to DIR.
+#   scripts/gpu-run.sh DIR [tests|bench|steps|replay]...   (all four when none is named)
 set -uo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 out="${1:?output directory}"; shift
-what="${*:-tests bench replay}"
+what="${*:-tests bench steps replay}"
 bin="$here/build-gpu/bin"
 export LD_LIBRARY_PATH="$bin${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 mkdir -p "$out"
@@ -20,6 +21,13 @@ for w in $what; do
       WB_DEVICE=cuda timeout 300 "$bin/wetbrush_bench" --benchmark_min_time=0.2 \
         --benchmark_out="$out/bench-cuda.json" --benchmark_out_format=json > "$out/bench-cuda.txt" 2>&1
       echo "bench (cuda): exit $?"; grep -E "^BM_" "$out/bench-cuda.txt" ;;
+    steps)
+      # `wetbrush bench` per example: the median step and its stages, host reads and launches.
+      for ex in stab-and-roll tablet-scribble press-and-drag; do
+        f="$(ls "$here"/examples/$ex.* | head -1)"
+        timeout 120 "$bin/wetbrush" bench "$f" --device cuda --json "$out/steps-$ex.json" > "$out/steps-$ex.txt" 2>&1
+        echo "steps $ex (cuda): exit $?"; grep -E "sim.step|host" "$out/steps-$ex.txt" | head -4
+      done ;;
     replay)
       "$here/scripts/gallery.sh" "$out" cuda "$bin" ;;
   esac

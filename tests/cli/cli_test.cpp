@@ -122,14 +122,23 @@ TEST(Cli, BenchReportsEveryStageTheStepRateAndMemory) {
   EXPECT_GT(j["steps"].get<int>(), 0);
   EXPECT_GT(j["step_rate"].get<double>(), 0.0);
   EXPECT_GT(j["memory_peak_bytes"].get<double>(), 1e5) << "the window and the brush alone hold more";
+  // Every other step is timed whole (its stages untimed), the others stage by stage.
   const nlohmann::json& step = j["stages"]["sim.step"];
-  EXPECT_EQ(step["calls"].get<int>(), j["steps"].get<int>());
+  const nlohmann::json& whole = j["stages"]["sim.step:whole"];
+  EXPECT_EQ(step["calls"].get<int>() + whole["calls"].get<int>(), j["steps"].get<int>());
+  EXPECT_NEAR(step["calls"].get<int>(), whole["calls"].get<int>(), 1);
+  EXPECT_EQ(j["stages"].count("grid.advect:whole"), 0u) << "an inner scope was timed in a whole step";
   EXPECT_GE(step["p90_ms"].get<double>(), step["median_ms"].get<double>());
-  // Host reads of device results: every step makes some (the books' record at least).
+  EXPECT_GT(j["step_median_ms"].get<double>(), 0.0);
+  // Host reads of device results: every step makes some (the books' record at least), and
+  // launches, counted alike on either backend.
   EXPECT_GE(j["host_waits_per_step"].get<double>(), 1.0);
   EXPECT_GE(step["host_reads_mean"].get<double>(), 1.0);
+  EXPECT_GT(j["launches_per_step"].get<double>(), 10.0);
+  EXPECT_GE(step["launches_mean"].get<double>(), j["stages"]["grid.advect"]["launches_mean"].get<double>());
   for (const auto& [name, st] : j["stages"].items())
-    EXPECT_LE(st["median_ms"].get<double>(), step["p90_ms"].get<double>() * 1.01 + 1e-3) << name << " longer than a step";
+    if (name.find(":whole") == std::string::npos)
+      EXPECT_LE(st["median_ms"].get<double>(), step["p90_ms"].get<double>() * 1.01 + 1e-3) << name << " longer than a step";
   EXPECT_NE(run_cli("bench --device cpu " + data("strokes/bad/empty.json")).exit_code, 0);
   std::filesystem::remove_all(dir);
 }

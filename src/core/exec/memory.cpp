@@ -58,9 +58,12 @@ void reset_peak() {
 
 namespace {
 thread_local int64_t t_host_reads = 0;  // per thread: the studio's UI and simulation threads apart
-}
+thread_local int64_t t_launches = 0;
+}  // namespace
 int64_t host_reads() { return t_host_reads; }
 void count_host_read() { ++t_host_reads; }
+int64_t launches() { return t_launches; }
+void count_launch() { ++t_launches; }
 
 void* allocate(const Device& device, size_t bytes) {
   if (bytes == 0) bytes = 1;
@@ -95,6 +98,7 @@ void release(const Device& device, void* ptr) noexcept {
 
 void copy_to_host(const Device& device, void* host_dst, const void* dev_src, size_t bytes) {
   count_host_read();
+  count_launch();
   if (device.is_cpu()) {
     std::memcpy(host_dst, dev_src, bytes);
     return;
@@ -108,6 +112,8 @@ void copy_to_host(const Device& device, void* host_dst, const void* dev_src, siz
 }
 
 void copy_from_host(const Device& device, void* dev_dst, const void* host_src, size_t bytes) {
+  count_host_read();
+  count_launch();
   if (device.is_cpu()) {
     std::memcpy(dev_dst, host_src, bytes);
     return;
@@ -122,6 +128,7 @@ void copy_from_host(const Device& device, void* dev_dst, const void* host_src, s
 }
 
 void copy_on_device(const Device& device, void* dst, const void* src, size_t bytes) {
+  count_launch();
   if (device.is_cpu()) {
     std::memmove(dst, src, bytes);
     return;
@@ -134,6 +141,7 @@ void copy_on_device(const Device& device, void* dst, const void* src, size_t byt
 }
 
 void fill_zero(const Device& device, void* ptr, size_t bytes) {
+  count_launch();
   if (device.is_cpu()) {
     std::memset(ptr, 0, bytes);
     return;

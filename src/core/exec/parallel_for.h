@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "core/exec/hd.h"
+#include "core/exec/memory.h"
 
 #if defined(__CUDACC__)
 #include "core/exec/cuda_check.h"
@@ -45,6 +46,7 @@ namespace WB_BACKEND_NS {
 template <typename F>
 void parallel_for(int64_t n, F fn, int64_t serial_below = kMinParallelSize) {
   if (n <= 0) return;
+  mem::count_launch();
 #if defined(__CUDACC__)
   static_assert(__nv_is_extended_host_device_lambda_closure_type(F) || !__nv_is_extended_device_lambda_closure_type(F),
                 "parallel_for takes __host__ __device__ (WB_HD) lambdas or functors");
@@ -67,6 +69,7 @@ template <typename F>
 void parallel_for_count(const int64_t* count, int64_t capacity, F fn, int64_t serial_below = kMinParallelSize) {
   if (capacity <= 0) return;
 #if defined(__CUDACC__)
+  mem::count_launch();
   static_assert(__nv_is_extended_host_device_lambda_closure_type(F) || !__nv_is_extended_device_lambda_closure_type(F),
                 "parallel_for_count takes __host__ __device__ (WB_HD) lambdas or functors");
   detail::parallel_for_count_kernel<<<detail::blocks_for(capacity), detail::kBlock, 0, ::wb::cuda_stream()>>>(

@@ -9,6 +9,10 @@ thread_local Profiler* g_current = nullptr;
 }
 
 Profiler* Profiler::current() { return g_current; }
+int& ProfileScope::depth() {
+  thread_local int d = 0;
+  return d;
+}
 void Profiler::set_current(Profiler* p) { g_current = p; }
 
 double Profiler::median_ms(const std::string& name) const {
@@ -35,6 +39,11 @@ const std::vector<int64_t>& Profiler::host_reads(const std::string& name) const 
   static const std::vector<int64_t> empty;
   auto it = reads_.find(name);
   return it == reads_.end() ? empty : it->second;
+}
+const std::vector<int64_t>& Profiler::launches(const std::string& name) const {
+  static const std::vector<int64_t> empty;
+  auto it = launches_.find(name);
+  return it == launches_.end() ? empty : it->second;
 }
 std::vector<std::string> Profiler::names() const {
   std::vector<std::string> n;

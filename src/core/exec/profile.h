@@ -1,7 +1,8 @@
 // Per-stage timing. WB_PROFILE_SCOPE("grid.project") times the enclosing scope into
-// the profiler installed on this thread (none: free), and counts the host reads made in it
-// (mem::host_reads). On CUDA the scope synchronises at its ends so that the time is the
-// stage's, not the launch's.
+// the profiler installed on this thread (none: free), and counts the host reads and the
+// launches made in it (mem::host_reads, mem::launches). On CUDA the scope synchronises at its
+// ends so that the time is the stage's, not the launch's; those waits lengthen the step they
+// break up, so a profiler set to `outermost` times only the outermost scope, as NAME:whole.
 #pragma once
 #include <chrono>
 #include <map>
@@ -16,9 +17,10 @@ namespace wb {
 class Profiler {
  public:
   explicit Profiler(Device device = {}) : device_(device) {}
-  void add(const char* name, double ms, int64_t host_reads = 0) {
+  void add(const std::string& name, double ms, int64_t host_reads = 0, int64_t launches = 0) {
     samples_[name].push_back(ms);
     reads_[name].push_back(host_reads);
+    launches_[name].push_back(launches);
   }
   /// Median of the recorded samples of `name` in ms (0 when none).
   double median_ms(const std::string& name) const;
@@ -29,10 +31,16 @@ class Profiler {
   const std::vector<double>& samples(const std::string& name) const;
   /// Host reads (mem::host_reads) made in each recorded call of `name`, in order.
   const std::vector<int64_t>& host_reads(const std::string& name) const;
+  /// Launches (mem::launches) made in each recorded call of `name`, in order.
+  const std::vector<int64_t>& launches(const std::string& name) const;
   void clear() {
     samples_.clear();
     reads_.clear();
+    launches_.clear();
   }
+  /// Time only the outermost scope (no synchronisation inside it), recorded as NAME:whole.
+  void set_outermost(bool on) { outermost_ = on; }
+  bool outermost() const { return outermost_; }
   const Device& device() const { return device_; }
 
   /// The profiler of the calling thread (may be null).
@@ -43,22 +51,31 @@ class Profiler {
   Device device_;
   std::map<std::string, std::vector<double>> samples_;
   std::map<std::string, std::vector<int64_t>> reads_;
+  std::map<std::string, std::vector<int64_t>> launches_;
+  bool outermost_ = false;
 };
 
 class ProfileScope {
  public:
   explicit ProfileScope(const char* name) : name_(name), prof_(Profiler::current()) {
+    if (prof_ && prof_->outermost()) {
+      open_ = &depth();
+      if ((*open_)++ > 0) prof_ = nullptr;
+    }
     if (prof_) {
       prof_->device().synchronize();
       reads_ = mem::host_reads();
+      launches_ = mem::launches();
       start_ = std::chrono::steady_clock::now();
     }
   }
   ~ProfileScope() {
+    if (open_) --*open_;
     if (!prof_) return;
     prof_->device().synchronize();
-    prof_->add(name_, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count(),
-               mem::host_reads() - reads_);
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count();
+    prof_->add(open_ ? std::string(name_) + ":whole" : std::string(name_), ms,
+               mem::host_reads() - reads_, mem::launches() - launches_);
   }
   ProfileScope(const ProfileScope&) = delete;
   ProfileScope& operator=(const ProfileScope&) = delete;
@@ -66,8 +83,10 @@ class ProfileScope {
  private:
   const char* name_;
   Profiler* prof_;
-  int64_t reads_ = 0;
+  int64_t reads_ = 0, launches_ = 0;
   std::chrono::steady_clock::time_point start_{};
+  int* open_ = nullptr;  // the open scopes of an outermost-only profiler on this thread
+  static int& depth();
 };
 
 /// Installs a profiler on this thread for the lifetime of the guard.

@@ -55,10 +55,6 @@ void SampleHashGrid::build(const SampleView& s, float cell_size, Workspace& ws, 
   start_.fill_zero();
   end_.fill_zero();
   coarse_.fill_zero();
-  // Empty box (lo > hi) until the key pass widens it with integer atomics.
-  const int32_t empty_box[6] = {INT32_MAX, INT32_MAX, INT32_MAX, INT32_MIN, INT32_MIN, INT32_MIN};
-  bounds_.copy_from_host(empty_box, 6);
-  if (n == 0) return;
   if (keys_.size() < size_t(n)) {
     keys_.grow_keep(size_t(n));
     index_.grow_keep(size_t(n));
@@ -66,6 +62,7 @@ void SampleHashGrid::build(const SampleView& s, float cell_size, Workspace& ws, 
   }
   keys(device_, s.x, s.v, rewind_dt, n, 1.f / h_, mask_, keys_.data(), index_.data(), bounds_.data(),
        coarse_.data());
+  if (n == 0) return;
   sort_by_key(device_, keys_.data(), index_.data(), n, bits, ws);
   ranges(device_, keys_.data(), index_.data(), s.x, s.v, rewind_dt, n, start_.data(), end_.data(), sorted_x_.data());
 }

@@ -13,6 +13,14 @@ WB_HD WB_INLINE Vec3 hashed_position(const Vec3* x, const Vec3* v, float rewind_
 
 void hash_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, uint32_t mask,
                     uint32_t* keys, uint32_t* index, int32_t* bounds, int32_t* coarse) {
+  // Empty box (lo > hi) until the key pass widens it with integer atomics; set on the device,
+  // so that the host never waits for an upload.
+  parallel_for(1, [=] WB_HD(int64_t) {
+    for (int a = 0; a < 3; ++a) {
+      bounds[a] = INT32_MAX;
+      bounds[3 + a] = INT32_MIN;
+    }
+  });
   parallel_for(n, [=] WB_HD(int64_t i) {
     int cx, cy, cz;
     hash_cell_of(hashed_position(x, v, rewind_dt, i), inv_h, cx, cy, cz);
