@@ -52,19 +52,19 @@ void visc_setup_d(const Device& d, GridView g, const uint32_t* list, int64_t n, 
   WB_DISPATCH(d, grid_viscous_setup(g, list, n, idx, mu, scale, nu, nb, diag, b, x));
 }
 void visc_apply_d(const Device& d, int64_t n, const float* nu, const int32_t* nb, const float* diag, const float* p,
-                  float* q, float* pq) {
-  WB_DISPATCH(d, grid_viscous_apply(n, nu, nb, diag, p, q, pq));
+                  float* q, float* pq, CgGuard guard = {}) {
+  WB_DISPATCH(d, grid_viscous_apply(n, nu, nb, diag, p, q, pq, guard));
 }
 void pcg_start_d(const Device& d, int64_t n, const float* b, const float* ax, const float* diag, float* r, float* z,
                  float* p, float* rz, float* bz) {
   WB_DISPATCH(d, grid_pcg_start(n, b, ax, diag, r, z, p, rz, bz));
 }
-void pcg_update_d(const Device& d, int64_t n, const double* rz_old, const double* pq, const float* p, const float* q,
-                  const float* diag, float* x, float* r, float* z, float* rz) {
-  WB_DISPATCH(d, grid_pcg_update(n, rz_old, pq, p, q, diag, x, r, z, rz));
+void pcg_update_d(const Device& d, int64_t n, CgGuard guard, const double* pq, const float* p, const float* q,
+                  const float* diag, float* x, float* r, float* z, float* rz, double* iterations) {
+  WB_DISPATCH(d, grid_pcg_update(n, guard, pq, p, q, diag, x, r, z, rz, iterations));
 }
-void pcg_direction_d(const Device& d, int64_t n, const double* rz_new, const double* rz_old, const float* z, float* p) {
-  WB_DISPATCH(d, grid_pcg_direction(n, rz_new, rz_old, z, p));
+void pcg_direction_d(const Device& d, int64_t n, CgGuard guard, const double* rz_new, const float* z, float* p) {
+  WB_DISPATCH(d, grid_pcg_direction(n, guard, rz_new, z, p));
 }
 void visc_write_d(const Device& d, GridView g, const uint32_t* list, int64_t n, const float* x) {
   WB_DISPATCH(d, grid_viscous_write(g, list, n, x));
@@ -269,7 +269,7 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   for (auto* b : {&cg_nu_, &cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_, &cg_dot_a_, &cg_dot_b_})
     b->set_device(d);
   cg_sums_.set_device(d);
-  cg_sums_.resize(4);
+  cg_sums_.resize(5);
   advect_max_.set_device(d);
   advect_max_.resize(4);
   const size_t tiles = size_t((g.nx + kPaintTile - 1) / kPaintTile) * size_t((g.ny + kPaintTile - 1) / kPaintTile);
@@ -453,37 +453,45 @@ void Grid::apply_viscosity(float dt) {
   visc_setup_d(d, v, list, n, idx, mu_.data(), nu_scale, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_b_.data(),
                cg_x_.data());
   // Jacobi-preconditioned conjugate gradients (Saad 2003, Alg. 9.1) from the current velocity.
-  // alpha and beta are formed on the device from sums kept there (cg_sums_: r.z of the current
-  // and the next iteration, p.Ap, b.D^-1 b), so an iteration makes no host read; the host reads
-  // r.z to test convergence every kCgCheckEvery iterations (one read instead of two an iteration;
-  // the few extra iterations only reduce the residual further).
-  constexpr int kCgCheckEvery = 8;
+  // alpha, beta and the test of convergence are formed on the device from sums kept there
+  // (cg_sums_: r.z of the current and the next iteration, p.Ap, b.D^-1 b, the iterations made),
+  // so an iteration makes no host read and one launched past convergence does nothing
+  // (CgGuard). The host launches as many as the last solve made, and a few more, then reads
+  // once; only a solve that needs more reads again, every kCgCheckEvery iterations.
+  constexpr int kCgCheckEvery = 8, kCgMargin = 2;
   double* sums = cg_sums_.data();
+  cg_sums_.fill_zero();
   visc_apply_d(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_x_.data(), cg_q_.data(), cg_dot_a_.data());
   pcg_start_d(d, n, cg_b_.data(), cg_q_.data(), cg_diag_.data(), cg_r_.data(), cg_z_.data(), cg_p_.data(),
               cg_dot_a_.data(), cg_dot_b_.data());
   reduce_sum_into(d, cg_dot_a_.data(), n, sums + 0, ws_);
   reduce_sum_into(d, cg_dot_b_.data(), n, sums + 3, ws_);
-  double host[4];
-  cg_sums_.copy_to_host(host, 4);
-  double rz = host[0];
-  const double bnorm = host[3];
-  const double target = double(params_.viscosity_tolerance) * double(params_.viscosity_tolerance) * bnorm;
-  int it = 0, cur = 0;
-  while (it < params_.viscosity_max_iterations && rz > target && rz > 0.0) {
-    const int next = 1 - cur;
-    visc_apply_d(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_p_.data(), cg_q_.data(), cg_dot_a_.data());
-    reduce_sum_into(d, cg_dot_a_.data(), n, sums + 2, ws_);
-    pcg_update_d(d, n, sums + cur, sums + 2, cg_p_.data(), cg_q_.data(), cg_diag_.data(), cg_x_.data(), cg_r_.data(),
-                 cg_z_.data(), cg_dot_a_.data());
-    reduce_sum_into(d, cg_dot_a_.data(), n, sums + next, ws_);
-    pcg_direction_d(d, n, sums + next, sums + cur, cg_z_.data(), cg_p_.data());
-    cur = next;
-    ++it;
-    if (it % kCgCheckEvery == 0 || it == params_.viscosity_max_iterations) cg_sums_.copy_range_to_host(&rz, size_t(cur), 1);
+  const double tol2 = double(params_.viscosity_tolerance) * double(params_.viscosity_tolerance);
+  const int max_it = params_.viscosity_max_iterations;
+  int launched = 0, cur = 0;
+  double host[5] = {};
+  for (int planned = std::min(max_it, cg_last_iterations_ + kCgMargin);;) {
+    for (; launched < planned; ++launched) {
+      const int next = 1 - cur;
+      const CgGuard guard{sums + cur, sums + 3, tol2};
+      visc_apply_d(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_p_.data(), cg_q_.data(), cg_dot_a_.data(),
+                   guard);
+      reduce_sum_into(d, cg_dot_a_.data(), n, sums + 2, ws_);
+      pcg_update_d(d, n, guard, sums + 2, cg_p_.data(), cg_q_.data(), cg_diag_.data(), cg_x_.data(), cg_r_.data(),
+                   cg_z_.data(), cg_dot_a_.data(), sums + 4);
+      reduce_sum_into(d, cg_dot_a_.data(), n, sums + next, ws_);
+      pcg_direction_d(d, n, guard, sums + next, cg_z_.data(), cg_p_.data());
+      cur = next;
+    }
+    cg_sums_.copy_to_host(host, 5);
+    const double rz = host[cur];
+    if (!(rz > tol2 * host[3] && rz > 0.0) || launched >= max_it) break;
+    planned = std::min(max_it, launched + kCgCheckEvery);
   }
+  const int it = int(host[4]);
+  cg_last_iterations_ = it;
   stats_.viscosity_iterations = it;
-  stats_.viscosity_residual = bnorm > 0.0 ? std::sqrt(std::max(rz, 0.0) / bnorm) : 0.0;
+  stats_.viscosity_residual = host[3] > 0.0 ? std::sqrt(std::max(host[cur], 0.0) / host[3]) : 0.0;
   visc_write_d(d, v, list, n, cg_x_.data());
 }
 

@@ -147,6 +147,7 @@ class Grid {
   DeviceBuffer<float> cg_nu_, cg_x_, cg_b_, cg_r_, cg_z_, cg_p_, cg_q_, cg_diag_, cg_dot_a_, cg_dot_b_;
   /// The CG's scalars on the device: r.z of the two latest iterations, p.Ap, b.D^-1 b.
   DeviceBuffer<double> cg_sums_;
+  int cg_last_iterations_ = 0;  ///< the last viscous solve's CG iterations: the next one plans on them
   /// The advection's outflow rate and top layers (paint, joint) in one copy, then the joint
   /// top after the particles joined (find_extent).
   DeviceBuffer<float> advect_max_;
@@ -186,12 +187,12 @@ class Grid {
   void grid_viscous_setup(GridView g, const uint32_t* list, int64_t n, const uint32_t* idx, const float* mu,       \
                           float nu_scale, float* nu, int32_t* nb, float* diag, float* b, float* x);                  \
   void grid_viscous_apply(int64_t n, const float* nu, const int32_t* nb, const float* diag, const float* p,         \
-                          float* q, float* pq);                                                                      \
+                          float* q, float* pq, CgGuard guard);                                                       \
   void grid_pcg_start(int64_t n, const float* b, const float* ax, const float* diag, float* r, float* z, float* p,  \
                       float* rz, float* bz);                                                                         \
-  void grid_pcg_update(int64_t n, const double* rz_old, const double* pq, const float* p, const float* q,            \
-                       const float* diag, float* x, float* r, float* z, float* rz);                                 \
-  void grid_pcg_direction(int64_t n, const double* rz_new, const double* rz_old, const float* z, float* p);        \
+  void grid_pcg_update(int64_t n, CgGuard guard, const double* pq, const float* p, const float* q,                 \
+                       const float* diag, float* x, float* r, float* z, float* rz, double* iterations);             \
+  void grid_pcg_direction(int64_t n, CgGuard guard, const double* rz_new, const float* z, float* p);              \
   void grid_viscous_write(GridView g, const uint32_t* list, int64_t n, const float* x);                             \
   void grid_rhs(GridView g, const float* rho, float inv_dt, float* b);                                                                               \
   void poisson_jacobi(PoissonView s, const float* b, const float* x, float* out, float omega);                      \

@@ -79,6 +79,16 @@ struct GridExtent {
   int32_t dirty;   ///< the layers holding liquid at the last step
 };
 
+/// The viscous CG's test of convergence, made on the device by every kernel of an iteration:
+/// the iteration runs while r.z > tol2 b.D^-1 b (and r.z > 0), so that iterations launched past
+/// convergence do nothing and the host need not read r.z to stop them. rz null: always run.
+struct CgGuard {
+  const double* rz = nullptr;
+  const double* bnorm = nullptr;
+  double tol2 = 0.0;
+  WB_HD bool active() const { return !rz || (*rz > tol2 * *bnorm && *rz > 0.0); }
+};
+
 /// Columns of the window in tiles of kPaintTile x kPaintTile: the paint's advection visits the
 /// tiles within its reach of the paint (docs/GRID.md "Work in proportion to the paint").
 constexpr int kPaintTile = 8;

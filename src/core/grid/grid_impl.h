@@ -363,8 +363,9 @@ void grid_viscous_setup(GridView g, const uint32_t* list, int64_t n, const uint3
 }
 
 void grid_viscous_apply(int64_t n, const float* nu, const int32_t* nb, const float* diag, const float* p, float* q,
-                        float* pq) {
+                        float* pq, CgGuard guard) {
   parallel_for(n, [=] WB_HD(int64_t e) {
+    if (!guard.active()) return;
     q[e] = viscous_apply(nu, nb, p, diag[e], e);
     pq[e] = p[e] * q[e];
   });
@@ -381,12 +382,14 @@ void grid_pcg_start(int64_t n, const float* b, const float* ax, const float* dia
   });
 }
 
-void grid_pcg_update(int64_t n, const double* rz_old, const double* pq, const float* p, const float* q,
-                     const float* diag, float* x, float* r, float* z, float* rz) {
+void grid_pcg_update(int64_t n, CgGuard guard, const double* pq, const float* p, const float* q,
+                     const float* diag, float* x, float* r, float* z, float* rz, double* iterations) {
   parallel_for(n, [=] WB_HD(int64_t e) {
+    if (!guard.active()) return;
+    if (e == 0) *iterations += 1.0;
     // alpha = (r.z) / (p.Ap) from the device sums; 0 (no step) where p.Ap is not positive,
     // which an SPD system reaches only by round-off at convergence.
-    const float alpha = *pq > 0.0 ? float(*rz_old / *pq) : 0.f;
+    const float alpha = *pq > 0.0 ? float(*guard.rz / *pq) : 0.f;
     x[e] += alpha * p[e];
     r[e] -= alpha * q[e];
     z[e] = r[e] / diag[e];
@@ -394,9 +397,10 @@ void grid_pcg_update(int64_t n, const double* rz_old, const double* pq, const fl
   });
 }
 
-void grid_pcg_direction(int64_t n, const double* rz_new, const double* rz_old, const float* z, float* p) {
+void grid_pcg_direction(int64_t n, CgGuard guard, const double* rz_new, const float* z, float* p) {
   parallel_for(n, [=] WB_HD(int64_t e) {
-    const float beta = *rz_old > 0.0 ? float(*rz_new / *rz_old) : 0.f;
+    if (!guard.active()) return;
+    const float beta = float(*rz_new / *guard.rz);
     p[e] = z[e] + beta * p[e];
   });
 }

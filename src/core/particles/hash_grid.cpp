@@ -28,6 +28,7 @@ SampleHashGrid::SampleHashGrid(const Device& device) : device_(device) {
   end_.set_device(device);
   sorted_x_.set_device(device);
   bounds_.set_device(device);
+  bounds_.resize(6);
   coarse_.set_device(device);
 }
 

@@ -66,8 +66,6 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
   extent_.resize(5);
   box_ = samples_box();
   grid_->move_window(place_window(box_, box_));
-  nonfinite_counts_.set_device(d);
-  nonfinite_counts_.resize(2 * kCheckedArrays);
   step_sums_ = DeviceBuffer<StepSums>(d, 1);
   step_sums_.fill_zero();
   transfer_->set_sums(&step_sums_.data()->transfer);
@@ -94,15 +92,23 @@ PaintCensus Simulator::census() {
 }
 
 PaintCensus Simulator::record_census(TransferRecord& rec) {
-  // The census's sums join the transfer's on the device; one copy brings the step's record.
-  StepSums* d = step_sums_.data();
-  reduce_sum_into(device(), load_->m.data(), load_->size(), &d->bristles, ws_);
-  reduce_sum_into(device(), particles_.m.data(), particles_.size(), &d->particles, ws_);
-  const PaintWindow& paint = grid_->window().paint();
-  reduce_sum_into(device(), paint.density.data(), paint.cell_count(), &d->window_density, ws_);
+  // The census's sums join the transfer's and the non-finite counts on the device; one copy
+  // brings the step's record. Where the counts show non-finite values, they are contained and
+  // the census taken again (a second read, on that path alone).
   StepSums h{};
-  step_sums_.copy_to_host(&h, 1);
-  step_sums_.fill_zero();
+  for (int take = 0; take < 2; ++take) {
+    StepSums* d = step_sums_.data();
+    reduce_sum_into(device(), load_->m.data(), load_->size(), &d->bristles, ws_);
+    reduce_sum_into(device(), particles_.m.data(), particles_.size(), &d->particles, ws_);
+    const PaintWindow& paint = grid_->window().paint();
+    reduce_sum_into(device(), paint.density.data(), paint.cell_count(), &d->window_density, ws_);
+    StepSums r{};
+    step_sums_.copy_to_host(&r, 1);
+    step_sums_.fill_zero();
+    if (take == 0) h = r;
+    h.bristles = r.bristles, h.particles = r.particles, h.window_density = r.window_density;
+    if (take == 1 || !contain_nonfinite(h.nonfinite)) break;
+  }
   Transfer::add_sums(h.transfer, double(transfer_->params().cell_mass()), rec);
   PaintCensus c;
   c.bristles = h.bristles;
@@ -404,7 +410,7 @@ void Simulator::step(const BrushPose* pen_poses, int substeps, float dt) {
   ProfilerGuard guard(&profiler_);
   WB_PROFILE_SCOPE("sim.step");
   grid_->set_particle_density(nullptr);  // last step's raster is stale
-  count_nonfinite_on_entry();
+  count_nonfinite(true);
 
   // --- 1-2. Brush (§4.1) in sub-steps, then its samples ------------------------------------
   const std::array<float, 4> box_before = box_;
@@ -462,12 +468,14 @@ void Simulator::step(const BrushPose* pen_poses, int substeps, float dt) {
     rec = transfer_->step(brush_->samples(), *load_, particles_, env);
   }
 
-  contain_nonfinite();
-  clamp_particles_to_canvas();
   {
+    // One read brings the step's record: the non-finite counts, the transfer's sums and the
+    // census. Where something went non-finite, it is contained and the census taken again.
     WB_PROFILE_SCOPE("books");
+    count_nonfinite(false);
     books_.record(rec, record_census(rec));
   }
+  clamp_particles_to_canvas();
   ++counters_.steps;
   counters_.substeps += substeps;
   counters_.particles_max = std::max(counters_.particles_max, particles_.size());
@@ -605,29 +613,25 @@ std::array<std::pair<float*, int64_t>, Simulator::kCheckedArrays> Simulator::che
       {particles_.dryness.data(), np}}};
 }
 
-void Simulator::count_nonfinite_on_entry() {
+void Simulator::count_nonfinite(bool on_entry) {
   // What the step receives is counted too (a value that went bad between steps, from outside
   // the step's stages): the step's own clamps may absorb it silently (max(m, 0) of NaN is 0),
-  // so this is where it is seen. Counted on the device; read with the end's counts.
+  // so this is where it is seen. Counted on the device; read with the step's record.
   const auto arrays = checked_arrays();
+  int64_t* counts = step_sums_.data()->nonfinite + (on_entry ? arrays.size() : 0);
   for (size_t i = 0; i < arrays.size(); ++i)
-    count_nonfinite_into(device(), arrays[i].first, arrays[i].second, nonfinite_counts_.data() + arrays.size() + i,
-                         ws_);
+    count_nonfinite_into(device(), arrays[i].first, arrays[i].second, counts + i, ws_);
 }
 
-void Simulator::contain_nonfinite() {
+bool Simulator::contain_nonfinite(const int64_t* counts) {
   // A non-finite value anywhere in the live state is zeroed (grid fields, velocities, the
   // brush's load: that paint is lost and the books show it) or removed (particles) before
-  // anything renders or scatters it; the event is counted. Every array is counted on the
-  // device and the counts, with those on entry, come back in one copy (one host read).
+  // anything renders or scatters it; the event is counted.
   const auto arrays = checked_arrays();
   const size_t n = arrays.size();
-  for (size_t i = 0; i < n; ++i)
-    count_nonfinite_into(device(), arrays[i].first, arrays[i].second, nonfinite_counts_.data() + i, ws_);
-  std::array<int64_t, 2 * kCheckedArrays> counts;
-  nonfinite_counts_.copy_to_host(counts.data(), 2 * n);
   int64_t bad = 0;
   for (size_t i = 0; i < 2 * n; ++i) bad += counts[i];
+  if (!bad) return false;
   for (size_t i = 0; i + kNonfiniteParticleArrays < n; ++i)
     if (counts[i]) joint_zero_nonfinite(device(), arrays[i].first, arrays[i].second);
   int64_t particles_bad = 0;
@@ -636,7 +640,8 @@ void Simulator::contain_nonfinite() {
     joint_kill_nonfinite(device(), particles_.view());
     particles_.compact(ws_);
   }
-  if (bad) ++counters_.nonfinite_events;
+  ++counters_.nonfinite_events;
+  return true;
 }
 
 }  // namespace wb

@@ -141,8 +141,11 @@ class Simulator {
   /// The step's transfer sums added to rec and the census after it, from one read of step_sums_.
   PaintCensus record_census(TransferRecord& rec);
   void joint_fields_stage();
-  void contain_nonfinite();
-  void count_nonfinite_on_entry();
+  /// Counts, on the device, the non-finite values of every checked array (into step_sums_).
+  void count_nonfinite(bool on_entry);
+  /// Zeroes (fields) or removes (particles) what the step record's counts show non-finite;
+  /// true when there was any.
+  bool contain_nonfinite(const int64_t* counts);
   /// Every array of the live state the containment checks (device pointer, floats): the paint
   /// fields, 3 velocities, 5 load fields, then kNonfiniteParticleArrays particle fields.
   static constexpr size_t kNonfiniteParticleArrays = 8;
@@ -179,11 +182,12 @@ class Simulator {
   DeviceBuffer<float> psi_, bristle_v_[3], cell_v_[3];
   DeviceBuffer<float> raster_mass_, raster_density_, raster_mom_[3], raster_w_[3];
   DeviceBuffer<float> overlay_mass_;
-  DeviceBuffer<int64_t> nonfinite_counts_;  ///< per checked array at the end, then on entry: one copy
-  /// The step's record on the device: the transfer's sums and the census's, read in one copy.
+  /// The step's record on the device: the transfer's sums, the census's and the non-finite
+  /// counts of every checked array (at the end, then on entry), read in one copy.
   struct StepSums {
     TransferSums transfer;
     double bristles, particles, window_density;
+    int64_t nonfinite[2 * kCheckedArrays];
   };
   DeviceBuffer<StepSums> step_sums_;
   DeviceBuffer<float> solid_height_;  ///< dried-paint top per window column (particles' solid, Eq. 8)
