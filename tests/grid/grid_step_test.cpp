@@ -111,6 +111,7 @@ TEST_F(GridStepTest, StagesVisitOnlyThePaintsLayersAndLeaveTheRestAsTheWholeWind
     return out;
   };
   int first_layers = 0, last_layers = 0, checked = 0;
+  std::string tops;  // the paint's top / the layers visited, by step
   float x0 = 4.f;
   for (int s = 0; s < 30; ++s) {
     br.plate(d, x0, x0 + 2.f, 4, 28, 6, 30.f);
@@ -128,6 +129,12 @@ TEST_F(GridStepTest, StagesVisitOnlyThePaintsLayersAndLeaveTheRestAsTheWholeWind
     int top = s < 10 ? 16 : 0;
     for (int64_t c = 0; c < d.cells(); ++c)
       if (rho[size_t(c)] > 0.f) top = std::max(top, int(c / (int64_t(d.nx) * d.ny)) + 1);
+    tops += " " + std::to_string(top) + "/" + std::to_string(e.layers);
+    if (s == 29) {
+      double high = 0.0;
+      for (int64_t c = int64_t(d.nx) * d.ny * 10; c < d.cells(); ++c) high = std::max(high, double(rho[size_t(c)]));
+      std::printf("[ extent ] densest cell above layer 10 at the end: %.3g\n", high);
+    }
     ASSERT_GE(e.layers, std::min(d.nz, top + 1)) << "step " << s;
     if (s > 1 && s != 10) ASSERT_LE(e.layers, top + 2) << "step " << s;
     if (s == 9) EXPECT_GE(e.layers, 17);
@@ -163,6 +170,7 @@ TEST_F(GridStepTest, StagesVisitOnlyThePaintsLayersAndLeaveTheRestAsTheWholeWind
   }
   std::printf("[ extent ] layers visited: %d at the first step, %d at the last (of %d)\n", first_layers, last_layers,
               d.nz);
+  std::printf("[ extent ] paint's top / layers visited by step:%s\n", tops.c_str());
   EXPECT_EQ(checked, 30);
   EXPECT_EQ(first_layers, d.nz) << "the first step visits every layer once";
   EXPECT_LT(last_layers, 12) << "the extent follows the paint down when the particles are gone";

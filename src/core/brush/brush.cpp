@@ -34,7 +34,7 @@ WB_BRUSH_CALL(brush_density_delta, (BristleState s, MinDensityGrid g, const floa
 WB_BRUSH_CALL(brush_density_apply, (BristleState s), (s))
 WB_BRUSH_CALL(brush_inextensible, (BristleState s, BristleRest r, BrushFrame f, SolidField so), (s, r, f, so))
 WB_BRUSH_CALL(brush_velocities, (BristleState s, BrushFrame f, SolidField so, float dt), (s, f, so, dt))
-WB_BRUSH_CALL(brush_restore, (BristleState s, BrushFrame f), (s, f))
+WB_BRUSH_CALL(brush_restore, (BristleState s, BrushFrame f, int64_t* c), (s, f, c))
 WB_BRUSH_CALL(brush_place, (BristleState s, BristleRest r, BrushFrame f), (s, r, f))
 WB_BRUSH_CALL(brush_stretch_and_z, (BristleState s, BristleRest r, float* a, float* b), (s, r, a, b))
 WB_BRUSH_CALL(samples_spline, (BristleState s, SampleView sv, SamplePrev p, SolidField so), (s, sv, p, so))
@@ -152,7 +152,8 @@ Brush::Brush(const Device& device, const BrushSpec& spec, const BrushPose& pose,
   scratch_a_.resize(size_t(std::max(N, S)));
   scratch_b_.resize(size_t(std::max(N, S)));
   nonfinite_.set_device(device);
-  nonfinite_.resize(2);
+  nonfinite_.resize(3);
+  nonfinite_.fill_zero();
   count_.set_device(device);
   count_.resize(1);
   // Reserve the sort's scratch now so that the first step does not allocate.
@@ -266,24 +267,14 @@ BrushFrame Brush::substep(const BrushPose& pose, float dt, const BrushEnvironmen
     brush_inextensible_on(device_, s, r, f, env.solid);
   }
   brush_velocities_on(device_, s, f, env.solid, dt);
-  // Containment: a non-finite vertex never propagates; the step is undone. Both counts come
-  // back in one copy (one host read a sub-step).
+  // Containment: a non-finite vertex never propagates; the sub-step is undone, on the device
+  // (the host learns of it from rollback_counter(), read with the step's record).
   const int64_t N = vertex_count();
   count_nonfinite_into(device_, reinterpret_cast<const float*>(xb_.data()), 3 * N, nonfinite_.data(), ws_);
   count_nonfinite_into(device_, reinterpret_cast<const float*>(vb_.data()), 3 * N, nonfinite_.data() + 1, ws_);
-  int64_t counts[2];
-  nonfinite_.copy_to_host(counts, 2);
-  const int64_t bad = counts[0] + counts[1];
-  if (bad > 0) {
-    brush_restore_on(device_, s, f);
-    ++rollbacks_;
-    frame_v_ = Vec3();
-    frame_omega_B_ = Vec3();
-    sample_history_ = 0;
-  } else {
-    frame_v_ = v_now;
-    frame_omega_B_ = omega_B;
-  }
+  brush_restore_on(device_, s, f, nonfinite_.data());
+  frame_v_ = v_now;
+  frame_omega_B_ = omega_B;
   pose_ = pose;
   return f;
 }
@@ -359,6 +350,16 @@ void Brush::max_stretch_into(float* out) {
   reduce_max_into(device_, scratch_a_.data(), vertex_count(), out, ws_);
 }
 
+void Brush::rolled_back(int64_t total) {
+  if (total <= rollbacks_) return;
+  // The motion of the undone sub-steps is forgotten: the frame's rates and the samples' history
+  // start again from the state that was kept.
+  rollbacks_ = total;
+  frame_v_ = Vec3();
+  frame_omega_B_ = Vec3();
+  sample_history_ = 0;
+}
+
 BrushStats Brush::stats() {
   BrushStats st;
   const int64_t N = vertex_count(), S = sample_count();
@@ -367,6 +368,9 @@ BrushStats Brush::stats() {
   const float zv = reduce_min(device_, scratch_b_.data(), N, ws_);
   samples_z_on(device_, samples(), scratch_b_.data());
   st.min_z = std::min(zv, reduce_min(device_, scratch_b_.data(), S, ws_));
+  int64_t total = 0;
+  nonfinite_.copy_range_to_host(&total, 2, 1);
+  rolled_back(total);
   st.nonfinite = rollbacks_;
   return st;
 }

@@ -68,13 +68,18 @@ class Brush {
   /// brush-frame dynamics (Eq. 2), constraints and collisions per sub-step, then the samples
   /// once, with the motion they made over the whole step (v, omega from the step's start and
   /// end states, a, alpha from the previous step's), so that Eq. 9's rewind x - v dt is exact
-  /// whatever the sub-step count. Allocates nothing. A non-finite sub-step is rolled back
-  /// (see rollbacks()).
+  /// whatever the sub-step count. Allocates nothing. A non-finite sub-step is rolled back on
+  /// the device (see rollback_counter()).
   void step(const BrushPose* poses, int substeps, float dt, const BrushEnvironment& env);
   void step(const BrushPose& pose, float dt, const BrushEnvironment& env) { step(&pose, 1, dt, env); }
-  /// Sub-steps whose result was non-finite and rolled back, since construction (no device work;
-  /// stats().nonfinite is the same count).
+  /// Sub-steps whose result was non-finite and rolled back, since construction, as far as the
+  /// host has learnt (rolled_back, stats()); no device work.
   int64_t rollbacks() const { return rollbacks_; }
+  /// The device's count of rolled-back sub-steps (one int64_t), for a caller that reads it with
+  /// its own results and then calls rolled_back() with it.
+  const int64_t* rollback_counter() const { return nonfinite_.data() + 2; }
+  /// The device's count as read: forgets the undone motion if it grew.
+  void rolled_back(int64_t total);
 
   /// Bristle density psi (occupied volume fraction, clamped to 1) and the psi-weighted
   /// mean bristle velocity (cells/s) on the cell-centred window at `window_origin`, sized
@@ -150,7 +155,7 @@ class Brush {
   // Scratch: contact keys, reductions.
   DeviceBuffer<uint32_t> contact_keys_, contact_vals_;
   DeviceBuffer<float> scratch_a_, scratch_b_;
-  DeviceBuffer<int64_t> nonfinite_;  ///< the sub-step's non-finite counts (positions, velocities)
+  DeviceBuffer<int64_t> nonfinite_;  ///< the sub-step's non-finite positions, velocities; rollbacks
   DeviceBuffer<double> count_;       ///< mark_contacts' count
 };
 

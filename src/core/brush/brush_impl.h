@@ -218,8 +218,12 @@ void brush_velocities(BristleState s, BrushFrame f, SolidField solid, float dt) 
   });
 }
 
-void brush_restore(BristleState s, BrushFrame f) {
+// Rolls the sub-step back where counts[0] + counts[1] (its non-finite positions and
+// velocities) is not zero, and counts it in counts[2]: decided on the device, no host wait.
+void brush_restore(BristleState s, BrushFrame f, int64_t* counts) {
   parallel_for(s.count(), [=] WB_HD(int64_t g) {
+    if (counts[0] + counts[1] == 0) return;
+    if (g == 0) counts[2] += 1;
     s.xb[g] = s.xb_old[g];
     s.vb[g] = Vec3();
     s.x[g] = f.R * s.xb[g] + f.p;

@@ -42,7 +42,7 @@ struct SamplePrev {
   void brush_density_apply(BristleState s);                                                                        \
   void brush_inextensible(BristleState s, BristleRest r, BrushFrame f, SolidField solid);                         \
   void brush_velocities(BristleState s, BrushFrame f, SolidField solid, float dt);                                \
-  void brush_restore(BristleState s, BrushFrame f);                                                                \
+  void brush_restore(BristleState s, BrushFrame f, int64_t* counts);                                              \
   void brush_place(BristleState s, BristleRest r, BrushFrame f);                                                   \
   void brush_stretch_and_z(BristleState s, BristleRest r, float* stretch, float* z);                              \
   void samples_spline(BristleState s, SampleView sv, SamplePrev prev, SolidField solid);                           \

@@ -112,16 +112,16 @@ void copy_to_host(const Device& device, void* host_dst, const void* dev_src, siz
 }
 
 void copy_from_host(const Device& device, void* dev_dst, const void* host_src, size_t bytes) {
-  count_host_read();
   count_launch();
   if (device.is_cpu()) {
     std::memcpy(dev_dst, host_src, bytes);
     return;
   }
 #if defined(WB_WITH_CUDA)
-  // Synchronous: the host source may be a temporary.
+  // The host source may be a temporary: from pageable memory (all the host memory this program
+  // copies from) the copy returns once the driver has staged the source, so the caller may
+  // free it at once without a wait (CUDA's "API synchronization behavior").
   WB_CUDA_CHECK(cudaMemcpyAsync(dev_dst, host_src, bytes, cudaMemcpyHostToDevice, cuda_stream()));
-  WB_CUDA_CHECK(cudaStreamSynchronize(cuda_stream()));
 #else
   detail::throw_no_cuda();
 #endif

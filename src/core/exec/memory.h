@@ -27,8 +27,7 @@ void reset_peak();
 /// waits; on the CPU backend the same call sites are counted, so a test there measures what
 /// the GPU would wait for.
 int64_t host_reads();
-/// Counts one such read (copy_to_host and every primitive of algorithms.h that returns a value)
-/// or wait (copy_from_host, which drains the stream before the host's buffer may change).
+/// Counts one such read (copy_to_host and every primitive of algorithms.h that returns a value).
 void count_host_read();
 
 /// Device launches (kernels, device copies and fills, one per primitive of algorithms.h) the

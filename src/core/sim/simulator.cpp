@@ -102,10 +102,16 @@ PaintCensus Simulator::record_census(TransferRecord& rec) {
     reduce_sum_into(device(), particles_.m.data(), particles_.size(), &d->particles, ws_);
     const PaintWindow& paint = grid_->window().paint();
     reduce_sum_into(device(), paint.density.data(), paint.cell_count(), &d->window_density, ws_);
+    mem::copy_on_device(device(), &d->brush_rollbacks, brush_->rollback_counter(), sizeof(int64_t));
     StepSums r{};
     step_sums_.copy_to_host(&r, 1);
     step_sums_.fill_zero();
-    if (take == 0) h = r;
+    if (take == 0) {
+      h = r;
+      // Sub-steps the brush rolled back on the device (Brush::step) are non-finite events too.
+      counters_.nonfinite_events += r.brush_rollbacks - brush_->rollbacks();
+      brush_->rolled_back(r.brush_rollbacks);
+    }
     h.bristles = r.bristles, h.particles = r.particles, h.window_density = r.window_density;
     if (take == 1 || !contain_nonfinite(h.nonfinite)) break;
   }
@@ -510,7 +516,6 @@ SolidField Simulator::solid_field() {
 
 void Simulator::brush_stage(const BrushPose* poses, int substeps, float dt) {
   ActiveWindow& win = grid_->window();
-  const int64_t rollbacks_before = brush_->rollbacks();
   // The grid velocity kept from the last step drags the bristles (Eq. 2's a_i, §4.3).
   joint_cell_velocity(device(), grid_->view(), cell_v_[0].data(), cell_v_[1].data(), cell_v_[2].data());
   const Int3 n = win.dims(), o = win.origin();
@@ -520,7 +525,6 @@ void Simulator::brush_stage(const BrushPose* poses, int substeps, float dt) {
   env.drag = config_.params.bristle_drag > 0.f ? &drag : nullptr;
   env.solid = solid_field();
   brush_->step(poses, substeps, dt, env);
-  counters_.nonfinite_events += brush_->rollbacks() - rollbacks_before;
 }
 
 void Simulator::particle_stage(float dt) {

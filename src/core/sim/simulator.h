@@ -182,12 +182,14 @@ class Simulator {
   DeviceBuffer<float> psi_, bristle_v_[3], cell_v_[3];
   DeviceBuffer<float> raster_mass_, raster_density_, raster_mom_[3], raster_w_[3];
   DeviceBuffer<float> overlay_mass_;
-  /// The step's record on the device: the transfer's sums, the census's and the non-finite
-  /// counts of every checked array (at the end, then on entry), read in one copy.
+  /// The step's record on the device: the transfer's sums, the census's, the non-finite
+  /// counts of every checked array (at the end, then on entry) and the brush's rolled-back
+  /// sub-steps (Brush::rollback_counter), read in one copy.
   struct StepSums {
     TransferSums transfer;
     double bristles, particles, window_density;
     int64_t nonfinite[2 * kCheckedArrays];
+    int64_t brush_rollbacks;
   };
   DeviceBuffer<StepSums> step_sums_;
   DeviceBuffer<float> solid_height_;  ///< dried-paint top per window column (particles' solid, Eq. 8)
