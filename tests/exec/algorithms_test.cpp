@@ -90,6 +90,40 @@ TEST_F(AlgorithmsTest, ReductionsAndNonFinite) {
   EXPECT_EQ(count_nonfinite(device_, d.data(), n, ws_), 2);
 }
 
+TEST_F(AlgorithmsTest, NonfiniteCountsOfManyArraysInOneLaunch) {
+  // Arrays of very different lengths (empty, one element, many blocks' worth), NaN and both
+  // infinities planted at known places; the counts stay on the device, in one launch.
+  const std::vector<int64_t> sizes = {0, 1, 5, 300001, 77, 1 << 20};
+  std::vector<DeviceBuffer<float>> bufs;
+  std::vector<int64_t> expect;
+  FloatArrays all;
+  for (size_t k = 0; k < sizes.size(); ++k) {
+    std::vector<float> v(size_t(sizes[k]), 0.5f);
+    int64_t bad = 0;
+    for (int64_t i = int64_t(k) % 3; i < sizes[k]; i += 9973 + int64_t(k)) {
+      v[size_t(i)] = i % 3 == 0 ? std::numeric_limits<float>::quiet_NaN()
+                                : (i % 3 == 1 ? 1.f : -1.f) * std::numeric_limits<float>::infinity();
+      ++bad;
+    }
+    bufs.emplace_back(device_, std::max<size_t>(v.size(), 1));
+    if (!v.empty()) bufs.back().copy_from_host(v);
+    all.add(bufs.back().data(), sizes[k]);
+    expect.push_back(bad);
+  }
+  DeviceBuffer<int64_t> out(device_, sizes.size());
+  std::vector<int64_t> poison(sizes.size(), -7);
+  out.copy_from_host(poison);
+  const int64_t reads = mem::host_reads(), launches = mem::launches();
+  count_nonfinite_each_into(device_, all, out.data(), ws_);
+  EXPECT_EQ(mem::host_reads(), reads);
+  EXPECT_EQ(mem::launches(), launches + 1);
+  EXPECT_EQ(out.to_host(), expect);
+  EXPECT_GT(expect[5], 100) << "the long array has many planted values";
+  FloatArrays too_many;
+  for (int k = 0; k < FloatArrays::kMax; ++k) too_many.add(bufs[1].data(), 1);
+  EXPECT_THROW(too_many.add(bufs[1].data(), 1), Error);
+}
+
 TEST_F(AlgorithmsTest, SumIntoDeviceMemoryIsNotAHostRead) {
   // reduce_sum_into leaves its result on the device; every primitive that returns a value to
   // the host counts one host read, as does a copy to the host.

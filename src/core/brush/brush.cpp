@@ -270,8 +270,10 @@ BrushFrame Brush::substep(const BrushPose& pose, float dt, const BrushEnvironmen
   // Containment: a non-finite vertex never propagates; the sub-step is undone, on the device
   // (the host learns of it from rollback_counter(), read with the step's record).
   const int64_t N = vertex_count();
-  count_nonfinite_into(device_, reinterpret_cast<const float*>(xb_.data()), 3 * N, nonfinite_.data(), ws_);
-  count_nonfinite_into(device_, reinterpret_cast<const float*>(vb_.data()), 3 * N, nonfinite_.data() + 1, ws_);
+  FloatArrays state;
+  state.add(reinterpret_cast<const float*>(xb_.data()), 3 * N);
+  state.add(reinterpret_cast<const float*>(vb_.data()), 3 * N);
+  count_nonfinite_each_into(device_, state, nonfinite_.data(), ws_);
   brush_restore_on(device_, s, f, nonfinite_.data());
   frame_v_ = v_now;
   frame_omega_B_ = omega_B;

@@ -1,7 +1,10 @@
 // The one runtime dispatcher of the primitives: validates, then picks the backend.
 #include "core/exec/algorithms.h"
 
+#include <string>
+
 #include "core/exec/dispatch.h"
+#include "core/exec/error.h"
 #include "core/exec/memory.h"
 
 namespace wb {
@@ -43,6 +46,19 @@ void count_nonfinite_into(const Device& d, const float* in, int64_t n, int64_t* 
   check_ws(d, ws);
   mem::count_launch();
   WB_DISPATCH(d, count_nonfinite_into(in, n, out, ws));
+}
+void FloatArrays::add(const float* p, int64_t size) {
+  WB_REQUIRE(count < kMax, "FloatArrays: more than " + std::to_string(kMax) + " arrays");
+  WB_REQUIRE(size >= 0 && (size == 0 || p), "FloatArrays: a null array or a negative length");
+  ptr[count] = p;
+  n[count] = size;
+  ++count;
+}
+void count_nonfinite_each_into(const Device& d, const FloatArrays& arrays, int64_t* out, Workspace& ws) {
+  check_ws(d, ws);
+  mem::count_launch();
+  if (arrays.count == 0) return;
+  WB_DISPATCH(d, count_nonfinite_each_into(arrays, out, ws));
 }
 float reduce_max(const Device& d, const float* in, int64_t n, Workspace& ws) {
   check_ws(d, ws);

@@ -29,9 +29,21 @@ int64_t count_nonfinite(const Device& device, const float* in, int64_t n, Worksp
 /// The same count written to *out, a device pointer (not a host read): several arrays' counts
 /// gathered in one device buffer come back to the host in one copy.
 void count_nonfinite_into(const Device& device, const float* in, int64_t n, int64_t* out, Workspace& ws);
+/// Arrays of floats (device pointers and lengths), passed whole to one kernel.
+struct FloatArrays {
+  static constexpr int kMax = 32;
+  const float* ptr[kMax] = {};
+  int64_t n[kMax] = {};
+  int count = 0;
+  void add(const float* p, int64_t size);
+};
+/// out[k] = the non-finite values of array k, for every array, in one launch (not a host read):
+/// the containment's check of the whole live state costs one pass, not one launch an array.
+void count_nonfinite_each_into(const Device& device, const FloatArrays& arrays, int64_t* out, Workspace& ws);
 
 namespace cpu {
 void count_nonfinite_into(const float* in, int64_t n, int64_t* out, Workspace& ws);
+void count_nonfinite_each_into(const FloatArrays& arrays, int64_t* out, Workspace& ws);
 void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Workspace& ws);
 uint32_t exclusive_scan(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);
 double reduce_sum(const float* in, int64_t n, Workspace& ws);
@@ -44,6 +56,7 @@ int64_t count_nonfinite(const float* in, int64_t n, Workspace& ws);
 }  // namespace cpu
 namespace cuda {
 void count_nonfinite_into(const float* in, int64_t n, int64_t* out, Workspace& ws);
+void count_nonfinite_each_into(const FloatArrays& arrays, int64_t* out, Workspace& ws);
 void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Workspace& ws);
 uint32_t exclusive_scan(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);
 double reduce_sum(const float* in, int64_t n, Workspace& ws);

@@ -79,6 +79,10 @@ float reduce_min(const float* in, int64_t n, Workspace&) {
   return m;
 }
 
+void count_nonfinite_each_into(const FloatArrays& arrays, int64_t* out, Workspace& ws) {
+  for (int k = 0; k < arrays.count; ++k) out[k] = count_nonfinite(arrays.ptr[k], arrays.n[k], ws);
+}
+
 int64_t count_nonfinite(const float* in, int64_t n, Workspace&) {
   int64_t c = 0;
 #pragma omp parallel for reduction(+ : c) schedule(static) if (n > 65536)

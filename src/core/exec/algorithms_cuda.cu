@@ -117,6 +117,32 @@ void count_nonfinite_into(const float* in, int64_t n, int64_t* out, Workspace& w
             reinterpret_cast<long long*>(out), ws);
 }
 
+namespace {
+// Block y counts array y: a strided pass, a warp sum, one integer atomic a warp (exact in any order).
+__global__ void count_nonfinite_each(FloatArrays a, unsigned long long* out) {
+  const int k = blockIdx.y;
+  const int64_t n = a.n[k];
+  const float* p = a.ptr[k];
+  unsigned long long c = 0;
+  const int64_t stride = int64_t(blockDim.x) * gridDim.x;
+  for (int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x; i < n; i += stride) c += isfinite(p[i]) ? 0 : 1;
+  for (int off = 16; off > 0; off >>= 1) c += __shfl_down_sync(0xffffffffu, c, off);
+  if ((threadIdx.x & 31) == 0 && c) atomicAdd(out + k, c);
+}
+}  // namespace
+
+void count_nonfinite_each_into(const FloatArrays& arrays, int64_t* out, Workspace&) {
+  static_assert(sizeof(int64_t) == sizeof(unsigned long long), "count type");
+  int64_t most = 0;
+  for (int k = 0; k < arrays.count; ++k) most = arrays.n[k] > most ? arrays.n[k] : most;
+  WB_CUDA_CHECK(cudaMemsetAsync(out, 0, size_t(arrays.count) * sizeof(int64_t), wb::cuda_stream()));
+  constexpr int kThreads = 256;
+  const int64_t blocks = (most + kThreads - 1) / kThreads;
+  const dim3 grid(unsigned(blocks < 1 ? 1 : blocks > 512 ? 512 : blocks), unsigned(arrays.count));
+  count_nonfinite_each<<<grid, kThreads, 0, wb::cuda_stream()>>>(arrays, reinterpret_cast<unsigned long long*>(out));
+  WB_CUDA_CHECK(cudaGetLastError());
+}
+
 float reduce_max(const float* in, int64_t n, Workspace& ws) {
   return reduce(in, n, MaxOp{}, -::cuda::std::numeric_limits<float>::infinity(), ws);
 }

@@ -621,10 +621,9 @@ void Simulator::count_nonfinite(bool on_entry) {
   // What the step receives is counted too (a value that went bad between steps, from outside
   // the step's stages): the step's own clamps may absorb it silently (max(m, 0) of NaN is 0),
   // so this is where it is seen. Counted on the device; read with the step's record.
-  const auto arrays = checked_arrays();
-  int64_t* counts = step_sums_.data()->nonfinite + (on_entry ? arrays.size() : 0);
-  for (size_t i = 0; i < arrays.size(); ++i)
-    count_nonfinite_into(device(), arrays[i].first, arrays[i].second, counts + i, ws_);
+  FloatArrays all;
+  for (const auto& [ptr, n] : checked_arrays()) all.add(ptr, n);
+  count_nonfinite_each_into(device(), all, step_sums_.data()->nonfinite + (on_entry ? kCheckedArrays : 0), ws_);
 }
 
 bool Simulator::contain_nonfinite(const int64_t* counts) {
