@@ -1,0 +1,59 @@
+// The host's waits for the device in a step: the CPU backend counts them at the same call sites
+// as CUDA, where each drains the stream (mem::host_reads). Each stage has its budget, so that a
+// read added to the step fails here, on every machine, not only as a slower step on a GPU.
+#include <cstdio>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/exec/memory.h"
+#include "sim/sim_fixture.h"
+
+namespace wb::test {
+namespace {
+
+double mean_of(const std::vector<int64_t>& v) {
+  double s = 0.0;
+  for (int64_t x : v) s += double(x);
+  return v.empty() ? 0.0 : s / double(v.size());
+}
+
+TEST_F(SimulatorTest, HostWaitsPerStepStayWithinEachStagesBudget) {
+  const SimConfig c = small_config();
+  Simulator sim(c, pose_at(c.brush, 90, 128, 0.f, false));
+  sim.load_paint(red());
+  const float dt = 1.f / 60.f;
+  for (int i = 0; i < 4; ++i) sim.step(pose_at(c.brush, 90.f, 128.f, 0.25f * float(i)), dt);
+  // A pressed stroke across the canvas (the window follows it), in sub-steps, then held still.
+  for (int i = 0; i < 24; ++i) {
+    BrushPose poses[4];
+    for (int s = 0; s < 4; ++s) poses[s] = pose_at(c.brush, 90.f + 3.f * float(i) + 0.75f * float(s + 1), 128.f, 0.8f);
+    sim.step(poses, 4, dt);
+  }
+  for (int i = 0; i < 8; ++i) sim.step(pose_at(c.brush, 162.f, 128.f, 0.8f), dt);
+  const Profiler& prof = sim.profiler();
+  ASSERT_EQ(prof.host_reads("sim.step").size(), 36u);
+  ASSERT_GT(prof.count("grid.window_move"), 4u) << "the stroke moves the window";
+  // Reads a step, the mean over the stroke, by scope: what each may make and why.
+  const std::map<std::string, double> budget = {
+      {"brush.step", 0.0},       // sub-steps roll back on the device; the record reports it
+      {"books", 1.0},            // the step's record: sums, census, non-finite counts, rollbacks
+      {"grid.advect", 1.0},      // the velocity maxima that set the sub-step count
+      {"grid.viscosity", 2.5},   // the fluid faces' count; CG's one test when the plan holds
+      {"transfer.step", 3.0},    // the particle counts that size the emission, sampling, compaction
+      {"window", 3.0},           // the samples' box and ground; a move's tile flags and sums
+  };
+  for (const auto& [scope, most] : budget) {
+    const double m = mean_of(prof.host_reads(scope));
+    std::printf("[ waits ] %-16s %.2f a step (budget %.1f)\n", scope.c_str(), m, most);
+    EXPECT_LE(m, most) << scope;
+  }
+  const double total = mean_of(prof.host_reads("sim.step"));
+  std::printf("[ waits ] %-16s %.2f a step; %.0f launches a step\n", "sim.step", total,
+              mean_of(prof.launches("sim.step")));
+  EXPECT_LE(total, 8.5) << "a step's host waits";
+  EXPECT_EQ(sim.counters().nonfinite_events, 0);
+}
+
+}  // namespace
+}  // namespace wb::test
