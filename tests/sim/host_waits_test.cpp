@@ -41,7 +41,7 @@ TEST_F(SimulatorTest, HostWaitsPerStepStayWithinEachStagesBudget) {
       {"grid.advect", 1.0},      // the velocity maxima that set the sub-step count
       {"grid.viscosity", 2.5},   // the fluid faces' count; CG's one test when the plan holds
       {"transfer.step", 3.0},    // the particle counts that size the emission, sampling, compaction
-      {"window", 3.0},           // the samples' box and ground; a move's tile flags and sums
+      {"window", 2.0},           // the samples' box and ground; a move's tile flags, compaction
   };
   for (const auto& [scope, most] : budget) {
     const double m = mean_of(prof.host_reads(scope));
@@ -51,7 +51,7 @@ TEST_F(SimulatorTest, HostWaitsPerStepStayWithinEachStagesBudget) {
   const double total = mean_of(prof.host_reads("sim.step"));
   std::printf("[ waits ] %-16s %.2f a step; %.0f launches a step\n", "sim.step", total,
               mean_of(prof.launches("sim.step")));
-  EXPECT_LE(total, 8.5) << "a step's host waits";
+  EXPECT_LE(total, 9.0) << "a step's host waits";
   EXPECT_EQ(sim.counters().nonfinite_events, 0);
 }
 

@@ -39,6 +39,23 @@ TileStore::TileStore(const Device& device, CanvasDims dims) : device_(device), d
   ws_ = Workspace(device);
   mass_before_.set_device(device);
   mass_after_.set_device(device);
+  mass_sums_ = DeviceBuffer<double>(device, 2);
+  mass_sums_.fill_zero();
+}
+
+double TileStore::total_density() const {
+  if (mass_pending_) {
+    double sums[2];
+    mass_sums_.copy_to_host(sums, 2);
+    const_cast<TileStore*>(this)->take_mass_sums(sums);
+  }
+  return mass_;
+}
+
+void TileStore::take_mass_sums(const double sums[2]) {
+  mass_ += sums[0] - sums[1];
+  mass_sums_.fill_zero();
+  mass_pending_ = false;
 }
 
 TileStoreView TileStore::view() {
@@ -124,7 +141,9 @@ void TileStore::scatter(PaintWindow& window) {
   mass_before_.resize(size_t(cells));
   mass_after_.resize(size_t(cells));
   scatter_dispatch(device_, view(), window.view(), mass_before_.data(), mass_after_.data());
-  mass_ += reduce_sum(device_, mass_after_.data(), cells, ws_) - reduce_sum(device_, mass_before_.data(), cells, ws_);
+  reduce_sum_add_into(device_, mass_after_.data(), cells, mass_sums_.data(), ws_);
+  reduce_sum_add_into(device_, mass_before_.data(), cells, mass_sums_.data() + 1, ws_);
+  mass_pending_ = true;
 }
 
 void TileStore::advance_drying(double amount) {
@@ -153,6 +172,8 @@ void TileStore::clear() {
   host_dried_to_.clear();
   slots_used_ = 0;
   mass_ = 0.0;
+  mass_sums_.fill_zero();
+  mass_pending_ = false;
   slot_of_tile_.copy_from_host(host_slot_);
   if (slot_capacity_ > 0) {
     density_.fill_zero();
@@ -171,7 +192,9 @@ void TileStore::copy_from(const TileStore& src) {
   host_dried_to_ = src.host_dried_to_;
   slots_used_ = src.slots_used_;
   clock_ = src.clock_;
-  mass_ = src.mass_;
+  mass_ = src.mass_;  // and the sums src has not read yet, on the device below
+  mem::copy_on_device(device_, mass_sums_.data(), src.mass_sums_.data(), 2 * sizeof(double));
+  mass_pending_ = src.mass_pending_;
   slot_of_tile_.copy_from_host(host_slot_);
   const size_t cells = size_t(slots_used_) * size_t(tile_cells());
   if (cells == 0) return;

@@ -103,9 +103,14 @@ class TileStore {
   /// Bytes held now: tile index (host and device) plus the pool's capacity.
   size_t memory_bytes() const;
   /// Sum of density over all cells (in cell units), in double: kept up to date by every write
-  /// (a scatter adds what it writes less what it overwrites), so reading it costs nothing
-  /// whatever the size of the painting.
-  double total_density() const { return mass_; }
+  /// (a scatter adds what it writes less what it overwrites), so it costs nothing whatever the
+  /// size of the painting. A scatter's sums stay on the device until they are read (one host
+  /// read, here or with a caller's own results: mass_sums / take_mass_sums).
+  double total_density() const;
+  /// The scatters' sums not yet read (two doubles on the device: written, overwritten) ...
+  const double* mass_sums() const { return mass_sums_.data(); }
+  /// ... and those sums as a caller read them: added to the total, and zeroed on the device.
+  void take_mass_sums(const double sums[2]);
   /// The same sum counted over the whole tile pool (for tests of the running total).
   double recount_density(Workspace& ws) const;
 
@@ -139,7 +144,9 @@ class TileStore {
   DeviceBuffer<int32_t> tile_flags_;  ///< scratch of scatter: which window tiles hold paint
   std::vector<int32_t> host_flags_;
   double clock_ = 0.0;                 ///< drying clock
-  double mass_ = 0.0;                  ///< sum of density over the pool (total_density)
+  mutable double mass_ = 0.0;          ///< sum of density over the pool, less mass_sums_
+  mutable DeviceBuffer<double> mass_sums_;  ///< the scatters' written and overwritten sums since read
+  mutable bool mass_pending_ = false;  ///< mass_sums_ may be non-zero
   Workspace ws_;                       ///< scratch of the scatter's mass difference
   DeviceBuffer<float> mass_before_, mass_after_;  ///< per window cell: density overwritten, written
   std::vector<int32_t> touched_;       ///< scratch of scatter: slots of the window's tiles

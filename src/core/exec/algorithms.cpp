@@ -37,6 +37,11 @@ void reduce_sum_into(const Device& d, const float* in, int64_t n, double* out, W
   mem::count_launch();
   WB_DISPATCH(d, reduce_sum_into(in, n, out, ws));
 }
+void reduce_sum_into(const Device& d, const double* in, int64_t n, double* out, Workspace& ws) {
+  check_ws(d, ws);
+  mem::count_launch();
+  WB_DISPATCH(d, reduce_sum_into(in, n, out, ws));
+}
 void reduce_sum_add_into(const Device& d, const float* in, int64_t n, double* out, Workspace& ws) {
   check_ws(d, ws);
   mem::count_launch();

@@ -18,6 +18,7 @@ double reduce_sum(const Device& device, const float* in, int64_t n, Workspace& w
 /// The same sum written to *out, a device pointer: the result stays on the device for the
 /// kernels that use it, and the host does not wait for it (not a host read).
 void reduce_sum_into(const Device& device, const float* in, int64_t n, double* out, Workspace& ws);
+void reduce_sum_into(const Device& device, const double* in, int64_t n, double* out, Workspace& ws);
 /// *out += the sum, on the device (not a host read): a record the device keeps over a step.
 void reduce_sum_add_into(const Device& device, const float* in, int64_t n, double* out, Workspace& ws);
 float reduce_max(const Device& device, const float* in, int64_t n, Workspace& ws);
@@ -48,6 +49,7 @@ void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Work
 uint32_t exclusive_scan(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);
 double reduce_sum(const float* in, int64_t n, Workspace& ws);
 void reduce_sum_into(const float* in, int64_t n, double* out, Workspace& ws);
+void reduce_sum_into(const double* in, int64_t n, double* out, Workspace& ws);
 void reduce_sum_add_into(const float* in, int64_t n, double* out, Workspace& ws);
 float reduce_max(const float* in, int64_t n, Workspace& ws);
 void reduce_max_into(const float* in, int64_t n, float* out, Workspace& ws);
@@ -61,6 +63,7 @@ void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Work
 uint32_t exclusive_scan(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);
 double reduce_sum(const float* in, int64_t n, Workspace& ws);
 void reduce_sum_into(const float* in, int64_t n, double* out, Workspace& ws);
+void reduce_sum_into(const double* in, int64_t n, double* out, Workspace& ws);
 void reduce_sum_add_into(const float* in, int64_t n, double* out, Workspace& ws);
 float reduce_max(const float* in, int64_t n, Workspace& ws);
 void reduce_max_into(const float* in, int64_t n, float* out, Workspace& ws);

@@ -59,6 +59,13 @@ double reduce_sum(const float* in, int64_t n, Workspace&) {
 
 void reduce_sum_into(const float* in, int64_t n, double* out, Workspace& ws) { *out = reduce_sum(in, n, ws); }
 
+void reduce_sum_into(const double* in, int64_t n, double* out, Workspace&) {
+  double s = 0.0;
+#pragma omp parallel for reduction(+ : s) schedule(static) if (n > 65536)
+  for (int64_t i = 0; i < n; ++i) s += in[i];
+  *out = s;
+}
+
 void reduce_sum_add_into(const float* in, int64_t n, double* out, Workspace& ws) { *out += reduce_sum(in, n, ws); }
 
 void count_nonfinite_into(const float* in, int64_t n, int64_t* out, Workspace& ws) { *out = count_nonfinite(in, n, ws); }

@@ -99,6 +99,10 @@ void reduce_sum_into(const float* in, int64_t n, double* out, Workspace& ws) {
   reduce_to(thrust::make_transform_iterator(in, ToDouble{}), n, ::cuda::std::plus<double>{}, 0.0, out, ws);
 }
 
+void reduce_sum_into(const double* in, int64_t n, double* out, Workspace& ws) {
+  reduce_to(in, n, ::cuda::std::plus<double>{}, 0.0, out, ws);
+}
+
 namespace {
 __global__ void add_to(double* out, const double* v) { *out += *v; }
 }  // namespace

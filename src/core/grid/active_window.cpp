@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/exec/algorithms.h"
 #include "core/exec/dispatch.h"
 #include "core/exec/profile.h"
 #include "core/grid/grid.h"
@@ -16,7 +17,7 @@ void shift_dispatch(const Device& d, const float* src, float* dst, int ex, int e
 }  // namespace
 
 ActiveWindow::ActiveWindow(TileStore& canvas, Int3 dims, Int3 origin)
-    : canvas_(&canvas), paint_(canvas.device(), dims), ws_(canvas.device()) {
+    : canvas_(&canvas), paint_(canvas.device(), dims), ws_(canvas.device()), gathered_dev_(canvas.device(), 1) {
   const GridDims d = grid_dims();
   const size_t most = size_t(std::max({d.nu(), d.nv(), d.nw()}));
   for (int c = 0; c < 3; ++c) {
@@ -29,7 +30,7 @@ ActiveWindow::ActiveWindow(TileStore& canvas, Int3 dims, Int3 origin)
   shift_tmp_.resize(most);
   paint_.set_origin(origin);
   canvas_->gather(paint_);
-  gathered_mass_ = paint_.total_density(ws_);
+  sum_gathered();
 }
 
 void ActiveWindow::shift_faces(int c, int dx, int dy, int dz) {
@@ -49,7 +50,7 @@ void ActiveWindow::move_to(Int3 new_origin) {
   for (int c = 0; c < 3; ++c) shift_faces(c, new_origin.x - o.x, new_origin.y - o.y, new_origin.z - o.z);
   paint_.set_origin(new_origin);
   canvas_->gather(paint_);
-  gathered_mass_ = paint_.total_density(ws_);
+  sum_gathered();
 }
 
 Int3 ActiveWindow::origin_for(Vec3 brush, int snap) const {
@@ -72,17 +73,32 @@ bool ActiveWindow::recentre_on(Vec3 brush, int snap) {
 void ActiveWindow::flush() {
   WB_PROFILE_SCOPE("grid.window_flush");
   canvas_->scatter(paint_);
-  gathered_mass_ = paint_.total_density(ws_);
+  sum_gathered();
 }
 
 void ActiveWindow::restore(const std::vector<std::vector<float>>& host, double gathered_mass) {
   paint_.from_host(host);
-  gathered_mass_ = gathered_mass;
+  gathered_dev_.copy_from_host(&gathered_mass, 1);
+  set_gathered_mass(gathered_mass);
+}
+
+void ActiveWindow::sum_gathered() {
+  reduce_sum_into(device(), paint_.density.data(), paint_.cell_count(), gathered_dev_.data(), ws_);
+  gathered_pending_ = true;
+}
+
+double ActiveWindow::gathered_mass() const {
+  if (gathered_pending_) {
+    double m = 0;
+    gathered_dev_.copy_to_host(&m, 1);
+    set_gathered_mass(m);
+  }
+  return gathered_mass_;
 }
 
 void ActiveWindow::reload() {
   canvas_->gather(paint_);
-  gathered_mass_ = paint_.total_density(ws_);
+  sum_gathered();
 }
 
 double ActiveWindow::total_mass(Workspace& ws) const {
@@ -90,7 +106,7 @@ double ActiveWindow::total_mass(Workspace& ws) const {
 }
 
 double ActiveWindow::total_mass_with(double window_density) const {
-  return canvas_->total_density() - gathered_mass_ + window_density;
+  return canvas_->total_density() - gathered_mass() + window_density;
 }
 
 }  // namespace wb

@@ -44,8 +44,16 @@ class ActiveWindow {
 
   /// Sum of density in the window now.
   double window_mass(Workspace& ws) const { return paint_.total_density(ws); }
-  /// Density the canvas holds in the window's region (as last gathered or flushed).
-  double gathered_mass() const { return gathered_mass_; }
+  /// Density the canvas holds in the window's region (as last gathered or flushed). Summed on
+  /// the device at a gather; read once, here or with a caller's results (gathered_sum).
+  double gathered_mass() const;
+  /// That sum on the device (one double), for a caller that reads it with its own results and
+  /// then gives the value read to set_gathered_mass.
+  const double* gathered_sum() const { return gathered_dev_.data(); }
+  void set_gathered_mass(double m) const {
+    gathered_mass_ = m;
+    gathered_pending_ = false;
+  }
   /// All paint: canvas + window - the canvas copy of the window region. Unchanged by moves.
   double total_mass(Workspace& ws) const;
   /// total_mass with the window's density sum already known (read with other sums).
@@ -59,7 +67,10 @@ class ActiveWindow {
   DeviceBuffer<float> vel_[3];
   DeviceBuffer<float> shift_tmp_;
   Workspace ws_;
-  double gathered_mass_ = 0;
+  DeviceBuffer<double> gathered_dev_;  ///< the window region's density sum at the last gather
+  mutable double gathered_mass_ = 0;   ///< its value as last read
+  mutable bool gathered_pending_ = false;
+  void sum_gathered();  ///< into gathered_dev_, no host wait
 };
 
 }  // namespace wb

@@ -40,7 +40,7 @@ void advect_vel_d(const Device& d, GridView g, const float* u, const float* v, c
   WB_DISPATCH(d, grid_advect_velocity(g, u, v, w, dt, layers));
 }
 void gravity_d(const Device& d, GridView g, float* ph, float g_dt) { WB_DISPATCH(d, grid_gravity(g, ph, g_dt)); }
-void mu_d(const Device& d, GridView g, const float* oil, HerschelBulkley s, HerschelBulkley o, float m, float* mu) {
+void mu_d(const Device& d, GridView g, JointOil oil, HerschelBulkley s, HerschelBulkley o, float m, float* mu) {
   WB_DISPATCH(d, grid_effective_viscosity(g, oil, s, o, m, mu));
 }
 void visc_flags_d(const Device& d, GridView g, uint32_t* flag) { WB_DISPATCH(d, grid_viscous_flags(g, flag)); }
@@ -48,25 +48,25 @@ void visc_list_d(const Device& d, GridView g, const uint32_t* idx, uint32_t* lis
   WB_DISPATCH(d, grid_viscous_list(g, idx, list));
 }
 void visc_setup_d(const Device& d, GridView g, const uint32_t* list, int64_t n, const uint32_t* idx, const float* mu,
-                  float scale, float* nu, int32_t* nb, float* diag, float* b, float* x) {
+                  float scale, float* nu, int32_t* nb, double* diag, double* b, double* x) {
   WB_DISPATCH(d, grid_viscous_setup(g, list, n, idx, mu, scale, nu, nb, diag, b, x));
 }
-void visc_apply_d(const Device& d, int64_t n, const float* nu, const int32_t* nb, const float* diag, const float* p,
-                  float* q, float* pq, CgGuard guard = {}) {
+void visc_apply_d(const Device& d, int64_t n, const float* nu, const int32_t* nb, const double* diag, const double* p,
+                  double* q, double* pq, CgGuard guard = {}) {
   WB_DISPATCH(d, grid_viscous_apply(n, nu, nb, diag, p, q, pq, guard));
 }
-void pcg_start_d(const Device& d, int64_t n, const float* b, const float* ax, const float* diag, float* r, float* z,
-                 float* p, float* rz, float* bz) {
+void pcg_start_d(const Device& d, int64_t n, const double* b, const double* ax, const double* diag, double* r,
+                 double* z, double* p, double* rz, double* bz) {
   WB_DISPATCH(d, grid_pcg_start(n, b, ax, diag, r, z, p, rz, bz));
 }
-void pcg_update_d(const Device& d, int64_t n, CgGuard guard, const double* pq, const float* p, const float* q,
-                  const float* diag, float* x, float* r, float* z, float* rz, double* iterations) {
+void pcg_update_d(const Device& d, int64_t n, CgGuard guard, const double* pq, const double* p, const double* q,
+                  const double* diag, double* x, double* r, double* z, double* rz, double* iterations) {
   WB_DISPATCH(d, grid_pcg_update(n, guard, pq, p, q, diag, x, r, z, rz, iterations));
 }
-void pcg_direction_d(const Device& d, int64_t n, CgGuard guard, const double* rz_new, const float* z, float* p) {
+void pcg_direction_d(const Device& d, int64_t n, CgGuard guard, const double* rz_new, const double* z, double* p) {
   WB_DISPATCH(d, grid_pcg_direction(n, guard, rz_new, z, p));
 }
-void visc_write_d(const Device& d, GridView g, const uint32_t* list, int64_t n, const float* x) {
+void visc_write_d(const Device& d, GridView g, const uint32_t* list, int64_t n, const double* x) {
   WB_DISPATCH(d, grid_viscous_write(g, list, n, x));
 }
 void rhs_d(const Device& d, GridView g, const float* rho, float inv_dt, float* b) {
@@ -266,7 +266,8 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
     b->resize(all_faces);
   }
   cg_nb_.set_device(d);
-  for (auto* b : {&cg_nu_, &cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_, &cg_dot_a_, &cg_dot_b_})
+  cg_nu_.set_device(d);
+  for (auto* b : {&cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_, &cg_dot_a_, &cg_dot_b_})
     b->set_device(d);
   cg_sums_.set_device(d);
   cg_sums_.resize(5);
@@ -409,7 +410,9 @@ void Grid::rheology() {
   WB_PROFILE_SCOPE("grid.rheology");
   const HerschelBulkley stiff{params_.yield_stress_stiff, params_.consistency_stiff, params_.flow_index_stiff};
   const HerschelBulkley oily{params_.yield_stress_oily, params_.consistency_oily, params_.flow_index_oily};
-  mu_d(device(), view(), window_.paint().oil.data(), stiff, oily, params_.regularisation, mu_.data());
+  const PaintWindow& paint = window_.paint();
+  const JointOil oil{paint.density.data(), paint.oil.data(), particle_density_, particle_oil_};
+  mu_d(device(), view(), oil, stiff, oily, params_.regularisation, mu_.data());
 }
 
 void Grid::add_external_forces(float dt) {
@@ -442,7 +445,8 @@ void Grid::apply_viscosity(float dt) {
   if (cg_x_.size() < size_t(n)) {
     const size_t cap = std::min(size_t(all), size_t(n) + size_t(n) / 2);
     cg_nb_.resize(6 * cap);
-    for (auto* b : {&cg_nu_, &cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_, &cg_dot_a_, &cg_dot_b_})
+    cg_nu_.resize(cap);
+    for (auto* b : {&cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_, &cg_dot_a_, &cg_dot_b_})
       b->resize(cap);
   }
   // (1 - dt div(nu grad)) u = u_old, nu = mu / rho0 in cells^2/s.

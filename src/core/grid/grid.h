@@ -72,8 +72,13 @@ class Grid {
   /// The pointers must stay valid until the next call.
   void set_bristles(const BristleField& b) { bristles_ = b; }
   /// Rasterised particle volume (cell-centred volume fraction, device; nullable) that joins the
-  /// grid density when cells are classified (the joint density of §4.3). Valid until the next call.
-  void set_particle_density(const float* density) { particle_density_ = density; }
+  /// grid density when cells are classified (the joint density of §4.3), and the particles' oil
+  /// in the same units (sum of volume times oil fraction; nullable: the grid's oil alone), which
+  /// joins the grid's in the rheology. Valid until the next call.
+  void set_particle_density(const float* density, const float* oil = nullptr) {
+    particle_density_ = density;
+    particle_oil_ = density ? oil : nullptr;
+  }
   /// This step's particle density on the window (cell fractions), or null before the joint fields.
   const float* particle_density() const { return particle_density_; }
 
@@ -135,6 +140,7 @@ class Grid {
   ActiveWindow window_;
   BristleField bristles_{};
   const float* particle_density_ = nullptr;
+  const float* particle_oil_ = nullptr;
   DeviceBuffer<float> theta_[3], solid_vel_[3], vel_pre_[3], vel_tmp_[3];
   DeviceBuffer<uint8_t> cls_, fluid_[3];
   DeviceBuffer<float> pressure_, rhs_, cell_tmp_, face_tmp_, mu_;
@@ -144,7 +150,9 @@ class Grid {
   // (never per step in a steady stroke) and keep their capacity.
   DeviceBuffer<uint32_t> visc_idx_, visc_list_;
   DeviceBuffer<int32_t> cg_nb_;
-  DeviceBuffer<float> cg_nu_, cg_x_, cg_b_, cg_r_, cg_z_, cg_p_, cg_q_, cg_diag_, cg_dot_a_, cg_dot_b_;
+  DeviceBuffer<float> cg_nu_;
+  /// The viscous CG's vectors and matrix diagonal, in double (viscous_apply says why).
+  DeviceBuffer<double> cg_x_, cg_b_, cg_r_, cg_z_, cg_p_, cg_q_, cg_diag_, cg_dot_a_, cg_dot_b_;
   /// The CG's scalars on the device: r.z of the two latest iterations, p.Ap, b.D^-1 b.
   DeviceBuffer<double> cg_sums_;
   int cg_last_iterations_ = 0;  ///< the last viscous solve's CG iterations: the next one plans on them
@@ -180,20 +188,20 @@ class Grid {
   void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst, bool reads);   \
   void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt, int layers);                  \
   void grid_gravity(GridView g, float* ph, float g_dt);                                                              \
-  void grid_effective_viscosity(GridView g, const float* oil, HerschelBulkley stiff, HerschelBulkley oily, float m,  \
+  void grid_effective_viscosity(GridView g, JointOil oil, HerschelBulkley stiff, HerschelBulkley oily, float m,    \
                                 float* mu);                                                                          \
   void grid_viscous_flags(GridView g, uint32_t* flag);                                                               \
   void grid_viscous_list(GridView g, const uint32_t* idx, uint32_t* list);                                           \
   void grid_viscous_setup(GridView g, const uint32_t* list, int64_t n, const uint32_t* idx, const float* mu,       \
-                          float nu_scale, float* nu, int32_t* nb, float* diag, float* b, float* x);                  \
-  void grid_viscous_apply(int64_t n, const float* nu, const int32_t* nb, const float* diag, const float* p,         \
-                          float* q, float* pq, CgGuard guard);                                                       \
-  void grid_pcg_start(int64_t n, const float* b, const float* ax, const float* diag, float* r, float* z, float* p,  \
-                      float* rz, float* bz);                                                                         \
-  void grid_pcg_update(int64_t n, CgGuard guard, const double* pq, const float* p, const float* q,                 \
-                       const float* diag, float* x, float* r, float* z, float* rz, double* iterations);             \
-  void grid_pcg_direction(int64_t n, CgGuard guard, const double* rz_new, const float* z, float* p);              \
-  void grid_viscous_write(GridView g, const uint32_t* list, int64_t n, const float* x);                             \
+                          float nu_scale, float* nu, int32_t* nb, double* diag, double* b, double* x);               \
+  void grid_viscous_apply(int64_t n, const float* nu, const int32_t* nb, const double* diag, const double* p,       \
+                          double* q, double* pq, CgGuard guard);                                                     \
+  void grid_pcg_start(int64_t n, const double* b, const double* ax, const double* diag, double* r, double* z,      \
+                      double* p, double* rz, double* bz);                                                            \
+  void grid_pcg_update(int64_t n, CgGuard guard, const double* pq, const double* p, const double* q,               \
+                       const double* diag, double* x, double* r, double* z, double* rz, double* iterations);        \
+  void grid_pcg_direction(int64_t n, CgGuard guard, const double* rz_new, const double* z, double* p);            \
+  void grid_viscous_write(GridView g, const uint32_t* list, int64_t n, const double* x);                           \
   void grid_rhs(GridView g, const float* rho, float inv_dt, float* b);                                                                               \
   void poisson_jacobi(PoissonView s, const float* b, const float* x, float* out, float omega);                      \
   void poisson_residual(PoissonView s, const float* b, const float* x, float* r);                                   \

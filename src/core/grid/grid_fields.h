@@ -79,6 +79,22 @@ struct GridExtent {
   int32_t dirty;   ///< the layers holding liquid at the last step
 };
 
+/// The oil fraction of the joint paint (§4.3: grid and particles) in a cell, mass-weighted: the
+/// paint near the bristles is mostly particles, and a cell liquid by its particles alone has the
+/// rheology of their paint, not of the grid's empty cell (oil 0, the stiffest).
+/// particle_oil: the particles' volume times oil fraction, rasterised; null: the grid's oil.
+struct JointOil {
+  const float* density = nullptr;
+  const float* oil = nullptr;
+  const float* particle_density = nullptr;
+  const float* particle_oil = nullptr;
+  WB_HD float at(int64_t c) const {
+    if (!particle_oil) return oil[c];
+    const float total = density[c] + particle_density[c];
+    return total > 0.f ? (density[c] * oil[c] + particle_oil[c]) / total : oil[c];
+  }
+};
+
 /// The viscous CG's test of convergence, made on the device by every kernel of an iteration:
 /// the iteration runs while r.z > tol2 b.D^-1 b (and r.z > 0), so that iterations launched past
 /// convergence do nothing and the host need not read r.z to stop them. rz null: always run.

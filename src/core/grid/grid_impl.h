@@ -301,7 +301,7 @@ void grid_gravity(GridView g, float* ph, float g_dt) {
   });
 }
 
-void grid_effective_viscosity(GridView g, const float* oil, HerschelBulkley stiff, HerschelBulkley oily, float m,
+void grid_effective_viscosity(GridView g, JointOil oil, HerschelBulkley stiff, HerschelBulkley oily, float m,
                               float* mu) {
   const GridDims d = g.d;
   for_cells(d, g.extent, [=] WB_HD(int64_t c) {
@@ -311,7 +311,7 @@ void grid_effective_viscosity(GridView g, const float* oil, HerschelBulkley stif
     }
     int i, j, k;
     d.decompose_cell(c, i, j, k);
-    mu[c] = apparent_viscosity(rheology_at_oil(oil[c], stiff, oily), cell_strain_rate(g, i, j, k), m);
+    mu[c] = apparent_viscosity(rheology_at_oil(oil.at(c), stiff, oily), cell_strain_rate(g, i, j, k), m);
   });
 }
 
@@ -347,7 +347,7 @@ WB_HD WB_INLINE int64_t list_face(const GridDims& d, const uint32_t* list, int64
 }  // namespace detail
 
 void grid_viscous_setup(GridView g, const uint32_t* list, int64_t n, const uint32_t* idx, const float* mu,
-                        float nu_scale, float* nu, int32_t* nb, float* diag, float* b, float* x) {
+                        float nu_scale, float* nu, int32_t* nb, double* diag, double* b, double* x) {
   const GridDims d = g.d;
   parallel_for(n, [=] WB_HD(int64_t e) {
     int c, i, j, k;
@@ -362,8 +362,8 @@ void grid_viscous_setup(GridView g, const uint32_t* list, int64_t n, const uint3
   });
 }
 
-void grid_viscous_apply(int64_t n, const float* nu, const int32_t* nb, const float* diag, const float* p, float* q,
-                        float* pq, CgGuard guard) {
+void grid_viscous_apply(int64_t n, const float* nu, const int32_t* nb, const double* diag, const double* p, double* q,
+                        double* pq, CgGuard guard) {
   parallel_for(n, [=] WB_HD(int64_t e) {
     if (!guard.active()) return;
     q[e] = viscous_apply(nu, nb, p, diag[e], e);
@@ -371,8 +371,8 @@ void grid_viscous_apply(int64_t n, const float* nu, const int32_t* nb, const flo
   });
 }
 
-void grid_pcg_start(int64_t n, const float* b, const float* ax, const float* diag, float* r, float* z, float* p,
-                    float* rz, float* bz) {
+void grid_pcg_start(int64_t n, const double* b, const double* ax, const double* diag, double* r, double* z, double* p,
+                    double* rz, double* bz) {
   parallel_for(n, [=] WB_HD(int64_t e) {
     r[e] = b[e] - ax[e];
     z[e] = r[e] / diag[e];
@@ -382,14 +382,14 @@ void grid_pcg_start(int64_t n, const float* b, const float* ax, const float* dia
   });
 }
 
-void grid_pcg_update(int64_t n, CgGuard guard, const double* pq, const float* p, const float* q,
-                     const float* diag, float* x, float* r, float* z, float* rz, double* iterations) {
+void grid_pcg_update(int64_t n, CgGuard guard, const double* pq, const double* p, const double* q,
+                     const double* diag, double* x, double* r, double* z, double* rz, double* iterations) {
   parallel_for(n, [=] WB_HD(int64_t e) {
     if (!guard.active()) return;
     if (e == 0) *iterations += 1.0;
     // alpha = (r.z) / (p.Ap) from the device sums; 0 (no step) where p.Ap is not positive,
     // which an SPD system reaches only by round-off at convergence.
-    const float alpha = *pq > 0.0 ? float(*guard.rz / *pq) : 0.f;
+    const double alpha = *pq > 0.0 ? *guard.rz / *pq : 0.0;
     x[e] += alpha * p[e];
     r[e] -= alpha * q[e];
     z[e] = r[e] / diag[e];
@@ -397,21 +397,21 @@ void grid_pcg_update(int64_t n, CgGuard guard, const double* pq, const float* p,
   });
 }
 
-void grid_pcg_direction(int64_t n, CgGuard guard, const double* rz_new, const float* z, float* p) {
+void grid_pcg_direction(int64_t n, CgGuard guard, const double* rz_new, const double* z, double* p) {
   parallel_for(n, [=] WB_HD(int64_t e) {
     if (!guard.active()) return;
-    const float beta = float(*rz_new / *guard.rz);
+    const double beta = *rz_new / *guard.rz;
     p[e] = z[e] + beta * p[e];
   });
 }
 
-void grid_viscous_write(GridView g, const uint32_t* list, int64_t n, const float* x) {
+void grid_viscous_write(GridView g, const uint32_t* list, int64_t n, const double* x) {
   const GridDims d = g.d;
   parallel_for(n, [=] WB_HD(int64_t e) {
     int c;
     int64_t f;
     detail::split_face_below(d, d.nz, int64_t(list[e]), c, f);
-    g.vel[c][f] = x[e];
+    g.vel[c][f] = float(x[e]);
   });
 }
 

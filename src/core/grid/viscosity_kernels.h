@@ -74,34 +74,38 @@ WB_HD WB_INLINE float link_nu(float a, float b) { return (a + b) > 0.f ? 2.f * a
 /// u_old + sum over walls of weight * wall velocity. nu is compact (entry-indexed), idx maps a
 /// global face to its entry.
 WB_HD WB_INLINE void viscous_row(const GridView& g, const float* nu, const uint32_t* idx, int64_t e, int c, int i,
-                                 int j, int k, float u_old, int32_t* nb, float& diag, float& rhs) {
+                                 int j, int k, float u_old, int32_t* nb, double& diag, double& rhs) {
   const float nf = nu[e];
-  float dsum = 1.f, r = u_old;
+  double dsum = 1.0, r = u_old;
   int q = 0;
   for_viscous_links(
       g, c, i, j, k,
       [&](int64_t t) {
         const uint32_t en = idx[t];
         nb[q++] = int32_t(en);
-        dsum += link_nu(nf, nu[en]);
+        dsum += double(link_nu(nf, nu[en]));
       },
       [&](float uw, float s) {
-        dsum += s * nf;
-        r += s * nf * uw;
+        dsum += double(s * nf);
+        r += double(s * nf) * double(uw);
       });
   for (; q < 6; ++q) nb[q] = -1;
   diag = dsum;
   rhs = r;
 }
 
-/// (A x) of list entry e: diag x_e - sum over its fluid links of weight x_nb.
-WB_HD WB_INLINE float viscous_apply(const float* nu, const int32_t* nb, const float* x, float diag, int64_t e) {
+/// (A x) of list entry e: diag x_e - sum over its fluid links of weight x_nb. In double: with stiff
+/// paint nu dt reaches 1e9 cells^2, and in float the 1 of the diagonal (the identity of backward
+/// Euler) is lost to the rounding of the links' sum; a blob not held by a wall (free slip on all
+/// its sides: a Laplacian's null space) then has an indefinite matrix and CG diverges
+/// (docs/GRID.md "Viscosity").
+WB_HD WB_INLINE double viscous_apply(const float* nu, const int32_t* nb, const double* x, double diag, int64_t e) {
   const float nf = nu[e];
-  float off = 0.f;
+  double off = 0.0;
   for (int q = 0; q < 6; ++q) {
     const int32_t n = nb[6 * e + q];
     if (n < 0) break;
-    off += link_nu(nf, nu[n]) * x[n];
+    off += double(link_nu(nf, nu[n])) * x[n];
   }
   return diag * x[e] - off;
 }

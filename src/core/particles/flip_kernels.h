@@ -22,6 +22,7 @@ struct ParticleRasterView {
   float* weight[3];
   int nx, ny, nz;
   int ox, oy, oz;  ///< canvas cell of the window's cell (0, 0, 0)
+  float* oil = nullptr;  ///< cell-centred, mass times oil fraction (nullable)
 };
 
 /// Splats `value` trilinearly onto a node grid of ex x ey x ez nodes at offsets (ox, oy, oz):
@@ -47,10 +48,11 @@ WB_HD WB_INLINE bool inside_window(Vec3 q, int nx, int ny, int nz) {
 /// Rasterises one particle of mass m and velocity vel at canvas position p: mass onto the
 /// cell centres, momentum m v_c and weight m onto the faces of each component c (mass only
 /// when g.mom[0] is null).
-WB_HD WB_INLINE void rasterise_particle(const ParticleRasterView& g, Vec3 p, Vec3 vel, float m) {
+WB_HD WB_INLINE void rasterise_particle(const ParticleRasterView& g, Vec3 p, Vec3 vel, float m, float oil) {
   const Vec3 q(p.x - float(g.ox), p.y - float(g.oy), p.z - float(g.oz));
   if (!inside_window(q, g.nx, g.ny, g.nz)) return;
   splat_nodes(g.mass, g.nx, g.ny, g.nz, 0.5f, 0.5f, 0.5f, q, m);
+  if (g.oil) splat_nodes(g.oil, g.nx, g.ny, g.nz, 0.5f, 0.5f, 0.5f, q, m * oil);
   if (g.mom[0] == nullptr) return;
   splat_nodes(g.mom[0], g.nx + 1, g.ny, g.nz, 0.f, 0.5f, 0.5f, q, m * vel.x);
   splat_nodes(g.weight[0], g.nx + 1, g.ny, g.nz, 0.f, 0.5f, 0.5f, q, m);

@@ -24,7 +24,7 @@ void particles_adhesion_step(ParticleView p, SampleView s, SolidView solid, Part
 }
 
 void particles_rasterise(ParticleView p, ParticleRasterView g) {
-  parallel_for(p.count, [=] WB_HD(int64_t k) { rasterise_particle(g, p.x[k], p.v[k], p.m[k]); });
+  parallel_for(p.count, [=] WB_HD(int64_t k) { rasterise_particle(g, p.x[k], p.v[k], p.m[k], p.oil[k]); });
 }
 
 void particles_face_velocity(ParticleRasterView g, float* u, float* v, float* w, float empty) {

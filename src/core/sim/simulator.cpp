@@ -56,6 +56,7 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
   };
   cells(psi_);
   cells(raster_mass_);
+  cells(raster_oil_);
   cells(raster_density_);
   cells(overlay_mass_);
   for (auto* b : {&solid_height_, &wet_top_, &surface_}) {
@@ -103,9 +104,14 @@ PaintCensus Simulator::record_census(TransferRecord& rec) {
     const PaintWindow& paint = grid_->window().paint();
     reduce_sum_into(device(), paint.density.data(), paint.cell_count(), &d->window_density, ws_);
     mem::copy_on_device(device(), &d->brush_rollbacks, brush_->rollback_counter(), sizeof(int64_t));
+    ActiveWindow& win = grid_->window();
+    mem::copy_on_device(device(), d->canvas_sums, canvas_->mass_sums(), 2 * sizeof(double));
+    mem::copy_on_device(device(), &d->gathered, win.gathered_sum(), sizeof(double));
     StepSums r{};
     step_sums_.copy_to_host(&r, 1);
     step_sums_.fill_zero();
+    canvas_->take_mass_sums(r.canvas_sums);
+    win.set_gathered_mass(r.gathered);
     if (take == 0) {
       h = r;
       // Sub-steps the brush rolled back on the device (Brush::step) are non-finite events too.
@@ -573,6 +579,7 @@ void Simulator::joint_fields_stage() {
   ActiveWindow& win = grid_->window();
   const Int3 n = win.dims(), o = win.origin();
   raster_mass_.fill_zero();
+  raster_oil_.fill_zero();
   for (int c = 0; c < 3; ++c) {
     raster_mom_[c].fill_zero();
     raster_w_[c].fill_zero();
@@ -580,11 +587,14 @@ void Simulator::joint_fields_stage() {
   ParticleRasterView rv{raster_mass_.data(),
                         {raster_mom_[0].data(), raster_mom_[1].data(), raster_mom_[2].data()},
                         {raster_w_[0].data(), raster_w_[1].data(), raster_w_[2].data()},
-                        n.x, n.y, n.z, o.x, o.y, o.z};
+                        n.x, n.y, n.z, o.x, o.y, o.z, raster_oil_.data()};
   particles_rasterise(device(), particles_.view(), rv);
   const float cell_mass = transfer_->params().cell_mass();
-  joint_scale(device(), raster_mass_.data(), raster_density_.data(), int64_t(raster_mass_.size()), 1.f / cell_mass);
-  grid_->set_particle_density(raster_density_.data());
+  const int64_t cells = int64_t(raster_mass_.size());
+  joint_scale(device(), raster_mass_.data(), raster_density_.data(), cells, 1.f / cell_mass);
+  // The particles' oil in the density's units, for the joint paint's rheology (JointOil).
+  joint_scale(device(), raster_oil_.data(), raster_oil_.data(), cells, 1.f / cell_mass);
+  grid_->set_particle_density(raster_density_.data(), raster_oil_.data());
   raster_step_ = counters_.steps, raster_origin_ = o;
   joint_blend_velocity(device(), grid_->view(), win.paint().view(), rv, cell_mass);
 }

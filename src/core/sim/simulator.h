@@ -181,15 +181,18 @@ class Simulator {
   // for the drag, the particles' raster (mass, face momentum and weight) and their density.
   DeviceBuffer<float> psi_, bristle_v_[3], cell_v_[3];
   DeviceBuffer<float> raster_mass_, raster_density_, raster_mom_[3], raster_w_[3];
+  DeviceBuffer<float> raster_oil_;  ///< the particles' mass times oil fraction, then per cell mass
   DeviceBuffer<float> overlay_mass_;
   /// The step's record on the device: the transfer's sums, the census's, the non-finite
-  /// counts of every checked array (at the end, then on entry) and the brush's rolled-back
-  /// sub-steps (Brush::rollback_counter), read in one copy.
+  /// counts of every checked array (at the end, then on entry), the brush's rolled-back
+  /// sub-steps (Brush::rollback_counter) and the canvas's and window's mass sums, read in one copy.
   struct StepSums {
     TransferSums transfer;
     double bristles, particles, window_density;
     int64_t nonfinite[2 * kCheckedArrays];
     int64_t brush_rollbacks;
+    double canvas_sums[2];  ///< the canvas's scatter sums not yet read (TileStore::mass_sums)
+    double gathered;        ///< the window region's density at its last gather
   };
   DeviceBuffer<StepSums> step_sums_;
   DeviceBuffer<float> solid_height_;  ///< dried-paint top per window column (particles' solid, Eq. 8)
