@@ -151,9 +151,13 @@ TEST_F(GridStepTest, FloatingStiffPaintSolveConverges) {
 }
 
 // The same scene as below on the CPU and on this backend (a GPU), in lockstep: a plate sweeps a
-// paint layer with particles in flight above it for 10 steps. The paint and the velocity agree
-// after every stage, first with the stages called one by one on the whole window, then with the
-// step (its stages bounded to the paint's layers); the first stage that parts them is named.
+// paint layer with particles in flight above it for 10 steps. Sums run in another order on each,
+// and the regularised viscosity is steep near the yield stress (a rounding's change of strain rate
+// moves it by decades), so the two part by rounding: the paint agrees to 10^-3 of its mass with
+// the same top after every stage, the velocity to 2 % of the fastest face, first with the stages
+// called one by one on the whole window, then with the step (bounded to the paint's layers).
+// Before the viscous solve ran in double, a floating block's solve diverged on each backend to
+// its own values (faces at 10^5 to 10^6 cells/s) and the paint parted in the first step.
 TEST_F(GridStepTest, SameStagesOnCpuAndThisBackend) {
   if (device_.is_cpu()) GTEST_SKIP() << "run with WB_DEVICE=cuda to compare the CUDA backend with the CPU";
   struct Side {
@@ -186,6 +190,7 @@ TEST_F(GridStepTest, SameStagesOnCpuAndThisBackend) {
       return top;
     };
     std::string first;  // the first stage whose results part
+    double worst_paint = 0, worst_v = 0;  // relative to the paint's mass and the fastest face
     auto compare = [&](int s, const char* stage) {
       const auto ra = host_density(a.g), rb = host_density(b.g);
       double diff = 0, mass = 0;
@@ -198,32 +203,25 @@ TEST_F(GridStepTest, SameStagesOnCpuAndThisBackend) {
         const auto va = a.g.window().velocity(c).to_host(), vb = b.g.window().velocity(c).to_host();
         for (size_t i = 0; i < va.size(); ++i) dv = std::max(dv, std::fabs(va[i] - vb[i]));
       }
-      const bool parted = diff > 1e-3 * mass || top_of(ra) != top_of(rb) || !(dv < 1.f);
+      const double fastest = std::max(1.0, double(b.g.max_fluid_speed()));
+      worst_paint = std::max(worst_paint, diff / mass);
+      worst_v = std::max(worst_v, double(dv) / fastest);
+      const bool parted = diff > 1e-3 * mass || top_of(ra) != top_of(rb) || !(double(dv) <= 0.02 * fastest);
       if (parted && first.empty()) {
         first = std::string(stage) + " of step " + std::to_string(s);
-        std::printf("[ backends ] %s: parted at %s: paint L1 %.3g of %.3g, top %d vs %d (cpu), |dv| %.3g cells/s\n",
-                    whole_step ? "step" : "stages", first.c_str(), diff, mass, top_of(ra), top_of(rb), double(dv));
-        const auto mua = a.g.apparent_viscosity().to_host(), mub = b.g.apparent_viscosity().to_host();
-        const GridDims gd = a.g.dims();
-        std::vector<uint8_t> cla(size_t(gd.cells())), clb(size_t(gd.cells()));
-        mem::copy_to_host(a.g.device(), cla.data(), a.g.view().cls, cla.size());
-        mem::copy_to_host(b.g.device(), clb.data(), b.g.view().cls, clb.size());
-        double dmu = 0;
-        int64_t dcls = 0;
-        for (size_t i = 0; i < mua.size(); ++i) dmu = std::max(dmu, std::fabs(double(mua[i]) - double(mub[i])));
-        for (size_t i = 0; i < cla.size(); ++i) dcls += cla[i] != clb[i];
-        std::printf("[ backends ] apparent viscosity differs by %.3g at most; %lld cells classed apart\n", dmu,
-                    static_cast<long long>(dcls));
+        std::printf("[ backends ] %s: parted at %s: paint L1 %.3g of %.3g, top %d vs %d (cpu), |dv| %.3g of %.3g cells/s\n",
+                    whole_step ? "step" : "stages", first.c_str(), diff, mass, top_of(ra), top_of(rb), double(dv),
+                    fastest);
         for (Side* x : {&a, &b}) {
           const GridStats& st = x->g.stats();
-          std::printf("[ backends ] %s: fastest face %.3g cells/s; viscous solve: %d faces, %d iterations, residual %.3g\n",
-                      x == &a ? "this backend" : "cpu", double(x->g.max_fluid_speed()), st.viscosity_faces,
-                      st.viscosity_iterations, st.viscosity_residual);
+          std::printf("[ backends ] %s: viscous solve: %d faces, %d iterations, residual %.3g\n",
+                      x == &a ? "this backend" : "cpu", st.viscosity_faces, st.viscosity_iterations,
+                      st.viscosity_residual);
         }
       }
     };
     float x0 = 4.f;
-    for (int s = 0; s < 14 && first.empty(); ++s) {
+    for (int s = 0; s < 14; ++s) {
       for (Side* x : {&a, &b}) {
         x->br.plate(d, x0, x0 + 2.f, 4, 28, 6, 30.f);
         x->g.set_bristles(x->br.field());
@@ -251,6 +249,8 @@ TEST_F(GridStepTest, SameStagesOnCpuAndThisBackend) {
         compare(s, name);
       }
     }
+    std::printf("[ backends ] %s: worst paint L1 %.2g of the mass, worst velocity %.2g of the fastest face\n",
+                whole_step ? "step" : "stages", worst_paint, worst_v);
     EXPECT_TRUE(first.empty()) << (whole_step ? "step: " : "stages: ") << first;
   }
 }

@@ -461,7 +461,8 @@ void Grid::apply_viscosity(float dt) {
   // (cg_sums_: r.z of the current and the next iteration, p.Ap, b.D^-1 b, the iterations made),
   // so an iteration makes no host read and one launched past convergence does nothing
   // (CgGuard). The host launches as many as the last solve made, and a few more, then reads
-  // once; only a solve that needs more reads again, every kCgCheckEvery iterations.
+  // once; only a solve that needs more reads again, after kCgCheckEvery more iterations, then
+  // twice as many each time (a solve far past its plan reads a few times, not every 8).
   constexpr int kCgCheckEvery = 8, kCgMargin = 2;
   double* sums = cg_sums_.data();
   cg_sums_.fill_zero();
@@ -474,7 +475,7 @@ void Grid::apply_viscosity(float dt) {
   const int max_it = params_.viscosity_max_iterations;
   int launched = 0, cur = 0;
   double host[5] = {};
-  for (int planned = std::min(max_it, cg_last_iterations_ + kCgMargin);;) {
+  for (int planned = std::min(max_it, cg_last_iterations_ + kCgMargin), more = kCgCheckEvery;; more *= 2) {
     for (; launched < planned; ++launched) {
       const int next = 1 - cur;
       const CgGuard guard{sums + cur, sums + 3, tol2};
@@ -490,7 +491,7 @@ void Grid::apply_viscosity(float dt) {
     cg_sums_.copy_to_host(host, 5);
     const double rz = host[cur];
     if (!(rz > tol2 * host[3] && rz > 0.0) || launched >= max_it) break;
-    planned = std::min(max_it, launched + kCgCheckEvery);
+    planned = std::min(max_it, launched + more);
   }
   const int it = int(host[4]);
   cg_last_iterations_ = it;
