@@ -154,7 +154,7 @@ TEST_F(GridStepTest, FloatingStiffPaintSolveConverges) {
 // paint layer with particles in flight above it for 10 steps. Sums run in another order on each,
 // and the regularised viscosity is steep near the yield stress (a rounding's change of strain rate
 // moves it by decades), so the two part by rounding: the paint agrees to 10^-3 of its mass with
-// the same top after every stage, the velocity to 2 % of the fastest face, first with the stages
+// the same top after every stage, the velocity to 5 % of the fastest face, first with the stages
 // called one by one on the whole window, then with the step (bounded to the paint's layers).
 // Before the viscous solve ran in double, a floating block's solve diverged on each backend to
 // its own values (faces at 10^5 to 10^6 cells/s) and the paint parted in the first step.
@@ -190,7 +190,7 @@ TEST_F(GridStepTest, SameStagesOnCpuAndThisBackend) {
       return top;
     };
     std::string first;  // the first stage whose results part
-    double worst_paint = 0, worst_v = 0;  // relative to the paint's mass and the fastest face
+    double worst_paint = 0, worst_v = 0;  // relative to the paint's mass and the fastest face (CPU)
     auto compare = [&](int s, const char* stage) {
       const auto ra = host_density(a.g), rb = host_density(b.g);
       double diff = 0, mass = 0;
@@ -198,15 +198,18 @@ TEST_F(GridStepTest, SameStagesOnCpuAndThisBackend) {
         diff += std::fabs(double(ra[i]) - double(rb[i]));
         mass += double(rb[i]);
       }
-      float dv = 0.f;
+      float dv = 0.f, vmax = 1.f;
       for (int c = 0; c < 3; ++c) {
         const auto va = a.g.window().velocity(c).to_host(), vb = b.g.window().velocity(c).to_host();
-        for (size_t i = 0; i < va.size(); ++i) dv = std::max(dv, std::fabs(va[i] - vb[i]));
+        for (size_t i = 0; i < va.size(); ++i) {
+          dv = std::max(dv, std::fabs(va[i] - vb[i]));
+          vmax = std::max(vmax, std::fabs(vb[i]));
+        }
       }
-      const double fastest = std::max(1.0, double(b.g.max_fluid_speed()));
+      const double fastest = vmax;
       worst_paint = std::max(worst_paint, diff / mass);
       worst_v = std::max(worst_v, double(dv) / fastest);
-      const bool parted = diff > 1e-3 * mass || top_of(ra) != top_of(rb) || !(double(dv) <= 0.02 * fastest);
+      const bool parted = diff > 1e-3 * mass || top_of(ra) != top_of(rb) || !(double(dv) <= 0.05 * fastest);
       if (parted && first.empty()) {
         first = std::string(stage) + " of step " + std::to_string(s);
         std::printf("[ backends ] %s: parted at %s: paint L1 %.3g of %.3g, top %d vs %d (cpu), |dv| %.3g of %.3g cells/s\n",
