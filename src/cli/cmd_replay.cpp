@@ -364,12 +364,17 @@ struct SoakArgs {
   std::string json;
 };
 
-/// Resident memory of this process, bytes (Linux /proc/self/statm).
-double resident_bytes() {
+/// Resident memory of this process, bytes, and the part of it backed by files (the program's and
+/// its libraries' code and read-only data, paged in as code first runs; Linux /proc/self/statm).
+struct Resident {
+  double all = 0, file = 0;
+};
+Resident resident_bytes() {
   std::ifstream f("/proc/self/statm");
-  long long pages_total = 0, pages_resident = 0;
-  f >> pages_total >> pages_resident;
-  return double(pages_resident) * double(sysconf(_SC_PAGESIZE));
+  long long pages_total = 0, pages_resident = 0, pages_shared = 0;
+  f >> pages_total >> pages_resident >> pages_shared;
+  const double page = double(sysconf(_SC_PAGESIZE));
+  return {double(pages_resident) * page, double(pages_shared) * page};
 }
 
 int run_soak(const SoakArgs& s) {
@@ -381,7 +386,7 @@ int run_soak(const SoakArgs& s) {
     int cycle;
     size_t stroke;
     int64_t steps;
-    double step_ms, drift, rss, heap, held;
+    double step_ms, drift, rss, rss_file, heap, held;
     int64_t nonfinite;
   };
   std::vector<Run> runs;
@@ -392,7 +397,7 @@ int run_soak(const SoakArgs& s) {
     for (size_t i = 0; i < strokes.size(); ++i) {
       ReplayArgs a;
       a.device = s.device;
-      Run r{cycle, i, 0, 0, 0, 0, 0, 0, 0};
+      Run r{cycle, i, 0, 0, 0, 0, 0, 0, 0, 0};
       {
         const SimConfig cfg = replay_config(a, strokes[i], device);
         StrokePlayer player(strokes[i]);
@@ -424,15 +429,18 @@ int run_soak(const SoakArgs& s) {
       // keeps freed memory for reuse (its mmap threshold rises after large frees); returning it
       // first makes the resident figure what is live, so a leak shows as growth.
       malloc_trim(0);
-      r.rss = resident_bytes();
+      const Resident res = resident_bytes();
+      r.rss = res.all;
+      r.rss_file = res.file;
       const struct mallinfo2 mi = mallinfo2();
       r.heap = double(mi.uordblks + mi.hblkhd);  // live C-library allocations, the process's own data
       r.held = double(mem::usage(!device.is_cpu()).in_use);
       runs.push_back(r);
       if (tty) std::fprintf(stderr, "\r");
-      std::printf("cycle %d  %-28s %5lld steps  %8.2f ms/step  drift %.1e  resident %7.1f MiB  heap %8.1f KiB  held %6.1f MiB  %.0f s\n",
+      std::printf("cycle %d  %-28s %5lld steps  %8.2f ms/step  drift %.1e  resident %7.1f MiB (files %6.1f MiB)  "
+                  "heap %8.1f KiB  held %6.1f MiB  %.0f s\n",
                   cycle, s.strokes[i].c_str(), static_cast<long long>(r.steps), r.step_ms, r.drift, r.rss / 1048576.0,
-                  r.heap / 1024.0, r.held / 1048576.0, elapsed());
+                  r.rss_file / 1048576.0, r.heap / 1024.0, r.held / 1048576.0, elapsed());
       std::fflush(stdout);
     }
   }
@@ -468,6 +476,7 @@ int run_soak(const SoakArgs& s) {
     for (const Run& r : runs)
       j["runs"].push_back({{"cycle", r.cycle}, {"stroke", s.strokes[r.stroke]}, {"steps", r.steps},
                            {"step_ms_median", r.step_ms}, {"drift", r.drift}, {"resident_bytes", r.rss},
+                           {"resident_file_bytes", r.rss_file}, {"heap_bytes", r.heap},
                            {"backend_held_bytes", r.held}});
     write_file_atomic(s.json, j.dump(2) + "\n");
   }

@@ -156,6 +156,10 @@ TEST(Cli, SoakReportsMemoryStepTimeAndBooksPerRun) {
   ASSERT_EQ(j["runs"].size(), 1u);
   EXPECT_GT(j["runs"][0]["steps"].get<int>(), 0);
   EXPECT_GT(j["runs"][0]["resident_bytes"].get<double>(), 1e6);
+  // The program's own code is paged in from its file: part of the resident figure, not all of it.
+  EXPECT_GT(j["runs"][0]["resident_file_bytes"].get<double>(), 1e5);
+  EXPECT_LT(j["runs"][0]["resident_file_bytes"].get<double>(), j["runs"][0]["resident_bytes"].get<double>());
+  EXPECT_GT(j["runs"][0]["heap_bytes"].get<double>(), 0.0);
   EXPECT_EQ(j["backend_held_max_bytes"].get<double>(), 0.0) << "a replay's buffers outlived its simulator";
   EXPECT_LE(j["drift_max"].get<double>(), 1e-4);
   EXPECT_NE(run_cli("soak --device cpu --minutes -1 " + data("strokes/good/minimal.json")).exit_code, 0);

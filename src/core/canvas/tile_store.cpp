@@ -47,12 +47,14 @@ double TileStore::total_density() const {
   if (mass_pending_) {
     double sums[2];
     mass_sums_.copy_to_host(sums, 2);
-    const_cast<TileStore*>(this)->take_mass_sums(sums);
+    fold_mass_sums(sums);
   }
   return mass_;
 }
 
-void TileStore::take_mass_sums(const double sums[2]) {
+void TileStore::take_mass_sums(const double sums[2]) { fold_mass_sums(sums); }
+
+void TileStore::fold_mass_sums(const double sums[2]) const {
   mass_ += sums[0] - sums[1];
   mass_sums_.fill_zero();
   mass_pending_ = false;

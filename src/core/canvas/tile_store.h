@@ -125,6 +125,7 @@ class TileStore {
 
  private:
   int32_t ensure_slot(int tile_id);
+  void fold_mass_sums(const double sums[2]) const;  ///< the read sums into the total
   void grow_pool(int32_t slots);
   /// Brings the stored dryness of these slots up to the clock (scatter writes partial tiles).
   void settle_drying(const std::vector<int32_t>& slots);
