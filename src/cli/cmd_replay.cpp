@@ -8,6 +8,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -382,6 +384,13 @@ int run_soak(const SoakArgs& s) {
   const Device device = resolve_device(s.device);
   std::vector<Stroke> strokes;
   for (const std::string& path : s.strokes) strokes.push_back(load_stroke(path));
+  // glibc keeps freed small blocks in a cache per thread (up to 7 of each size): they count as
+  // live and fill over the first hour, a few KiB a cycle, which reads as growth. Measured with
+  // the caches off the heap is flat (docs/PERFORMANCE.md "Soak").
+  const char* tunables = std::getenv("GLIBC_TUNABLES");
+  if (!tunables || !std::strstr(tunables, "glibc.malloc.tcache_count=0"))
+    std::printf("soak: the C library's per-thread caches are on; they fill over the first hour and show as growth "
+                "(GLIBC_TUNABLES=glibc.malloc.tcache_count=0 measures the program's own memory)\n");
   struct Run {
     int cycle;
     size_t stroke;
