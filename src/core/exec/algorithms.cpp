@@ -47,11 +47,6 @@ void reduce_sum_add_into(const Device& d, const float* in, int64_t n, double* ou
   mem::count_launch();
   WB_DISPATCH(d, reduce_sum_add_into(in, n, out, ws));
 }
-void count_nonfinite_into(const Device& d, const float* in, int64_t n, int64_t* out, Workspace& ws) {
-  check_ws(d, ws);
-  mem::count_launch();
-  WB_DISPATCH(d, count_nonfinite_into(in, n, out, ws));
-}
 void FloatArrays::add(const float* p, int64_t size) {
   WB_REQUIRE(count < kMax, "FloatArrays: more than " + std::to_string(kMax) + " arrays");
   WB_REQUIRE(size >= 0 && (size == 0 || p), "FloatArrays: a null array or a negative length");

@@ -27,9 +27,6 @@ void reduce_max_into(const Device& device, const float* in, int64_t n, float* ou
 float reduce_min(const Device& device, const float* in, int64_t n, Workspace& ws);
 /// Number of NaN or infinite values.
 int64_t count_nonfinite(const Device& device, const float* in, int64_t n, Workspace& ws);
-/// The same count written to *out, a device pointer (not a host read): several arrays' counts
-/// gathered in one device buffer come back to the host in one copy.
-void count_nonfinite_into(const Device& device, const float* in, int64_t n, int64_t* out, Workspace& ws);
 /// Arrays of floats (device pointers and lengths), passed whole to one kernel.
 struct FloatArrays {
   static constexpr int kMax = 32;
@@ -43,7 +40,6 @@ struct FloatArrays {
 void count_nonfinite_each_into(const Device& device, const FloatArrays& arrays, int64_t* out, Workspace& ws);
 
 namespace cpu {
-void count_nonfinite_into(const float* in, int64_t n, int64_t* out, Workspace& ws);
 void count_nonfinite_each_into(const FloatArrays& arrays, int64_t* out, Workspace& ws);
 void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Workspace& ws);
 uint32_t exclusive_scan(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);
@@ -57,7 +53,6 @@ float reduce_min(const float* in, int64_t n, Workspace& ws);
 int64_t count_nonfinite(const float* in, int64_t n, Workspace& ws);
 }  // namespace cpu
 namespace cuda {
-void count_nonfinite_into(const float* in, int64_t n, int64_t* out, Workspace& ws);
 void count_nonfinite_each_into(const FloatArrays& arrays, int64_t* out, Workspace& ws);
 void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Workspace& ws);
 uint32_t exclusive_scan(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);

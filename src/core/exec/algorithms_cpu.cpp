@@ -68,8 +68,6 @@ void reduce_sum_into(const double* in, int64_t n, double* out, Workspace&) {
 
 void reduce_sum_add_into(const float* in, int64_t n, double* out, Workspace& ws) { *out += reduce_sum(in, n, ws); }
 
-void count_nonfinite_into(const float* in, int64_t n, int64_t* out, Workspace& ws) { *out = count_nonfinite(in, n, ws); }
-
 float reduce_max(const float* in, int64_t n, Workspace&) {
   float m = -std::numeric_limits<float>::infinity();
 #pragma omp parallel for reduction(max : m) schedule(static) if (n > 65536)

@@ -115,11 +115,6 @@ void reduce_sum_add_into(const float* in, int64_t n, double* out, Workspace& ws)
   WB_CUDA_CHECK(cudaGetLastError());
 }
 
-void count_nonfinite_into(const float* in, int64_t n, int64_t* out, Workspace& ws) {
-  static_assert(sizeof(int64_t) == sizeof(long long), "count type");
-  reduce_to(thrust::make_transform_iterator(in, NonFinite{}), n, ::cuda::std::plus<long long>{}, 0LL,
-            reinterpret_cast<long long*>(out), ws);
-}
 
 namespace {
 // Block y counts array y: a strided pass, a warp sum, one integer atomic a warp (exact in any order).
