@@ -156,7 +156,32 @@ def flat_streaks():
           s, window=(192, 192, 32))
 
 
+def linen_dry_brush():
+    # Dry brush on linen: a fully loaded stroke lies over the weave and fills it; then, with a
+    # lightly loaded brush at light pressure, two quick passes catch only the threads' crowns.
+    canvas = {"width": 640, "height": 384, "depth": 32, "paper_rgb": [0.93, 0.9, 0.82],
+              "ground": {"weave": "linen", "thread_mm": 1.0, "relief_mm": 0.3}}
+    s = stroke(0.0, line((120, 130), (520, 130)), 1.2, 0.6, tilt=(15, 0))
+    t = s[-1]["t"]
+    events = [{"type": "clean", "t": round(t + 0.05, 4)},
+              {"type": "dip", "t": round(t + 0.06, 4), "ryb": [0.9, 0.35, 0.1], "oil": 0.2, "load": 0.3}]
+    s += hover(t, (520, 130), (120, 230), 0.2)
+    t = round(s[-1]["t"] + DT, 4)
+    passes = [((120, 230), (520, 230)), ((520, 270), (120, 270))]
+    for k, (a, b) in enumerate(passes):
+        s += stroke(t, line(a, b), 0.7, 0.12, tilt=(30 if b[0] > a[0] else -30, 0), press_time=0.08, lift_time=0.08)
+        nxt = passes[k + 1][0] if k + 1 < len(passes) else b
+        s += hover(s[-1]["t"], b, nxt, 0.1)
+        t = round(s[-1]["t"] + DT, 4)
+    write("linen-dry-brush.json",
+          "Dry brush on linen (docs/STUDIO.md \"Canvas texture\"): a loaded blue stroke fills the weave; "
+          "a lightly loaded orange brush dragged lightly twice catches the crowns of the threads.",
+          {"shape": "round"}, {"ryb": [0.1, 0.15, 0.85], "oil": 0.3, "load": 1.0, "reload_on_pen_down": False},
+          s, events, canvas=canvas)
+
+
 if __name__ == "__main__":
+    linen_dry_brush()
     flat_streaks()
     cross_wet()
     scumble()

@@ -20,7 +20,7 @@ namespace wb::cli {
 namespace {
 struct RenderOpts {
   std::string painting, out, camera = "top", light, center, size, test_volume, save, device = "auto";
-  float zoom = 1.f, elevation = 40.f, weave = 0.f;
+  float zoom = 1.f, elevation = 40.f;
   int ao_rays = 64, repeat = 1, incremental = 0;
 };
 
@@ -56,7 +56,6 @@ void register_render(CLI::App& app) {
   sub->add_option("--elevation", o->elevation, "Oblique view: degrees above the horizon")->capture_default_str();
   sub->add_option("--light", o->light, "Direction towards the light x,y,z (z up)");
   sub->add_option("--ao-rays", o->ao_rays, "Ambient-occlusion rays per pixel (0 = off)")->capture_default_str();
-  sub->add_option("--weave", o->weave, "Canvas weave height in cells (0 = flat primed canvas)")->capture_default_str();
   sub->add_option("--test-volume", o->test_volume,
                   "Render a built-in volume instead of a file: flat, hemisphere, ridges, glaze, swatches, films, impasto-1024");
   sub->add_option("--save", o->save, "Also save the rendered volume as a painting (.ora)");
@@ -80,7 +79,6 @@ void register_render(CLI::App& app) {
     Renderer renderer(device);
     RenderParams& p = renderer.params();
     p.ao_rays = o->ao_rays;
-    p.weave_amplitude = o->weave;
     if (!o->light.empty()) p.light_dir = parse_vec3(o->light, "--light");
 
     Camera cam;

@@ -17,6 +17,7 @@
 #include <QPushButton>
 #include <QSettings>
 #include <QSpinBox>
+#include <QDoubleSpinBox>
 #include <QStandardPaths>
 #include <QStatusBar>
 #include <QThreadPool>
@@ -73,8 +74,7 @@ class StrokeCommand : public QUndoCommand {
     auto d = diff_;
     sim_->post([d, after](SimThread& s) {
       s.restart_recording(false);
-      after ? d->apply_after(s.sim().canvas()) : d->apply_before(s.sim().canvas());
-      s.canvas_written();
+      s.write_canvas([&](TileStore& canvas) { after ? d->apply_after(canvas) : d->apply_before(canvas); });
       int x0, y0, x1, y1;
       diff_rect(*d, s.sim().canvas().tiles_x(), x0, y0, x1, y1);
       s.invalidate_rect(x0, y0, x1, y1);
@@ -300,17 +300,53 @@ void MainWindow::build_menus() {
       const QColor c = QColorDialog::getColor(paper, &d, "Paper colour");
       if (c.isValid()) paper = c;
     });
+    // The ground: a woven canvas is laid as dried primer in the paper's colour (docs/STUDIO.md
+    // "Canvas texture"); its sizes start at the weave's defaults.
+    auto* weave = new QComboBox;
+    weave->addItem("Smooth board", int(Weave::Smooth));
+    weave->addItem("Linen", int(Weave::Linen));
+    weave->addItem("Cotton duck", int(Weave::CottonDuck));
+    auto* thread = new QDoubleSpinBox;
+    thread->setRange(kThreadMmMin, kThreadMmMax);
+    thread->setSingleStep(0.1);
+    thread->setSuffix(" mm");
+    thread->setToolTip("Distance between neighbouring threads (the grid's cell is 0.2 mm)");
+    auto* relief = new QDoubleSpinBox;
+    relief->setRange(kReliefMmMin, kReliefMmMax);
+    relief->setSingleStep(0.05);
+    relief->setSuffix(" mm");
+    relief->setToolTip("Height of a thread's crown over the hollows of the weave");
+    auto weave_changed = [=] {
+      const CanvasGround g = CanvasGround::of(Weave(weave->currentData().toInt()));
+      thread->setValue(g.thread_mm);
+      relief->setValue(g.relief_mm);
+      thread->setEnabled(g.weave != Weave::Smooth);
+      relief->setEnabled(g.weave != Weave::Smooth);
+    };
+    connect(weave, &QComboBox::currentIndexChanged, &d, weave_changed);
+    weave_changed();
     form->addRow("Unit", unit);
     form->addRow("Width", w);
     form->addRow("Height", h);
     form->addRow(paper_b);
+    form->addRow("Canvas", weave);
+    form->addRow("Thread spacing", thread);
+    form->addRow("Relief", relief);
     auto* bb = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel);
     form->addRow(bb);
     connect(bb, &QDialogButtonBox::accepted, &d, &QDialog::accept);
     connect(bb, &QDialogButtonBox::rejected, &d, &QDialog::reject);
     if (d.exec() != QDialog::Accepted || !maybe_save()) return;
     const int k = unit->currentIndex() == 1 ? 50 : 1;  // 1 cm = 50 cells
-    new_canvas(w->value() * k, h->value() * k, paper);
+    CanvasGround g = CanvasGround::of(Weave(weave->currentData().toInt()));
+    g.thread_mm = float(thread->value());
+    g.relief_mm = float(relief->value());
+    const QString why = ground_refusal(w->value() * k, h->value() * k, g);
+    if (!why.isEmpty()) {
+      QMessageBox::warning(this, "New canvas", why);
+      return;
+    }
+    new_canvas(w->value() * k, h->value() * k, paper, g);
   });
   file->addAction("&Open...", QKeySequence::Open, this, [this] {
     if (!maybe_save()) return;
@@ -463,14 +499,40 @@ std::optional<std::array<float, 3>> MainWindow::pick_color(QPointF canvas) {
   return c;
 }
 
-void MainWindow::new_canvas(int width, int height, QColor paper) {
+QString MainWindow::ground_refusal(int width, int height, const CanvasGround& g) const {
+  if (g.weave == Weave::Smooth) return {};
+  const float cell = GridParams{}.cell_size;
+  const int depth = options_.preset.canvas_depth;
+  const WeaveField f = weave_field(g, cell, Vec3{});
+  if (f.base + f.relief * 4.f / 3.f > 0.5f * float(depth))
+    return QString("The ground (%1 mm of primer and %2 mm of relief) is thicker than half the canvas's paint depth "
+                   "(%3 mm): choose less relief.")
+        .arg(g.priming_mm)
+        .arg(g.relief_mm)
+        .arg(depth * cell * 1e3);
+  // A woven ground is paint in every tile: the whole volume is held (and saved) from the start.
+  const uint64_t tiles = uint64_t((width + kTileSize - 1) / kTileSize) * uint64_t((height + kTileSize - 1) / kTileSize);
+  const uint64_t bytes = tiles * kTileSize * kTileSize * uint64_t(depth) * 14;
+  if (bytes > LoadLimits{}.max_paint_bytes)
+    return QString("A woven ground fills the whole canvas: %1 x %2 cells would hold %3 GiB of paint, more than a "
+                   "painting may (%4 GiB). Choose a smaller canvas or a smooth board.")
+        .arg(width)
+        .arg(height)
+        .arg(double(bytes) / double(1 << 30), 0, 'f', 1)
+        .arg(double(LoadLimits{}.max_paint_bytes) / double(1 << 30), 0, 'f', 0);
+  return {};
+}
+
+void MainWindow::new_canvas(int width, int height, QColor paper, const CanvasGround& ground) {
   const Vec3 rgb(float(paper.redF()), float(paper.greenF()), float(paper.blueF()));
-  sim_->post([width, height, rgb](SimThread& s) {
+  sim_->post([width, height, rgb, ground](SimThread& s) {
     SimConfig c = s.config();
     c.canvas.width = width;
     c.canvas.height = height;
     s.renderer().params().paper_rgb = rgb;
+    s.set_ground(std::nullopt);
     s.rebuild(c, false);
+    if (ground.weave != Weave::Smooth) s.prime(ground);
     s.restart_recording(true);
   });
   clock_ = PenClock(width, height);
@@ -507,6 +569,7 @@ bool MainWindow::write_snapshot(const QString& path, bool wait, bool user_save) 
       nlohmann::json meta = {{"generator", "wetbrush-studio"},
                              {"brush", brush_to_json(s.config().brush)},
                              {"paper_rgb", {paper.x, paper.y, paper.z}},
+                             {"ground", s.ground() ? ground_to_json(*s.ground()) : nlohmann::json(nullptr)},
                              {"recording_from_blank", from_blank}};
       QThreadPool::globalInstance()->start([done, file, copy, image, meta] {
         try {
@@ -592,11 +655,13 @@ bool MainWindow::open_from(const QString& path) {
         s.renderer().params().paper_rgb =
             Vec3(p.metadata["paper_rgb"][0].get<float>(), p.metadata["paper_rgb"][1].get<float>(),
                  p.metadata["paper_rgb"][2].get<float>());
+      // The ground is in the volume already; the painting records what it is (for recordings).
+      const bool grounded = p.metadata.contains("ground") && p.metadata["ground"].is_object();
+      s.set_ground(grounded ? std::optional(ground_from_json(p.metadata["ground"], file + ": ground")) : std::nullopt);
       SimConfig c = s.config();
       c.canvas = p.canvas.dims();
       s.rebuild(c, false);
-      s.sim().canvas().copy_from(p.canvas);  // loaded onto the simulator's device: copied there
-      s.canvas_written();
+      s.write_canvas([&](TileStore& canvas) { canvas.copy_from(p.canvas); });  // on the simulator's device
       s.restart_recording(false);
       s.invalidate_all();
       *dims = c.canvas;

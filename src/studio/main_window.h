@@ -56,7 +56,11 @@ class MainWindow : public QMainWindow {
   bool export_png(const QString& path);
   bool export_maps(const QString& height_path, const QString& normal_path);
   bool save_recording(const QString& path);
-  void new_canvas(int width, int height, QColor paper);
+  /// A new canvas, primed with `ground` (a smooth ground lays nothing).
+  void new_canvas(int width, int height, QColor paper, const CanvasGround& ground = {});
+  /// Why a canvas of this size cannot take this ground (too thick for the paint depth, or more
+  /// paint than a painting may hold); empty when it can.
+  QString ground_refusal(int width, int height, const CanvasGround& ground) const;
   void dip(const PaintLoad& p);
   void wipe(float fraction);
   void clean_brush();

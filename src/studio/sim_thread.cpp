@@ -157,19 +157,28 @@ void SimThread::rebuild(const SimConfig& config, bool keep_canvas) {
   BrushPose rest;
   rest.position = Vec3(config.canvas.width * 0.5f, config.canvas.height * 0.5f, config.brush.length * 1.5f);
   sim_ = std::make_unique<Simulator>(config_, rest);
+  // Nothing painted in this recording: a new one from the blank (primed) canvas is the same.
+  bool painted = false;
+  {
+    std::lock_guard lk(rec_mu_);
+    for (const PenSample& s : rec_.samples) painted |= s.down;
+  }
   if (keep_canvas && same_dims) {
     // The paint that was in flight comes too; the old simulator goes, so it settles for good,
     // and its canvas is copied on the device.
     old->settle();
-    if (old->device() == config.device) {
-      sim_->canvas().copy_from(old->canvas());
-    } else {
-      for (int id : old->canvas().allocated_tile_ids()) sim_->canvas().write_tile(old->canvas().read_tile(id));
-    }
+    write_canvas([&](TileStore& canvas) {
+      if (old->device() == config.device) {
+        canvas.copy_from(old->canvas());
+      } else {
+        for (int id : old->canvas().allocated_tile_ids()) canvas.write_tile(old->canvas().read_tile(id));
+      }
+    });
+  } else {
+    write_canvas([](TileStore&) {});
   }
   old.reset();
-  canvas_written();
-  restart_recording(recording_from_blank_.load() && sim_->canvas().allocated_tiles() == 0);
+  restart_recording(recording_from_blank_.load() && !(keep_canvas && same_dims && painted));
   if (!frames_.ready() || !same_dims) frames_.reset(config.canvas);
   {
     std::lock_guard lk(status_mu_);
@@ -188,6 +197,7 @@ void SimThread::restart_recording(bool from_blank) {
   rec_.canvas = config_.canvas;
   rec_.brush = config_.brush;
   rec_.paint = paint_;
+  rec_.ground = ground_;
   rec_.paint.reload_on_pen_down = false;  // the studio's brush stays dirty between strokes
   rec_.paper_rgb = std::array<float, 3>{renderer_.params().paper_rgb.x, renderer_.params().paper_rgb.y,
                                         renderer_.params().paper_rgb.z};
@@ -206,9 +216,17 @@ void SimThread::restart_recording(bool from_blank) {
   recording_from_blank_ = from_blank;
 }
 
-void SimThread::canvas_written() {
+void SimThread::prime(const CanvasGround& g) {
+  sim_->lay_ground(g, rgb_to_ryb(renderer_.params().paper_rgb));
+  ground_ = g;
+  undo_rec_.reset();
+  stroke_open_ = false;
+  invalidate_all();
+}
+
+void SimThread::write_canvas(const std::function<void(TileStore&)>& write) {
   if (!sim_) return;
-  sim_->canvas_replaced();
+  sim_->replace_canvas(write);
   undo_rec_.reset();
   stroke_open_ = false;
 }

@@ -103,10 +103,11 @@ class SimThread : public QObject {
   void rebuild(const SimConfig& config, bool keep_canvas);
   /// Starts a new recording (after undo, open, brush change): the next press begins it.
   void restart_recording(bool from_blank);
-  /// After tiles were written from outside (undo, redo, open): the simulation then holds that
-  /// canvas alone. The window is read back from the tiles, paint in flight is dropped (it
-  /// belonged to the canvas that was replaced) and the next undo record starts afresh.
-  void canvas_written();
+  /// Writes the canvas from outside (undo, redo, open, a primed ground) through
+  /// Simulator::replace_canvas: the simulation then holds that canvas alone, paint in flight is
+  /// dropped (it belonged to the canvas that was replaced, and the books say so) and the next
+  /// undo record starts afresh.
+  void write_canvas(const std::function<void(TileStore&)>& write);
   /// Re-renders the whole canvas (light, paper, new canvas).
   void invalidate_all();
   void invalidate_rect(int x0, int y0, int x1, int y1);
@@ -121,6 +122,12 @@ class SimThread : public QObject {
   /// Paint the brush holds (the palette's current well) for recordings that start now.
   void set_paint(const PaintLoad& p) { paint_ = p; }
   const PaintLoad& paint() const { return paint_; }
+  /// Primes the blank canvas with `g` in the paper's colour (Simulator::lay_ground); the ground
+  /// is the canvas's from then on: saved with the painting and with every recording.
+  void prime(const CanvasGround& g);
+  /// The canvas's ground as an opened painting records it (nothing is laid).
+  void set_ground(const std::optional<CanvasGround>& g) { ground_ = g; }
+  const std::optional<CanvasGround>& ground() const { return ground_; }
   /// The brush's pose and paint as of the last rendered frame (the preview and the swatch).
   BrushPicture brush_picture() const;
 
@@ -145,6 +152,7 @@ class SimThread : public QObject {
   std::unique_ptr<Simulator> sim_;
   Renderer renderer_;
   PaintLoad paint_{};
+  std::optional<CanvasGround> ground_;  ///< the canvas's priming (unset: bare)
 
   // Inputs (UI -> worker).
   mutable std::mutex in_mu_;

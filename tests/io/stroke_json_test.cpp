@@ -189,6 +189,29 @@ TEST(StrokeJson, EventAfterLastSampleRejected) {
   EXPECT_THROW(parse_stroke_json(text, "m.json"), Error);
 }
 
+TEST(StrokeJson, CanvasGroundIsReadCheckedAndKept) {
+  auto with_ground = [](const std::string& g) {
+    return R"({"format": "wetbrush-stroke", "version": 1, "canvas": {"width": 512, "height": 512, "ground": )" + g +
+           R"(}, "samples": [{"t": 0, "x": 10, "y": 10, "pressure": 0.5}]})";
+  };
+  const Stroke st = parse_stroke_json(with_ground(R"({"weave": "cotton_duck", "relief_mm": 0.25})"), "g.json");
+  ASSERT_TRUE(st.ground.has_value());
+  EXPECT_EQ(st.ground->weave, Weave::CottonDuck);
+  EXPECT_FLOAT_EQ(st.ground->thread_mm, 0.8f) << "the weave's default";
+  EXPECT_FLOAT_EQ(st.ground->relief_mm, 0.25f);
+  EXPECT_EQ(parse_stroke_json(stroke_to_json_string(st), "again.json").ground, st.ground);
+  EXPECT_FALSE(parse_stroke_json(with_ground("{}"), "g.json").ground->weave != Weave::Smooth);
+  for (const char* bad : {R"({"weave": "burlap"})", R"({"weave": 3})", R"({"thread_mm": 0.1})", R"({"relief_mm": -1})",
+                          R"({"relief_mm": 1e400})", R"({"relief_mm": "0.3"})", R"({"thread": 1})", "[1, 2]"}) {
+    try {
+      parse_stroke_json(with_ground(bad), "g.json");
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("g.json"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(StrokeJson, SimulationWindowIsReadCheckedAndKept) {
   auto with_window = [](const std::string& w) {
     return R"({"format": "wetbrush-stroke", "version": 1, "canvas": {"width": 512, "height": 512}, "simulation": {"window": )" + w +

@@ -415,6 +415,63 @@ TEST_F(LayerPropertiesTest, LightBrushPaintsOnADriedStrokeWhateverItsHeight) {
   }
 }
 
+TEST_F(LayerPropertiesTest, DryBrushCatchesTheWeaveOfALinenCanvas) {
+  // The scumble test's light brush (white, load 0.3, pressure 0.1) dragged over a smooth board and
+  // over linen (threads 1 mm apart, 0.3 mm relief, on 0.2 mm of primer) primed in a dark colour:
+  // on linen the bristles rest on the threads' crowns and bridge the hollows, so the paint covers
+  // less of the track than on the board, and lies on the crowns (docs/STUDIO.md "Canvas texture").
+  constexpr int kW = 160, kH = 64;
+  constexpr float kX0 = 24.f, kX1 = 136.f;
+  double cover[2] = {}, crowns = 0, hollows = 0;
+  for (const Weave weave : {Weave::Smooth, Weave::Linen}) {
+    SimConfig c = layer_config(CanvasDims{kW, kH, kDepth});
+    Simulator sim(c, pose_at(c.brush, kX0, kY, 0.f, false));
+    const CanvasGround g = CanvasGround::of(weave);
+    const Vec3 primer(0.2f, 0.2f, 0.6f);
+    sim.lay_ground(g, primer);
+    const WeaveField w = weave_field(g, c.params.grid.cell_size, primer);
+    Books books;
+    books.open(sim);
+    if (weave == Weave::Linen) {
+      EXPECT_NEAR(sim.books().external_total(), sim.census().total(), 1e-6 * sim.census().total())
+          << "the books record the primer as paint from outside";
+      EXPECT_GT(sim.canvas().total_density(), double(kW) * kH * w.base) << "the primer is laid under the hollows";
+      EXPECT_EQ(sim.books().steps().size(), 0u);
+    }
+    PaintLoad white;
+    white.ryb[0] = white.ryb[1] = white.ryb[2] = 0.f;
+    white.load = 0.3f;
+    sim.load_paint(white);
+    drag(sim, kX0, kX1, 300.f, 0.1f);
+    EXPECT_EQ(sim.counters().nonfinite_events, 0);
+    EXPECT_LT(books.max_drift(sim), 1e-4);
+    const auto f = canvas_fields(sim);
+    int covered = 0, columns = 0, n_crowns = 0, n_hollows = 0;
+    for (int y = int(kY) - 4; y <= int(kY) + 4; ++y)
+      for (int x = int(kX0) + 24; x < int(kX1) - 16; ++x) {
+        double fresh = 0;
+        for (int z = 0; z < kDepth; ++z) {
+          const size_t id = (size_t(z) * kH + y) * kW + x;
+          if (f[5][id] < c.params.grid.dry_threshold) fresh += f[0][id];
+        }
+        covered += fresh > 0.05, ++columns;
+        if (weave != Weave::Linen) continue;
+        // Crowns: the top third of the relief; hollows: the bottom third.
+        const float h = (weave_height(w, float(x) + 0.5f, float(y) + 0.5f) - w.base) / w.relief;
+        if (h > 0.67f) crowns += fresh, ++n_crowns;
+        if (h < 0.33f) hollows += fresh, ++n_hollows;
+      }
+    cover[weave == Weave::Linen] = double(covered) / columns;
+    if (weave == Weave::Linen) crowns /= std::max(n_crowns, 1), hollows /= std::max(n_hollows, 1);
+  }
+  std::printf("dry brush: covers %.2f of the track on a smooth board, %.2f on linen; on linen %.3f cells of paint "
+              "per column on the crowns, %.3f in the hollows\n",
+              cover[0], cover[1], crowns, hollows);
+  EXPECT_GT(cover[0], 0.5) << "the light brush paints the smooth board";
+  EXPECT_LT(cover[1], 0.9 * cover[0]) << "linen's hollows stay bare under a dry brush";
+  EXPECT_GT(crowns, 1.5 * hollows) << "the paint lies on the threads' crowns";
+}
+
 }  // namespace
 // --- support ------------------------------------------------------------------------------------
 

@@ -109,11 +109,11 @@ TEST_F(SimulatorTest, SettledCanvasLeavesTheSimulationAsItWasAndReplacedCanvasIs
   EXPECT_NEAR(a.census().bristles, b.census().bristles, 1e-3 * b.census().total());
   // Undo writes a tile back under the window: the paint in flight goes, and the books say so.
   const PaintCensus before = a.census();
-  a.flush_window();
-  TileData t = a.canvas().read_tile((128 / kTileSize) * a.canvas().tiles_x() + 130 / kTileSize);
-  std::fill(t.density.begin(), t.density.end(), 0.f);  // as an undo to the blank canvas writes it
-  a.canvas().write_tile(t);
-  a.canvas_replaced();
+  a.replace_canvas([&](TileStore& canvas) {
+    TileData t = canvas.read_tile((128 / kTileSize) * canvas.tiles_x() + 130 / kTileSize);
+    std::fill(t.density.begin(), t.density.end(), 0.f);  // as an undo to the blank canvas writes it
+    canvas.write_tile(t);
+  });
   EXPECT_EQ(a.particle_count(), 0);
   stroke(a, 12, 14);
   EXPECT_LT(std::abs(a.books().max_drift()), 1e-4) << "dropped " << before.particles << " kg in flight";

@@ -58,7 +58,9 @@ auto on_sim(MainWindow& w, F fn) {
 }
 
 /// Column paint (sum of density over z) per canvas cell.
-std::vector<float> column_density(TileStore& c) {
+/// Paint per column (cell volumes); with `wet_only`, the paint that is not dried (a stroke's,
+/// not the canvas's ground).
+std::vector<float> column_density(TileStore& c, bool wet_only = false) {
   const CanvasDims d = c.dims();
   std::vector<float> col(size_t(d.width) * d.height, 0.f);
   for (int id : c.allocated_tile_ids()) {
@@ -67,18 +69,19 @@ std::vector<float> column_density(TileStore& c) {
       for (int ly = 0; ly < kTileSize; ++ly)
         for (int lx = 0; lx < kTileSize; ++lx) {
           const int x = t.tile_x * kTileSize + lx, y = t.tile_y * kTileSize + ly;
-          if (x < d.width && y < d.height)
-            col[size_t(y) * d.width + x] += t.density[(size_t(z) * kTileSize + ly) * kTileSize + lx];
+          const size_t i = (size_t(z) * kTileSize + ly) * kTileSize + lx;
+          if (x < d.width && y < d.height && !(wet_only && t.dryness[i] == 65535))
+            col[size_t(y) * d.width + x] += t.density[i];
         }
   }
   return col;
 }
 
 /// Column paint of the studio's canvas with its paint at rest.
-std::vector<float> column_density(MainWindow& w) {
-  return on_sim(w, [](SimThread& s) {
+std::vector<float> column_density(MainWindow& w, bool wet_only = false) {
+  return on_sim(w, [wet_only](SimThread& s) {
     TileStore c = s.sim().settled_canvas_copy(Device{});
-    return column_density(c);
+    return column_density(c, wet_only);
   });
 }
 
@@ -395,6 +398,63 @@ class StudioTest : public QObject {
     qInfo("widest painted column: light press (0.15) %d cells, heavy press (0.95) %d cells", light, heavy);
     QVERIFY2(light > 0, "a light press paints");
     QVERIFY2(heavy >= light + 3, "a harder press paints a wider stroke");
+  }
+
+  void canvasTextureCatchesADryBrush() {
+    // The same lightly loaded brush dragged lightly across a smooth board and across linen: on
+    // linen it rests on the threads' crowns and bridges the hollows (docs/STUDIO.md "Canvas texture").
+    // The track runs across the weave at a slant: this brush is narrower than the weave's repeat,
+    // and one drawn along a groove between two threads sinks into it.
+    PaintLoad dry = w_->paint_panel()->current_paint();
+    dry.load = 0.3f;
+    const QColor paper(235, 228, 210);
+    const CanvasGround linen = CanvasGround::of(Weave::Linen);
+    const QPointF a(30.f, 45.f), b(130.f, 75.f);
+    const float nx = -(b.y() - a.y()), ny = b.x() - a.x(), nl = std::hypot(nx, ny);
+    double cover[2] = {}, crowns = 0, hollows = 0;
+    for (const bool woven : {false, true}) {
+      w_->new_canvas(kW, kH, paper, woven ? linen : CanvasGround{});
+      w_->settle();
+      w_->clean_brush();
+      w_->dip(dry);
+      tablet_stroke(w_->view(), line_points(a, b, 48, 0.1f), 20);
+      w_->settle();
+      const std::vector<float> fresh = column_density(*w_, true);
+      const WeaveField wf = weave_field(linen, GridParams{}.cell_size, Vec3{});
+      int covered = 0, columns = 0, n_crowns = 0, n_hollows = 0;
+      for (int y = 0; y < kH; ++y)
+        for (int x = 40; x < 120; ++x) {
+          const float d = std::abs(((x + 0.5f) - float(a.x())) * nx + ((y + 0.5f) - float(a.y())) * ny) / nl;
+          if (d > 4.f) continue;  // the band under the brush
+          const float v = fresh[size_t(y) * kW + x];
+          covered += v > 0.05f, ++columns;
+          if (!woven) continue;
+          const float h = (weave_height(wf, x + 0.5f, y + 0.5f) - wf.base) / wf.relief;
+          // Crowns: the top third of the relief; hollows: the bottom third.
+          if (h > 0.67f) crowns += v, ++n_crowns;
+          if (h < 0.33f) hollows += v, ++n_hollows;
+        }
+      cover[woven] = double(covered) / columns;
+      if (woven) crowns /= std::max(n_crowns, 1), hollows /= std::max(n_hollows, 1);
+    }
+    qInfo("dry brush: covers %.2f of the track on a smooth board, %.2f on linen; on linen %.3f cells per column on "
+          "the crowns, %.3f in the hollows", cover[0], cover[1], crowns, hollows);
+    QVERIFY2(cover[0] > 0.3, "the light brush paints the smooth board");
+    QVERIFY2(cover[1] < 0.9 * cover[0], "linen's hollows stay bare under a dry brush");
+    QVERIFY2(crowns > 1.5 * hollows, "the paint lies on the threads' crowns");
+    // The ground is the painting's: saved, reopened, and in the recording of the session.
+    const QString path = dir_->path() + "/linen.ora";
+    QVERIFY(w_->save_to(path, true));
+    w_->new_canvas(kW, kH, paper);
+    QVERIFY(w_->open_from(path));
+    w_->settle();
+    const auto ground = on_sim(*w_, [](SimThread& s) { return s.ground(); });
+    QVERIFY2(ground && *ground == linen, "the painting reopens on its linen");
+    const auto rec = on_sim(*w_, [](SimThread& s) { return s.recording(); });
+    QVERIFY2(rec.ground && *rec.ground == linen, "a recording from the reopened painting keeps the ground");
+    const std::vector<float> all = column_density(*w_);
+    const float crown = weave_height(weave_field(linen, GridParams{}.cell_size, Vec3{}), 2.5f, 2.5f);
+    QVERIFY2(std::abs(all[2 * kW + 2] - crown) < 0.5f, "the weave is in the reopened volume");
   }
 
   void eyedropperPicksThePaintedPigment() {

@@ -1,6 +1,7 @@
 // Gather and scatter between the sparse tiles and the dense active window (DESIGN
 // step 3). Compiled once per backend; one launch per operation.
 #pragma once
+#include "core/canvas/ground.h"
 #include "core/canvas/tile_store.h"
 #include "core/exec/atomics.h"
 #include "core/exec/parallel_for.h"
@@ -91,6 +92,27 @@ void scatter_window(TileStoreView t, PaintWindowView w, float* before, float* af
 void dry_all(TileStoreView t, int64_t cells) {
   parallel_for(cells, [=] WB_HD(int64_t i) {
     if (t.density[i] > 0.f) t.dryness[i] = 65535;
+  });
+}
+
+/// Lays the woven ground into every cell of the canvas (all tiles allocated, slot = tile id):
+/// dried primer up to weave_height, nothing above it.
+void lay_weave(TileStoreView t, WeaveField w, int64_t cells) {
+  parallel_for(cells, [=] WB_HD(int64_t i) {
+    const int64_t tc = t.tile_cells();
+    const int32_t slot = int32_t(i / tc);
+    const int64_t in = i - int64_t(slot) * tc;
+    const int lx = int(in % kTileSize), ly = int((in / kTileSize) % kTileSize), z = int(in / (kTileSize * kTileSize));
+    const int x = (slot % t.tiles_x) * kTileSize + lx, y = (slot / t.tiles_x) * kTileSize + ly;
+    const bool on = x < t.width && y < t.height;
+    const float d = on ? ground_density(weave_height(w, float(x) + 0.5f, float(y) + 0.5f), z) : 0.f;
+    t.density[i] = d;
+    const bool paint = d > 0.f;
+    t.pigment_r[i] = paint ? encode_unorm16(w.ryb.x) : 0;
+    t.pigment_y[i] = paint ? encode_unorm16(w.ryb.y) : 0;
+    t.pigment_b[i] = paint ? encode_unorm16(w.ryb.z) : 0;
+    t.oil[i] = paint ? encode_unorm16(w.oil) : 0;
+    t.dryness[i] = paint ? 65535 : 0;
   });
 }
 

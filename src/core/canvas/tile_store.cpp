@@ -17,6 +17,9 @@ void scatter_dispatch(const Device& d, TileStoreView t, PaintWindowView w, float
   WB_DISPATCH(d, scatter_window(t, w, before, after));
 }
 void dry_dispatch(const Device& d, TileStoreView t, int64_t cells) { WB_DISPATCH(d, dry_all(t, cells)); }
+void weave_dispatch(const Device& d, TileStoreView t, WeaveField w, int64_t cells) {
+  WB_DISPATCH(d, lay_weave(t, w, cells));
+}
 void settle_dispatch(const Device& d, TileStoreView t, const int32_t* slots, int64_t n) {
   WB_DISPATCH(d, settle_tile_drying(t, slots, n));
 }
@@ -166,6 +169,21 @@ void TileStore::settle_drying(const std::vector<int32_t>& slots) {
 void TileStore::dry_all() {
   if (slots_used_ == 0) return;
   dry_dispatch(device_, view(), int64_t(slots_used_) * tile_cells());
+}
+
+void TileStore::lay_weave(const WeaveField& w) {
+  WB_REQUIRE(slots_used_ == 0, "TileStore::lay_weave: the canvas is not empty");
+  // Slot = tile id, allocated at once (one index upload, not one per tile).
+  const int32_t n = tiles_x_ * tiles_y_;
+  grow_pool(n);
+  tile_of_slot_.resize(size_t(n));
+  for (int32_t s = 0; s < n; ++s) host_slot_[size_t(s)] = tile_of_slot_[size_t(s)] = s;
+  slots_used_ = n;
+  host_dried_to_.assign(size_t(n), float(clock_));
+  slot_of_tile_.copy_from_host(host_slot_);
+  dried_to_.copy_range_from_host(host_dried_to_.data(), 0, size_t(n));
+  weave_dispatch(device_, view(), w, int64_t(n) * tile_cells());
+  mass_ = recount_density(ws_);
 }
 
 void TileStore::clear() {

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/canvas/ground.h"
 #include "core/canvas/paint_fields.h"
 #include "core/canvas/window.h"
 #include "core/exec/buffer.h"
@@ -88,6 +89,9 @@ class TileStore {
   void scatter(PaintWindow& window);
   /// "Let it dry": every cell holding paint becomes fully dry (solid).
   void dry_all();
+  /// Primes an empty canvas with a woven ground (ground.h): every tile is allocated and filled
+  /// on the device with dried primer up to the weave's height.
+  void lay_weave(const WeaveField& w);
   /// Every painted cell of the canvas gains `amount` of dryness (capped at 1), at the cost of
   /// one addition: the tiles catch up when read. The window's own cells are dried by the grid.
   void advance_drying(double amount);
@@ -162,6 +166,7 @@ void settle_tile_drying(TileStoreView t, const int32_t* slots, int64_t count);
 void mark_painted_tiles(TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* flags);
 void scatter_window(TileStoreView t, PaintWindowView w, float* before, float* after);
 void dry_all(TileStoreView t, int64_t cells);
+void lay_weave(TileStoreView t, WeaveField w, int64_t cells);
 }  // namespace cpu
 namespace cuda {
 void gather_window(TileStoreView t, PaintWindowView w);
@@ -169,6 +174,7 @@ void settle_tile_drying(TileStoreView t, const int32_t* slots, int64_t count);
 void mark_painted_tiles(TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* flags);
 void scatter_window(TileStoreView t, PaintWindowView w, float* before, float* after);
 void dry_all(TileStoreView t, int64_t cells);
+void lay_weave(TileStoreView t, WeaveField w, int64_t cells);
 }  // namespace cuda
 
 }  // namespace wb

@@ -40,6 +40,7 @@ struct StrokeEvent {
 struct Stroke {
   CanvasDims canvas{};
   std::optional<std::array<float, 3>> paper_rgb;  ///< paper colour, linear RGB in [0, 1]
+  std::optional<CanvasGround> ground;             ///< the canvas's priming (ground.h); unset: bare
   BrushSpec brush{};
   PaintLoad paint{};
   std::vector<PenSample> samples;

@@ -341,6 +341,7 @@ Stroke parse_stroke_json(std::string_view text, const std::string& source) {
       c.fail("canvas " + std::to_string(st.canvas.width) + " x " + std::to_string(st.canvas.height) + " has more than " +
              std::to_string(kMaxCanvasCells) + " cells (16384 x 16384): refused");
     if (c.has("paper_rgb")) st.paper_rgb = c.triple("paper_rgb", 0.0, 1.0);
+    if (c.has("ground")) st.ground = ground_from_json(root.at("canvas").at("ground"), source + ": canvas.ground");
     c.warn_unknown(st.warnings);
   }
   if (top.has("brush")) st.brush = brush_from_json(root.at("brush"), source + ": brush", &st.warnings);
@@ -384,6 +385,7 @@ std::string stroke_to_json_string(const Stroke& st) {
   if (st.paper_rgb)
     canvas["paper_rgb"] = {float_for_json((*st.paper_rgb)[0]), float_for_json((*st.paper_rgb)[1]),
                            float_for_json((*st.paper_rgb)[2])};
+  if (st.ground) canvas["ground"] = ground_to_json(*st.ground);
   const json paint = {{"ryb", {float_for_json(st.paint.ryb[0]), float_for_json(st.paint.ryb[1]), float_for_json(st.paint.ryb[2])}},
                       {"oil", float_for_json(st.paint.oil)},
                       {"load", float_for_json(st.paint.load)},

@@ -139,7 +139,6 @@ std::vector<ParamInfo> build_table() {
       WB_PARAM(render.diffuse, "Diffuse", "", "", 0, 2, "Directional light"),
       WB_PARAM(render.specular, "Wet specular", "", "", 0, 2, "Specular of wet paint; fades as it dries"),
       WB_PARAM(render.shininess, "Shininess", "", "", 1, 1000, "Blinn-Phong exponent"),
-      WB_PARAM(render.weave_amplitude, "Canvas weave", "cells", "", 0, 4, "Height of the canvas weave"),
   };
 }
 #undef WB_PARAM

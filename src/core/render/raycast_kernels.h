@@ -372,20 +372,6 @@ WB_HD WB_INLINE Vec3 density_normal(const RenderVolume& v, const RenderParams& P
   return normalize_or(-g, Vec3(0.f, 0.f, 1.f));
 }
 
-/// Height of the canvas weave at (x, y): two crossing thread families (over-under pattern).
-WB_HD WB_INLINE float weave_height(const RenderParams& p, float x, float y) {
-  if (p.weave_amplitude <= 0.f) return 0.f;
-  const float k = 6.2831853f / p.weave_period;
-  return p.weave_amplitude * 0.25f * (2.f + cosf(k * x) * sinf(0.5f * k * y) + sinf(0.5f * k * x) * cosf(k * y));
-}
-WB_HD WB_INLINE Vec3 weave_normal(const RenderParams& p, float x, float y) {
-  if (p.weave_amplitude <= 0.f) return Vec3(0.f, 0.f, 1.f);
-  const float e = 0.25f;
-  const float hx = (weave_height(p, x + e, y) - weave_height(p, x - e, y)) / (2 * e);
-  const float hy = (weave_height(p, x, y + e) - weave_height(p, x, y - e)) / (2 * e);
-  return normalize(Vec3(-hx, -hy, 1.f));
-}
-
 /// What one ray found: the surface point, its normal, the blended pigment and the paint state.
 struct RayHit {
   int kind;     ///< 0 = missed the canvas (background), 1 = bare canvas, 2 = paint surface
@@ -513,7 +499,7 @@ WB_HD WB_INLINE RayHit cast_ray(const RenderVolume& v, const RenderParams& P, Ve
   if (g.x < 0.f || g.y < 0.f || g.x >= float(v.tiles.width) || g.y >= float(v.tiles.height)) return h;
   h.kind = 1;  // bare canvas: no paint in these columns
   h.pos = Vec3(g.x, g.y, 0.f);
-  h.normal = weave_normal(P, g.x, g.y);
+  h.normal = Vec3(0.f, 0.f, 1.f);
   h.albedo = P.paper_rgb;
   return h;
 }

@@ -32,8 +32,6 @@ struct RenderParams {
   // The primed canvas where there is no paint.
   Vec3 paper_rgb = Vec3(0.93f, 0.91f, 0.86f);
   Vec3 paper_ryb = Vec3(0.f, 0.f, 0.f);  ///< paper as pigment for glazes; set by the renderer from paper_rgb
-  float weave_amplitude = 0.f;  ///< canvas weave height, cells (0 = flat primed canvas)
-  float weave_period = 6.f;     ///< weave thread period, cells
   Vec3 background_rgb = Vec3(0.16f, 0.16f, 0.17f);  ///< outside the canvas
 };
 

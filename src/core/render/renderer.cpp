@@ -43,7 +43,6 @@ void check_params(const RenderParams& p) {
   WB_REQUIRE(p.ao_rays >= 0 && p.ao_rays <= 1024, "render: AO rays must be in [0, 1024]");
   WB_REQUIRE(p.ao_step > 0.f && p.ao_length >= 0.f, "render: AO step must be positive, length non-negative");
   WB_REQUIRE(length(p.light_dir) > 0.f && isfinite3(p.light_dir), "render: light direction must be non-zero");
-  WB_REQUIRE(p.weave_period > 0.f, "render: weave period must be positive");
   WB_REQUIRE(p.film_hiding > 0.f, "render: film hiding thickness must be positive");
   WB_REQUIRE(p.film_fade > 0.f, "render: film fade must be positive");
 }

@@ -1,3 +1,4 @@
+#include "core/color/ryb.h"
 #include "core/sim/replay.h"
 
 #include <algorithm>
@@ -35,6 +36,12 @@ Replay::Replay(Simulator& sim, StrokePlayer& player)
   contacts_.resize(steps);
   stretch_.set_device(sim.device());
   stretch_.resize(steps);
+  // The stroke's canvas is primed as its file says (the paper colour is the primer's).
+  if (const Stroke& st = player_.stroke(); st.ground) {
+    const Vec3 paper = st.paper_rgb ? Vec3((*st.paper_rgb)[0], (*st.paper_rgb)[1], (*st.paper_rgb)[2])
+                                    : sim_.config().params.render.paper_rgb;
+    sim_.lay_ground(*st.ground, rgb_to_ryb(paper));
+  }
   sim_.reset_brush(player_.pose_at(player_.t_begin()));
   // A brush that is not refilled at every pen-down carries one load for the whole stroke.
   if (!player_.stroke().paint.reload_on_pen_down) sim_.load_paint(player_.stroke().paint);

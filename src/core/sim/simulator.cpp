@@ -261,8 +261,20 @@ TileStore Simulator::settled_canvas_copy(const Device& device) {
   return copy;
 }
 
-void Simulator::canvas_replaced() {
+void Simulator::lay_ground(const CanvasGround& ground, Vec3 primer_ryb) {
+  if (ground.weave == Weave::Smooth) return;
+  const WeaveField w = weave_field(ground, config_.params.grid.cell_size, primer_ryb);
+  // The crowns reach base + 4/3 relief (the thickest linen thread); paint needs room above.
+  WB_REQUIRE(w.base + w.relief * 4.f / 3.f <= 0.5f * float(config_.canvas.depth),
+             "the ground (" + std::to_string(ground.priming_mm + ground.relief_mm) + " mm) is thicker than half the " +
+                 std::to_string(config_.canvas.depth) + "-cell canvas depth");
+  replace_canvas([&](TileStore& canvas) { canvas.lay_weave(w); });
+}
+
+void Simulator::replace_canvas(const std::function<void(TileStore&)>& write) {
   const double before = census().total();
+  flush_window();  // `write` sees the live canvas
+  write(*canvas_);
   grid_->window().reload();
   particles_.clear();
   books_.external(census().total() - before);

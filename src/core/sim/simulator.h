@@ -101,6 +101,9 @@ class Simulator {
 
   /// "Let it dry": flushes the window, dries every painted cell of the canvas, reloads.
   void dry_canvas();
+  /// Primes the empty canvas (throws wb::Error if it holds paint) with a woven ground of the primer's pigment (ground.h); the books
+  /// record it as paint that entered from outside. A smooth ground lays nothing.
+  void lay_ground(const CanvasGround& ground, Vec3 primer_ryb);
   /// Puts every particle back into the grid (Eq. 16 for all) and writes the window to the
   /// canvas, so that the canvas alone holds the painting (before saving or a final render).
   void settle();
@@ -118,10 +121,11 @@ class Simulator {
   /// Writes the live window to the tiles without changing the simulation (its next scatter
   /// writes the same cells).
   void flush_window();
-  /// The canvas's tiles were written from outside (undo, redo, open, a kept canvas): the window is
-  /// read back from them and the paint in flight, which belonged to the canvas that was replaced,
-  /// is dropped. The books record the change as paint that entered or left from outside.
-  void canvas_replaced();
+  /// Writes the canvas from outside (undo, redo, open, a kept canvas, a primed ground): `write`
+  /// changes the tiles (the window written to them first), the window is read back from them and the paint in flight, which belonged
+  /// to the canvas that was replaced, is dropped. The books record the difference of the census
+  /// before and after as paint that entered or left from outside, wherever the tiles changed.
+  void replace_canvas(const std::function<void(TileStore&)>& write);
   /// Liquid particles in flight.
   int64_t particle_count() const { return particles_.size(); }
   /// The live window and the particles, for the renderer.
