@@ -47,11 +47,6 @@ CanvasView::~CanvasView() {
   doneCurrent();
 }
 
-double CanvasView::now() {
-  using namespace std::chrono;
-  return duration<double>(steady_clock::now().time_since_epoch()).count();
-}
-
 void CanvasView::set_canvas_size(int w, int h) {
   canvas_w_ = std::max(1, w);
   canvas_h_ = std::max(1, h);
@@ -209,16 +204,18 @@ void CanvasView::tabletEvent(QTabletEvent* e) {
     case QEvent::TabletPress:
       if (e->button() == Qt::LeftButton && !pen_down_ && (e->modifiers() & Qt::AltModifier)) {
         Q_EMIT pickColor(to_canvas(e->position()));
+      } else if (e->button() == Qt::LeftButton && !pen_down_ && place_paint_ && (e->modifiers() & Qt::ControlModifier)) {
+        Q_EMIT placePaint(to_canvas(e->position()));
       } else if (e->button() == Qt::LeftButton && !pen_down_) {
         pen_down_ = tablet_down_ = true;
         last_input_ = in;
-        Q_EMIT penPress(in, now());
+        Q_EMIT penPress(in, wall_now());
       }
       break;
     case QEvent::TabletMove:
       if (tablet_down_) {
         last_input_ = in;
-        Q_EMIT penMove(in, now());
+        Q_EMIT penMove(in, wall_now());
       }
       break;
     case QEvent::TabletRelease:
@@ -227,7 +224,7 @@ void CanvasView::tabletEvent(QTabletEvent* e) {
         PenInput r = in;
         r.pressure = last_input_.pressure;
         pen_down_ = tablet_down_ = false;
-        Q_EMIT penRelease(r, now());
+        Q_EMIT penRelease(r, wall_now());
       }
       break;
     default: break;
@@ -247,11 +244,13 @@ void CanvasView::mousePressEvent(QMouseEvent* e) {
     pan_anchor_ = e->position();
   } else if (e->button() == Qt::LeftButton && !pen_down_ && (e->modifiers() & Qt::AltModifier)) {
     Q_EMIT pickColor(to_canvas(e->position()));
+  } else if (e->button() == Qt::LeftButton && !pen_down_ && place_paint_ && (e->modifiers() & Qt::ControlModifier)) {
+    Q_EMIT placePaint(to_canvas(e->position()));
   } else if (e->button() == Qt::LeftButton && !pen_down_) {
     pen_down_ = true;
     const PenInput in = input_at(e->position(), mouse_pressure_, 0.f, 0.f, 0.f);
     last_input_ = in;
-    Q_EMIT penPress(in, now());
+    Q_EMIT penPress(in, wall_now());
   }
   update();
 }
@@ -267,7 +266,7 @@ void CanvasView::mouseMoveEvent(QMouseEvent* e) {
   } else if (pen_down_ && !tablet_down_) {
     const PenInput in = input_at(e->position(), mouse_pressure_, 0.f, 0.f, 0.f);
     last_input_ = in;
-    Q_EMIT penMove(in, now());
+    Q_EMIT penMove(in, wall_now());
   }
   update();
 }
@@ -280,7 +279,7 @@ void CanvasView::mouseReleaseEvent(QMouseEvent* e) {
     panning_ = false;
   } else if (pen_down_ && !tablet_down_ && e->button() == Qt::LeftButton) {
     pen_down_ = false;
-    Q_EMIT penRelease(input_at(e->position(), mouse_pressure_, 0.f, 0.f, 0.f), now());
+    Q_EMIT penRelease(input_at(e->position(), mouse_pressure_, 0.f, 0.f, 0.f), wall_now());
   }
   update();
 }

@@ -42,6 +42,8 @@ class CanvasView : public QOpenGLWidget, protected QOpenGLFunctions {
   /// Pressure used for the mouse.
   void set_mouse_pressure(float p) { mouse_pressure_ = p; }
   float mouse_pressure() const { return mouse_pressure_; }
+  /// Ctrl + click puts paint down (placePaint) instead of painting: the palette's.
+  void set_place_paint(bool on) { place_paint_ = on; }
   /// Brush footprint radius in cells, for the cursor.
   void set_cursor_radius(float r) { cursor_radius_ = r; }
   /// Frames drawn so far (for frame-rate measurement).
@@ -53,6 +55,8 @@ class CanvasView : public QOpenGLWidget, protected QOpenGLFunctions {
   void penRelease(wb::studio::PenInput p, double now);
   /// Alt + click (mouse or pen): the eyedropper at this canvas point, cells.
   void pickColor(QPointF canvas);
+  /// Ctrl + click where set_place_paint is on: put paint at this canvas point, cells.
+  void placePaint(QPointF canvas);
   /// Right-button drag: the light follows the pointer (widget pixels moved since the press);
   /// `done` on release.
   void lightDrag(QPointF moved, bool done);
@@ -71,11 +75,11 @@ class CanvasView : public QOpenGLWidget, protected QOpenGLFunctions {
 
  private:
   PenInput input_at(QPointF widget_pos, float pressure, float tilt_x, float tilt_y, float twist) const;
-  static double now();
 
   std::function<QRect(QImage&)> source_;
   QImage image_;
   int canvas_w_ = 1, canvas_h_ = 1;
+  bool place_paint_ = false;
   bool texture_stale_ = true;
   GLuint texture_ = 0;
   QOpenGLShaderProgram program_;

@@ -1,17 +1,11 @@
 #include "studio/frame_cache.h"
+#include "studio/pen_clock.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cstring>
 
 namespace wb::studio {
-
-namespace {
-double wall_now() {
-  using namespace std::chrono;
-  return duration<double>(steady_clock::now().time_since_epoch()).count();
-}
-}  // namespace
 
 void FrameCache::reset(CanvasDims dims) {
   dims_ = dims;

@@ -37,11 +37,6 @@
 namespace wb::studio {
 namespace {
 
-double wall_now() {
-  using namespace std::chrono;
-  return duration<double>(steady_clock::now().time_since_epoch()).count();
-}
-
 /// Canvas rectangle (cells) covered by the tiles of a diff.
 void diff_rect(const TileDiff& d, int tiles_x, int& x0, int& y0, int& x1, int& y1) {
   x0 = y0 = 1 << 30;
@@ -128,8 +123,22 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
     idle_save_timer_.start();
   });
 
+  // The palette: its own small canvas and simulation, the same brush.
+  palette_ = new PalettePanel(cfg, rp, q.palette_width, q.palette_height);
+  connect(palette_, &PalettePanel::aboutToPaint, this, [this] { carry_brush(true); });
+  connect(palette_, &PalettePanel::placePaint, this,
+          [this](QPointF c) { palette_->put_paint(c, paint_panel_->current_paint()); });
+  connect(palette_, &PalettePanel::pickColor, this, [this](QPointF c) { pick_color(c, palette_->sim()); });
+  connect(palette_->sim(), &SimThread::failed, this, [this](const QString& m) {
+    std::fprintf(stderr, "wetbrush-studio: palette: %s\n", qPrintable(m));
+    statusBar()->showMessage("Palette error: " + m, 10000);
+  });
+
   // Pen input -> session clock -> simulation thread.
-  connect(view_, &CanvasView::penPress, this, [this](PenInput p, double t) { push_clock(clock_.press(p, t)); });
+  connect(view_, &CanvasView::penPress, this, [this](PenInput p, double t) {
+    carry_brush(false);
+    push_clock(clock_.press(p, t));
+  });
   connect(view_, &CanvasView::penMove, this, [this](PenInput p, double t) { push_clock(clock_.move(p, t)); });
   connect(view_, &CanvasView::pickColor, this, [this](QPointF c) { pick_color(c); });
   connect(view_, &CanvasView::penRelease, this, [this](PenInput p, double t) {
@@ -158,12 +167,15 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
       return;
     }
     view_->set_cursor_radius(b.width * 0.5f);
-    sim_->post([b](SimThread& s) {
-      SimConfig c = s.config();
-      c.brush = b;
-      s.rebuild(c, true);
-    });
+    palette_->view()->set_cursor_radius(b.width * 0.5f);
+    for (SimThread* sim : {sim_.get(), palette_->sim()})
+      sim->post([b](SimThread& s) {
+        SimConfig c = s.config();
+        c.brush = b;
+        s.rebuild(c, true);
+      });
     clock_.restart();
+    palette_->restart_clock();
   });
   paint_panel_ = new PaintPanel;
   connect(paint_panel_, &PaintPanel::dip, this, [this](PaintLoad p) { dip(p); });
@@ -219,11 +231,15 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   };
   dock(brush_panel_, "Brush");
   dock(paint_panel_, "Paint");
+  dock(palette_, "Palette");
   brush_preview_ = new BrushPreview;
   dock(brush_preview_, "Brush preview");
   dock(view_panel_, "View and input");
   // The preview follows the brush with every frame while painting, and the status timer otherwise.
-  connect(sim_.get(), &SimThread::frameReady, brush_preview_, [this] { brush_preview_->set_picture(sim_->brush_picture()); });
+  for (SimThread* sim : {sim_.get(), palette_->sim()})
+    connect(sim, &SimThread::frameReady, brush_preview_, [this, sim] {
+      if (sim == (brush_on_palette_ ? palette_->sim() : sim_.get())) brush_preview_->set_picture(sim->brush_picture());
+    });
   oblique_label_ = new QLabel;
   oblique_label_->setAlignment(Qt::AlignCenter);
   oblique_label_->setMinimumSize(240, 120);
@@ -262,10 +278,11 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
       idle_save_timer_.start();
   });
 
-  sim_->post([p = paint_panel_->current_paint()](SimThread& s) {
-    s.set_paint(p);
-    s.restart_recording(true);
-  });
+  for (SimThread* sim : {sim_.get(), palette_->sim()})
+    sim->post([p = paint_panel_->current_paint()](SimThread& s) {
+      s.set_paint(p);
+      s.restart_recording(true);
+    });
   resize(1400, 900);
   update_title();
   if (!options_.open_path.isEmpty())
@@ -399,6 +416,12 @@ void MainWindow::build_menus() {
   canvas->addAction("D&ip brush", QKeySequence(Qt::Key_D), this, [this] { dip(paint_panel_->current_paint()); });
   canvas->addAction("&Wipe brush", QKeySequence(Qt::Key_W), this, [this] { wipe(0.5f); });
   canvas->addAction("&Clean brush", QKeySequence(Qt::Key_C), this, [this] { clean_brush(); });
+  canvas->addAction("Clean &palette", this, [this] {
+    palette_->sim()->post([](SimThread& s) {
+      s.write_canvas([](TileStore& c) { c.clear(); });
+      s.invalidate_all();
+    });
+  });
 
   QMenu* view = menuBar()->addMenu("&View");
   view->addAction("&Fit (0)", this, [this] { view_->fit(); });
@@ -414,7 +437,35 @@ void MainWindow::push_clock(const ClockOutput& out) {
   if (!out.samples.empty()) dirty_ = dirty_ || false;
 }
 
+void MainWindow::carry_brush(bool to_palette) {
+  if (to_palette == brush_on_palette_) return;
+  SimThread* from = to_palette ? sim_.get() : palette_->sim();
+  SimThread* to = to_palette ? palette_->sim() : sim_.get();
+  // The receiving thread waits for the paint; the giving one never waits for it, so two carries
+  // in a row (there and back) cannot wait on each other.
+  auto paint = std::make_shared<std::promise<BristleLoadHost>>();
+  std::shared_future<BristleLoadHost> arrives = paint->get_future().share();
+  from->post([paint](SimThread& s) {
+    try {
+      paint->set_value(s.give_brush_paint());
+    } catch (...) {
+      paint->set_exception(std::current_exception());
+    }
+  });
+  to->post([arrives](SimThread& s) { s.receive_brush_paint(arrives.get()); });
+  if (to_palette)
+    palette_->restart_clock();
+  else
+    clock_.restart();
+  brush_on_palette_ = to_palette;
+}
+
 void MainWindow::send_event(StrokeEvent e) {
+  // The brush's events go where the brush is; drying is the painting's.
+  if (brush_on_palette_ && e.kind != StrokeEventKind::Dry) {
+    palette_->send_event(e);
+    return;
+  }
   if (clock_.down()) {
     pending_events_.push_back(e);
     return;
@@ -465,13 +516,14 @@ void MainWindow::refresh_oblique() {
   sim_->post([](SimThread& s) { s.render_oblique(30.f, 720); });
 }
 
-std::optional<std::array<float, 3>> MainWindow::pick_color(QPointF canvas) {
+std::optional<std::array<float, 3>> MainWindow::pick_color(QPointF canvas, SimThread* from) {
+  if (!from) from = sim_.get();
   // The pigment the renderer blends for the top view there, read between two steps (one image
   // tile rendered): what the artist sees, a glaze with the paper it lets through.
   const int x = int(std::floor(canvas.x())), y = int(std::floor(canvas.y()));
   auto done = std::make_shared<std::promise<std::optional<Vec3>>>();
   std::future<std::optional<Vec3>> result = done->get_future();
-  sim_->post([done, x, y](SimThread& s) {
+  from->post([done, x, y](SimThread& s) {
     try {
       done->set_value(s.renderer().pigment_at(s.sim().canvas(), x, y, s.sim().live_window()));
     } catch (...) {
@@ -544,10 +596,11 @@ void MainWindow::new_canvas(int width, int height, QColor paper, const CanvasGro
 }
 
 void MainWindow::settle() {
-  sim_->wait_idle();
-  QCoreApplication::processEvents();
-  sim_->wait_idle();
-  QCoreApplication::processEvents();
+  for (int pass = 0; pass < 2; ++pass) {
+    sim_->wait_idle();
+    palette_->sim()->wait_idle();
+    QCoreApplication::processEvents();
+  }
 }
 
 bool MainWindow::write_snapshot(const QString& path, bool wait, bool user_save) {
@@ -560,10 +613,23 @@ bool MainWindow::write_snapshot(const QString& path, bool wait, bool user_save) 
   ++saves_in_flight_;
   const int64_t serial = ++snapshot_serial_;
   if (!user_save) autosave_serial_ = serial;
-  sim_->post([done, file, from_blank](SimThread& s) {
+  // The palette at rest, copied on its own thread; posted with the canvas's snapshot, so the
+  // canvas's thread waits for it only behind what was asked of the palette before (a carry of
+  // the brush that the canvas's thread itself serves first).
+  auto palette_copy = std::make_shared<std::promise<std::shared_ptr<TileStore>>>();
+  std::shared_future<std::shared_ptr<TileStore>> palette = palette_copy->get_future().share();
+  palette_->sim()->post([palette_copy](SimThread& s) {
+    try {
+      palette_copy->set_value(std::make_shared<TileStore>(s.sim().settled_canvas_copy(Device{})));
+    } catch (...) {
+      palette_copy->set_exception(std::current_exception());
+    }
+  });
+  sim_->post([done, file, from_blank, palette](SimThread& s) {
     try {
       // The paint at rest, with what is in flight now; the simulation goes on unchanged.
       auto copy = std::make_shared<TileStore>(s.sim().settled_canvas_copy(Device{}));
+      std::shared_ptr<TileStore> pal = palette.get();
       auto image = std::make_shared<Image>(s.canvas_image());
       const Vec3 paper = s.renderer().params().paper_rgb;
       nlohmann::json meta = {{"generator", "wetbrush-studio"},
@@ -571,9 +637,11 @@ bool MainWindow::write_snapshot(const QString& path, bool wait, bool user_save) 
                              {"paper_rgb", {paper.x, paper.y, paper.z}},
                              {"ground", s.ground() ? ground_to_json(*s.ground()) : nlohmann::json(nullptr)},
                              {"recording_from_blank", from_blank}};
-      QThreadPool::globalInstance()->start([done, file, copy, image, meta] {
+      QThreadPool::globalInstance()->start([done, file, copy, image, meta, pal] {
         try {
-          save_painting(file, *copy, *image, meta);
+          SaveOptions options;
+          if (pal->allocated_tiles() > 0) options.palette = pal.get();
+          save_painting(file, *copy, *image, meta, options);
           done->set_value("");
         } catch (const std::exception& e) {
           done->set_value(user_message(e));
@@ -648,9 +716,26 @@ bool MainWindow::open_from(const QString& path) {
   auto done = std::make_shared<std::promise<std::string>>();
   auto dims = std::make_shared<CanvasDims>();
   const std::string file = path.toStdString();
-  sim_->post([done, dims, file](SimThread& s) {
+  PalettePanel* palette = palette_;
+  sim_->post([done, dims, file, palette](SimThread& s) {
     try {
       Painting p = load_painting(file, s.sim().device());
+      if (p.palette) {
+        // The painting's palette replaces the one on the desk (its own size, if it was saved
+        // with another preset's).
+        auto pal = std::make_shared<TileStore>(std::move(*p.palette));
+        palette->sim()->post([pal, palette](SimThread& ps) {
+          if (!(ps.config().canvas == pal->dims())) {
+            SimConfig c = ps.config();
+            c.canvas = pal->dims();
+            ps.rebuild(c, false);
+            const int w = c.canvas.width, h = c.canvas.height;
+            QMetaObject::invokeMethod(palette, [palette, w, h] { palette->set_canvas_size(w, h); }, Qt::QueuedConnection);
+          }
+          ps.write_canvas([&](TileStore& canvas) { canvas.copy_from(*pal); });
+          ps.invalidate_all();
+        });
+      }
       if (p.metadata.contains("paper_rgb") && p.metadata["paper_rgb"].is_array() && p.metadata["paper_rgb"].size() == 3)
         s.renderer().params().paper_rgb =
             Vec3(p.metadata["paper_rgb"][0].get<float>(), p.metadata["paper_rgb"][1].get<float>(),
@@ -752,8 +837,10 @@ void MainWindow::update_status() {
                             .arg(view_->rotation_deg(), 0, 'f', 0));
   status_device_->setText(QString("Device %1 \u00b7 Preset %2")
                               .arg(QString::fromStdString(st.device), QString::fromStdString(options_.preset.name)));
-  paint_panel_->show_brush(st.brush_ryb, st.brush_amount);
-  if (brush_preview_->isVisible()) brush_preview_->set_picture(sim_->brush_picture());
+  SimThread* holder = brush_on_palette_ ? palette_->sim() : sim_.get();
+  const SimStatus hs = brush_on_palette_ ? holder->status() : st;
+  paint_panel_->show_brush(hs.brush_ryb, hs.brush_amount);
+  if (brush_preview_->isVisible()) brush_preview_->set_picture(holder->brush_picture());
 }
 
 void MainWindow::update_title() {

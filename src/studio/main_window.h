@@ -15,6 +15,7 @@
 #include "core/io/undo_tiles.h"
 #include "studio/brush_preview.h"
 #include "studio/canvas_view.h"
+#include "studio/palette.h"
 #include "studio/panels.h"
 #include "studio/pen_clock.h"
 #include "studio/sim_thread.h"
@@ -67,7 +68,14 @@ class MainWindow : public QMainWindow {
   void dry_canvas();
   /// The eyedropper: puts the pigment of the paint shown at this canvas point (cells) into the
   /// selected well. Returns it, or nothing over bare canvas (the well is left as it was).
-  std::optional<std::array<float, 3>> pick_color(QPointF canvas);
+  std::optional<std::array<float, 3>> pick_color(QPointF canvas, SimThread* from = nullptr);
+  PalettePanel* palette() const { return palette_; }
+  /// True while the brush is on the palette (its paint there, sample by sample).
+  bool brush_on_palette() const { return brush_on_palette_; }
+  /// Carries the brush with its paint to the palette (`to_palette`) or back to the canvas: the
+  /// side it leaves simulates its time line to the end first; the side it reaches starts a new
+  /// recording with it. Does nothing when the brush is there already.
+  void carry_brush(bool to_palette);
   ViewPanel* view_panel() const { return view_panel_; }
   BrushPreview* brush_preview() const { return brush_preview_; }
   /// The oblique view as last rendered (null until the view is turned on).
@@ -104,6 +112,8 @@ class MainWindow : public QMainWindow {
   CanvasView* view_ = nullptr;
   BrushPanel* brush_panel_ = nullptr;
   PaintPanel* paint_panel_ = nullptr;
+  PalettePanel* palette_ = nullptr;
+  bool brush_on_palette_ = false;
   ViewPanel* view_panel_ = nullptr;
   BrushPreview* brush_preview_ = nullptr;
   QUndoStack* undo_ = nullptr;

@@ -1,9 +1,16 @@
 #include "studio/pen_clock.h"
 
+#include <chrono>
+
 #include <algorithm>
 #include <cmath>
 
 namespace wb::studio {
+
+double wall_now() {
+  using namespace std::chrono;
+  return duration<double>(steady_clock::now().time_since_epoch()).count();
+}
 
 double ceil_to(double t, double q) { return std::ceil(t / q - 1e-9) * q; }
 

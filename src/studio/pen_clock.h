@@ -61,6 +61,9 @@ class PenClock {
   PenSample last_{};
 };
 
+/// Seconds on the steady clock: the arrival time of pen input and the studio's timings.
+double wall_now();
+
 /// Rounds t up to the next multiple of q (t itself when it is one).
 double ceil_to(double t, double q);
 

@@ -12,23 +12,11 @@
 namespace wb::studio {
 namespace {
 
-double wall_now() {
-  using namespace std::chrono;
-  return duration<double>(steady_clock::now().time_since_epoch()).count();
-}
-
 /// Adds the time since `since` to `bucket`; returns now.
 double lap(double& bucket, double since) {
   const double now = wall_now();
   bucket += now - since;
   return now;
-}
-
-/// Cells around the pen that one step may change: the active window, centred near the brush's
-/// footprint (the bristles' reach) and snapped to the grid's window snap.
-int step_reach(const SimConfig& c) {
-  return int(c.brush.length + std::max(c.brush.width, c.brush.thickness)) + std::max(c.window.x, c.window.y) / 2 +
-         c.params.grid.window_snap + 2;
 }
 
 }  // namespace
@@ -41,6 +29,8 @@ QualityPreset QualityPreset::cpu() {
   p.canvas_width = 1200;
   p.canvas_height = 900;
   p.canvas_depth = 32;
+  p.palette_width = 320;
+  p.palette_height = 200;
   p.ao_rays = 12;
   p.window_xy = 64;
   p.window_z = 16;
@@ -55,6 +45,8 @@ QualityPreset QualityPreset::gpu() {
   p.canvas_width = 4096;
   p.canvas_height = 4096;
   p.canvas_depth = 64;
+  p.palette_width = 640;
+  p.palette_height = 400;
   p.ao_rays = 64;
   return p;
 }
@@ -69,6 +61,8 @@ QualityPreset QualityPreset::tiny() {
   p.canvas_width = 160;
   p.canvas_height = 120;
   p.canvas_depth = 16;
+  p.palette_width = 112;
+  p.palette_height = 80;
   p.ao_rays = 4;
   p.window_xy = 48;  // particles within D0's floor, about 8.6 cells, of the bristles (Simulator::place_window)
   p.window_z = 8;
@@ -113,11 +107,7 @@ SimThread::~SimThread() {
 
 void SimThread::push(const ClockOutput& out) {
   if (out.samples.empty() && out.events.empty()) return;
-  post([out](SimThread& self) {
-    std::lock_guard lk(self.rec_mu_);
-    for (const PenSample& s : out.samples) self.rec_.samples.push_back(s);
-    for (const StrokeEvent& e : out.events) self.rec_.events.push_back(e);
-  });
+  post([out](SimThread& self) { self.session_.append(out); });
 }
 
 void SimThread::post(std::function<void(SimThread&)> fn) {
@@ -133,10 +123,7 @@ void SimThread::wait_idle() {
   idle_cv_.wait(lk, [&] { return quit_ || (in_cmds_.empty() && !busy_); });
 }
 
-Stroke SimThread::recording() const {
-  std::lock_guard lk(rec_mu_);
-  return rec_;
-}
+Stroke SimThread::recording() const { return session_.recording(); }
 
 SimStatus SimThread::status() const {
   std::lock_guard lk(status_mu_);
@@ -157,12 +144,9 @@ void SimThread::rebuild(const SimConfig& config, bool keep_canvas) {
   BrushPose rest;
   rest.position = Vec3(config.canvas.width * 0.5f, config.canvas.height * 0.5f, config.brush.length * 1.5f);
   sim_ = std::make_unique<Simulator>(config_, rest);
+  carried_paint_ = false;  // a new brush is clean: its first stroke loads the well's paint
   // Nothing painted in this recording: a new one from the blank (primed) canvas is the same.
-  bool painted = false;
-  {
-    std::lock_guard lk(rec_mu_);
-    for (const PenSample& s : rec_.samples) painted |= s.down;
-  }
+  const bool painted = session_.painted();
   if (keep_canvas && same_dims) {
     // The paint that was in flight comes too; the old simulator goes, so it settles for good,
     // and its canvas is copied on the device.
@@ -178,7 +162,7 @@ void SimThread::rebuild(const SimConfig& config, bool keep_canvas) {
     write_canvas([](TileStore&) {});
   }
   old.reset();
-  restart_recording(recording_from_blank_.load() && !(keep_canvas && same_dims && painted));
+  restart_recording(session_.from_blank() && !(keep_canvas && same_dims && painted));
   if (!frames_.ready() || !same_dims) frames_.reset(config.canvas);
   {
     std::lock_guard lk(status_mu_);
@@ -192,43 +176,67 @@ void SimThread::restart_recording(bool from_blank) {
   // The old time line is simulated to its end first, and its open stroke closed.
   if (!failed_) drain();
   finish_stroke();
-  std::lock_guard lk(rec_mu_);
-  rec_ = Stroke{};
-  rec_.canvas = config_.canvas;
-  rec_.brush = config_.brush;
-  rec_.paint = paint_;
-  rec_.ground = ground_;
-  rec_.paint.reload_on_pen_down = false;  // the studio's brush stays dirty between strokes
-  rec_.paper_rgb = std::array<float, 3>{renderer_.params().paper_rgb.x, renderer_.params().paper_rgb.y,
-                                        renderer_.params().paper_rgb.z};
-  rec_.window = std::array<int, 3>{config_.window.x, config_.window.y, config_.window.z};  // the replay's window
-  rec_.dt = kStepDt;
-  rec_.lead_in = kLeadIn;
-  rec_.lead_out = 0.0;
-  rec_.source = "studio session";
-  chunk_start_ = 0;
-  player_.reset();
-  player_samples_ = 0;
-  t_done_ = 0.0;
-  started_ = false;
-  next_event_ = 0;
-  prev_contact_ = false;
-  recording_from_blank_ = from_blank;
+  Stroke header;
+  header.canvas = config_.canvas;
+  header.brush = config_.brush;
+  header.paint = paint_;
+  header.ground = ground_;
+  header.paint.reload_on_pen_down = false;  // the studio's brush stays dirty between strokes
+  const Vec3 paper = renderer_.params().paper_rgb;
+  header.paper_rgb = std::array<float, 3>{paper.x, paper.y, paper.z};
+  header.window = std::array<int, 3>{config_.window.x, config_.window.y, config_.window.z};  // the replay's window
+  header.dt = kStepDt;
+  header.lead_in = kLeadIn;
+  header.lead_out = 0.0;
+  header.source = "studio session";
+  session_.restart(std::move(header), from_blank);
+}
+
+BristleLoadHost SimThread::give_brush_paint() {
+  drain();
+  finish_stroke();
+  BristleLoadHost paint = sim_->brush_paint();
+  sim_->clean();  // the brush leaves: its paint goes with it (the books say so)
+  return paint;
+}
+
+void SimThread::receive_brush_paint(const BristleLoadHost& paint) {
+  drain();
+  finish_stroke();
+  sim_->set_brush_paint(paint);
+  // The recording goes on from here with the brush as it came (its steps load nothing); a replay
+  // of it starts with the carried paint's mean colour, oil and fill on every sample.
+  double m = 0, cap = 0, oil = 0;
+  Vec3 ryb{};
+  for (size_t j = 0; j < paint.m.size(); ++j) {
+    const double mj = paint.m[j];
+    m += mj, cap += paint.potential[j], oil += mj * paint.oil[j];
+    ryb = ryb + Vec3(paint.pigment_r[j], paint.pigment_y[j], paint.pigment_b[j]) * float(mj);
+  }
+  PaintLoad carried = paint_;
+  if (m > 0) {
+    carried.ryb[0] = ryb.x / float(m), carried.ryb[1] = ryb.y / float(m), carried.ryb[2] = ryb.z / float(m);
+    carried.oil = float(oil / m);
+  }
+  carried.load = cap > 0 ? float(std::min(1.0, m / cap)) : 0.f;
+  const PaintLoad well = paint_;
+  paint_ = carried;
+  restart_recording(false);
+  paint_ = well;
+  carried_paint_ = true;
 }
 
 void SimThread::prime(const CanvasGround& g) {
   sim_->lay_ground(g, rgb_to_ryb(renderer_.params().paper_rgb));
   ground_ = g;
-  undo_rec_.reset();
-  stroke_open_ = false;
+  undo_.reset();
   invalidate_all();
 }
 
 void SimThread::write_canvas(const std::function<void(TileStore&)>& write) {
   if (!sim_) return;
   sim_->replace_canvas(write);
-  undo_rec_.reset();
-  stroke_open_ = false;
+  undo_.reset();
 }
 
 void SimThread::invalidate_all() { frames_.invalidate_all(); }
@@ -250,131 +258,37 @@ void SimThread::render_oblique(float elevation_deg, int max_width) {
 }
 
 void SimThread::drain() {
-  PlayerStep step;
-  while (step_available()) {
-    bool found = false;
-    while (player_->next(step))
-      if (!started_ || step.t > t_done_) {
-        found = true;
-        break;
-      }
-    if (!found) break;
-    run_step(step);
-  }
+  SessionStep step;
+  while (!failed_ && sim_ && session_.next_step(step)) run_step(step);
 }
 
-void SimThread::rebuild_player() {
-  Stroke chunk;
-  {
-    std::lock_guard lk(rec_mu_);
-    chunk.canvas = rec_.canvas;
-    chunk.brush = rec_.brush;
-    chunk.paint = rec_.paint;
-    chunk.dt = rec_.dt;
-    chunk.max_move_per_substep = rec_.max_move_per_substep;
-    chunk.max_substeps = rec_.max_substeps;
-    chunk.samples.assign(rec_.samples.begin() + std::ptrdiff_t(chunk_start_), rec_.samples.end());
-    player_samples_ = rec_.samples.size();
-  }
-  // The first chunk has the recording's lead-in; later ones start at a knot on a step
-  // boundary, where the full recording's keys and these agree exactly.
-  chunk.lead_in = chunk_start_ == 0 ? rec_.lead_in : 0.0;
-  chunk.lead_out = 0.0;
-  chunk.source = "studio session";
-  player_ = std::make_unique<StrokePlayer>(std::move(chunk));
-}
-
-bool SimThread::step_available() {
-  if (failed_ || !sim_ || rec_.samples.empty()) return false;
-  if (!player_ || player_samples_ != rec_.samples.size()) rebuild_player();
-  const double horizon = rec_.samples.back().t;
-  if (started_ && t_done_ + kStepDt > horizon) return false;
-  // A long press: put a knot on the last step boundary we can reach, between two pen-down
-  // samples (where it changes no lift of a pen-up key), so the next player starts there.
-  if (started_ && t_done_ - rec_.samples[chunk_start_].t >= 0.5) {
-    const double T = std::floor(horizon / kStepDt) * kStepDt;
-    const auto it = std::upper_bound(rec_.samples.begin(), rec_.samples.end(), T,
-                                     [](double v, const PenSample& s) { return v < s.t; });
-    const size_t j = size_t(it - rec_.samples.begin());  // first sample after T
-    if (T > t_done_ && j > chunk_start_ + 1 && j < rec_.samples.size() && rec_.samples[j - 1].t < T &&
-        rec_.samples[j - 1].down && rec_.samples[j].down) {
-      PenSample knot = player_->pen_at(T);
-      knot.t = T;
-      knot.down = true;
-      {
-        std::lock_guard lk(rec_mu_);
-        rec_.samples.insert(rec_.samples.begin() + std::ptrdiff_t(j), knot);
-      }
-      rebuild_player();
-    }
-  }
-  return player_->t_begin() + kStepDt <= horizon;
-}
-
-void SimThread::run_step(const PlayerStep& step) {
+void SimThread::run_step(const SessionStep& s) {
   Simulator& sim = *sim_;
-  if (!started_) {
-    sim.reset_brush(player_->pose_at(player_->t_begin()));
-    sim.load_paint(rec_.paint);
-    started_ = true;
+  if (s.first) {
+    sim.reset_brush(session_.player().pose_at(session_.player().t_begin()));
+    // A brush carried in from the other canvas keeps its paint, sample by sample.
+    if (!carried_paint_) sim.load_paint(session_.paint());
+    carried_paint_ = false;
   }
-  // Events fire in the first step ending at or after them. The pen-down edge is the session's:
-  // a player rebuilt at a knot mid-stroke starts with the pen already down.
-  const size_t first_event = next_event_;
-  while (next_event_ < rec_.events.size() && rec_.events[next_event_].t <= step.t) ++next_event_;
-  const std::span<const StrokeEvent> events(rec_.events.data() + first_event, next_event_ - first_event);
-  const bool edge = step.pen_down && !prev_contact_;
-  prev_contact_ = step.pen_down;
-
-  // Undo: capture the tiles this step may touch before it runs.
-  const int reach = step_reach(config_);
-  const PenSample a = player_->pen_at(step.t_begin), b = step.pen;
-  const int x0 = int(std::min(a.x, b.x)) - reach, x1 = int(std::max(a.x, b.x)) + reach;
-  const int y0 = int(std::min(a.y, b.y)) - reach, y1 = int(std::max(a.y, b.y)) + reach;
-  // Every step belongs to the undo record of the stroke it leads to: the steps between two
-  // strokes (the lifted brush moving on, paint in flight landing) change tiles too.
-  stroke_open_ = true;
   double t = wall_now();
-  undo_rec_.capture_rect(sim.canvas(), x0, y0, x1, y1);
+  undo_.before_step(sim, s.from, s.step.pen);
   t = lap(times_.undo, t);
   const Int3 o0 = sim.live_window()->origin();
-  drive_step(sim, *player_, step, events, edge && rec_.paint.reload_on_pen_down, poses_);
-  for (const StrokeEvent& e : events)
+  drive_step(sim, session_.player(), s.step, s.events, s.pen_down_edge && session_.paint().reload_on_pen_down, poses_);
+  for (const StrokeEvent& e : s.events)
     if (e.kind == StrokeEventKind::Dry) invalidate_all();
   lap(times_.step, t);
   // Paint changes only inside the active window (where it was and where it moved to).
   const Int3 o = sim.live_window()->origin(), n = sim.live_window()->dims();
   invalidate_rect(std::min(o.x, o0.x), std::min(o.y, o0.y), std::max(o.x, o0.x) + n.x, std::max(o.y, o0.y) + n.y);
-  t_done_ = step.t;
+  session_.step_done(s);
   ++steps_;
   ++rate_steps_;
-
-  // Knots: a sample on this step boundary lets the next player start here (cheap rebuilds).
-  std::lock_guard lk(rec_mu_);
-  for (size_t j = rec_.samples.size(); j-- > chunk_start_ + 1;) {
-    if (rec_.samples[j].t < t_done_) break;
-    if (rec_.samples[j].t == t_done_) {
-      chunk_start_ = j;
-      player_.reset();
-      break;
-    }
-  }
 }
 
-
 void SimThread::finish_stroke() {
-  if (!stroke_open_ || !sim_) return;
-  stroke_open_ = false;
-  // The record holds the canvas with its paint at rest, before and after. Paint still in
-  // flight lands during the next steps, under the window: those tiles start the next record
-  // as they are at rest now, so that its undo returns to exactly this canvas.
-  auto diff = std::make_shared<TileDiff>();
-  const Int3 o = sim_->live_window()->origin(), n = sim_->live_window()->dims();
-  sim_->with_settled_canvas([&](TileStore& c) {
-    *diff = undo_rec_.finish(c);
-    undo_rec_.capture_rect(c, o.x, o.y, o.x + n.x, o.y + n.y);
-  });
-  if (!diff->empty()) Q_EMIT strokeFinished(diff);
+  if (!sim_) return;
+  if (std::shared_ptr<TileDiff> diff = undo_.finish(*sim_)) Q_EMIT strokeFinished(diff);
 }
 
 void SimThread::render(bool force) {
@@ -402,7 +316,7 @@ void SimThread::publish_status(bool force) {
   const BrushPicture picture = frames_.brush_picture();
   status_.brush_ryb = {picture.mean_ryb.x, picture.mean_ryb.y, picture.mean_ryb.z};
   status_.brush_amount = picture.amount;
-  status_.lag_s = rec_.samples.empty() ? 0.0 : std::max(0.0, rec_.samples.back().t - t_done_);
+  status_.lag_s = session_.lag();
 }
 
 void SimThread::run() {
@@ -433,16 +347,10 @@ void SimThread::run() {
     if (busy_since == 0.0) busy_since = t_start, rate_t0_ = t_start;
     int n = 0;
     try {
-      PlayerStep step;
+      SessionStep step;
       double tp = t_start;
-      while (n < 64 && wall_now() - t_start < 0.05 && step_available()) {
-        bool found = false;
-        while (player_->next(step)) {
-          if (!started_ || step.t > t_done_) {
-            found = true;
-            break;
-          }
-        }
+      while (n < 64 && wall_now() - t_start < 0.05 && !failed_ && sim_) {
+        const bool found = session_.next_step(step);
         lap(times_.player, tp);
         if (!found) break;
         run_step(step);
@@ -463,7 +371,7 @@ void SimThread::run() {
     t = lap(times_.player, t);
     if (!pending) {
       // Idle: the session time line is simulated up to its last sample; close the stroke.
-      if (!prev_contact_) {
+      if (!session_.pen_down()) {
         try {
           finish_stroke();
         } catch (const std::exception& e) {

@@ -25,6 +25,8 @@
 #include "core/sim/simulator.h"
 #include "studio/frame_cache.h"
 #include "studio/pen_clock.h"
+#include "studio/session.h"
+#include "studio/stroke_undo.h"
 
 namespace wb::studio {
 
@@ -34,6 +36,7 @@ struct QualityPreset {
   int bristles = 80;
   int samples_per_bristle = 32;
   int canvas_width = 1200, canvas_height = 900, canvas_depth = 32;
+  int palette_width = 320, palette_height = 200;  ///< the palette's own canvas, cells (same depth)
   int ao_rays = 12;
   int window_xy = 128, window_z = 32;  ///< active simulation window, cells (paper: 128 x 128 x 32)
   float brush_length = 0.f, brush_width = 0.f;  ///< starting round brush size, cells (0: the shape's default)
@@ -92,7 +95,7 @@ class SimThread : public QObject {
   /// The recording so far (a copy).
   Stroke recording() const;
   /// True while the recording reproduces the canvas from a blank one.
-  bool recording_from_blank() const { return recording_from_blank_.load(); }
+  bool recording_from_blank() const { return session_.from_blank(); }
   /// Blocks until every input pushed so far has been simulated (tests and shutdown only).
   void wait_idle();
 
@@ -122,6 +125,12 @@ class SimThread : public QObject {
   /// Paint the brush holds (the palette's current well) for recordings that start now.
   void set_paint(const PaintLoad& p) { paint_ = p; }
   const PaintLoad& paint() const { return paint_; }
+  /// The brush leaves this canvas for the other (the palette, or back): the time line is
+  /// simulated to its end, and the brush's paint, sample by sample, is returned and taken off it.
+  BristleLoadHost give_brush_paint();
+  /// The brush arrives with this paint (give_brush_paint of the other canvas); a new recording
+  /// starts, whose first step keeps that paint instead of loading the well's.
+  void receive_brush_paint(const BristleLoadHost& paint);
   /// Primes the blank canvas with `g` in the paper's colour (Simulator::lay_ground); the ground
   /// is the canvas's from then on: saved with the painting and with every recording.
   void prime(const CanvasGround& g);
@@ -141,9 +150,8 @@ class SimThread : public QObject {
 
  private:
   void run();
-  bool step_available();
-  void rebuild_player();
-  void run_step(const PlayerStep& step);
+  bool step_available() { return !failed_ && sim_ && session_.has_step(); }
+  void run_step(const SessionStep& step);
   void finish_stroke();
   void render(bool force);
   void publish_status(bool force);
@@ -153,6 +161,7 @@ class SimThread : public QObject {
   Renderer renderer_;
   PaintLoad paint_{};
   std::optional<CanvasGround> ground_;  ///< the canvas's priming (unset: bare)
+  bool carried_paint_ = false;  ///< the brush holds paint carried in: the next recording loads none
 
   // Inputs (UI -> worker).
   mutable std::mutex in_mu_;
@@ -163,20 +172,9 @@ class SimThread : public QObject {
   bool quit_ = false;
   bool busy_ = false;
 
-  // Session (worker only, except recording() which copies under rec_mu_).
-  mutable std::mutex rec_mu_;
-  Stroke rec_;
-  size_t chunk_start_ = 0;      ///< sample index where the current player's stroke starts
-  std::unique_ptr<StrokePlayer> player_;
+  SessionTimeline session_;  ///< the time line and its recording
   std::vector<BrushPose> poses_;
-  size_t player_samples_ = 0;   ///< samples the player was built with
-  double t_done_ = 0.0;         ///< session time simulated so far (a step boundary)
-  bool started_ = false;        ///< the first step of this recording has run
-  size_t next_event_ = 0;
-  bool prev_contact_ = false;
-  std::atomic<bool> recording_from_blank_{true};
-  StrokeTileRecorder undo_rec_;
-  bool stroke_open_ = false;
+  StrokeUndo undo_;
 
   // Frames (worker -> UI): the canvas image and the brush picture.
   FrameCache frames_{renderer_};

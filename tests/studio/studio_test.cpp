@@ -50,11 +50,31 @@ namespace {
 
 /// Runs fn on the simulation thread and waits for its result.
 template <class F>
-auto on_sim(MainWindow& w, F fn) {
-  using R = decltype(fn(*w.sim()));
+auto on_thread(SimThread& t, F fn) {
+  using R = decltype(fn(t));
   auto p = std::make_shared<std::promise<R>>();
-  w.sim()->post([p, fn](SimThread& s) mutable { p->set_value(fn(s)); });
+  t.post([p, fn](SimThread& s) mutable { p->set_value(fn(s)); });
   return p->get_future().get();
+}
+template <class F>
+auto on_sim(MainWindow& w, F fn) {
+  return on_thread(*w.sim(), fn);
+}
+
+/// Mass-weighted pigment (RYB) of the paint that is not dried, over the canvas, and its amount.
+std::pair<Vec3, double> wet_pigment(TileStore& c) {
+  Vec3 sum{};
+  double m = 0;
+  for (int id : c.allocated_tile_ids()) {
+    const TileData t = c.read_tile(id);
+    for (size_t i = 0; i < t.density.size(); ++i) {
+      if (t.density[i] <= 0.f || t.dryness[i] == 65535) continue;
+      const float d = t.density[i];
+      sum = sum + Vec3(decode_unorm16(t.pigment_r[i]), decode_unorm16(t.pigment_y[i]), decode_unorm16(t.pigment_b[i])) * d;
+      m += d;
+    }
+  }
+  return {m > 0 ? sum * float(1.0 / m) : Vec3{}, m};
 }
 
 /// Column paint (sum of density over z) per canvas cell.
@@ -455,6 +475,74 @@ class StudioTest : public QObject {
     const std::vector<float> all = column_density(*w_);
     const float crown = weave_height(weave_field(linen, GridParams{}.cell_size, Vec3{}), 2.5f, 2.5f);
     QVERIFY2(std::abs(all[2 * kW + 2] - crown) < 0.5f, "the weave is in the reopened volume");
+  }
+
+  void paletteMixesPaintAndLoadsTheBrush() {
+    // Blue and yellow put out on the palette side by side, scrubbed together with the brush, and
+    // the brush, loaded from the puddle by painting through it, paints green on the canvas
+    // (docs/STUDIO.md "Palette").
+    w_->new_canvas(kW, kH, QColor(240, 235, 225));
+    w_->settle();
+    PalettePanel* pal = w_->palette();
+    on_thread(*pal->sim(), [](SimThread& s) {
+      s.write_canvas([](TileStore& c) { c.clear(); });
+      return 0;
+    });
+    const float pw = float(preset_.palette_width), ph = float(preset_.palette_height);
+    PaintLoad blue, yellow;
+    blue.ryb[0] = 0.05f, blue.ryb[1] = 0.1f, blue.ryb[2] = 0.9f;
+    yellow.ryb[0] = 0.05f, yellow.ryb[1] = 0.9f, yellow.ryb[2] = 0.05f;
+    pal->put_paint(QPointF(0.38 * pw, 0.5 * ph), blue);
+    pal->put_paint(QPointF(0.62 * pw, 0.5 * ph), yellow);
+    w_->clean_brush();
+    w_->settle();
+    QVERIFY(!w_->brush_on_palette());
+    // Back and forth through both dabs.
+    for (int k = 0; k < 4; ++k) {
+      const double y = 0.5 * ph + (k % 2 ? 2.0 : -2.0);
+      const QPointF a(0.2 * pw, y), b(0.8 * pw, y);
+      tablet_stroke(pal->view(), line_points(k % 2 ? b : a, k % 2 ? a : b, 40, 0.6f), 20);
+    }
+    w_->settle();
+    QVERIFY2(w_->brush_on_palette(), "painting on the palette carries the brush there");
+    const auto [mixed, on_palette] = on_thread(*pal->sim(), [](SimThread& s) {
+      TileStore c = s.sim().settled_canvas_copy(Device{});
+      return wet_pigment(c);
+    });
+    const BrushPicture loaded = on_thread(*pal->sim(), [](SimThread& s) { return s.sim().brush_picture(); });
+    qInfo("palette: %.1f cells of paint, mean RYB %.2f %.2f %.2f; the brush: RYB %.2f %.2f %.2f, fill %.2f", on_palette,
+          mixed.x, mixed.y, mixed.z, loaded.mean_ryb.x, loaded.mean_ryb.y, loaded.mean_ryb.z, loaded.amount);
+    QVERIFY2(loaded.amount > 0.05f, "the brush picked paint up on the palette");
+    QVERIFY2(loaded.mean_ryb.y > 0.2f && loaded.mean_ryb.z > 0.2f, "the brush holds both the blue and the yellow");
+    // Painting on the canvas carries the brush back with its paint.
+    stroke(60.f, 0.6f);
+    QVERIFY(!w_->brush_on_palette());
+    const auto [painted, on_canvas] = on_sim(*w_, [](SimThread& s) {
+      TileStore c = s.sim().settled_canvas_copy(Device{});
+      return wet_pigment(c);
+    });
+    const Vec3 rgb = ryb_to_rgb(painted);
+    qInfo("canvas: %.1f cells of paint, mean RYB %.2f %.2f %.2f, RGB %.2f %.2f %.2f", on_canvas, painted.x, painted.y,
+          painted.z, rgb.x, rgb.y, rgb.z);
+    QVERIFY2(on_canvas > 1.0, "the brush loaded on the palette paints the canvas");
+    QVERIFY2(painted.y > 0.2f && painted.z > 0.2f && painted.x < 0.2f, "green paint: yellow and blue, little red");
+    QVERIFY2(rgb.y > rgb.x && rgb.y > rgb.z, "it looks green");
+    // The palette is saved with the painting and comes back on open.
+    const auto palette_volume = [&] {
+      return on_thread(*pal->sim(), [](SimThread& s) {
+        TileStore c = s.sim().settled_canvas_copy(Device{});
+        return canonical_volume(c, false);
+      });
+    };
+    const std::vector<uint8_t> saved = palette_volume();
+    const QString path = dir_->path() + "/palette.ora";
+    QVERIFY(w_->save_to(path, true));
+    pal->put_paint(QPointF(0.5 * pw, 0.2 * ph), blue);  // the palette changes after the save
+    w_->settle();
+    QVERIFY(palette_volume() != saved);
+    QVERIFY(w_->open_from(path));
+    w_->settle();
+    QVERIFY2(palette_volume() == saved, "the painting reopens with its palette");
   }
 
   void eyedropperPicksThePaintedPigment() {

@@ -165,8 +165,8 @@ std::vector<uint8_t> encode_volume(const TileStore& canvas) {
 }
 
 TileStore decode_volume(const uint8_t* p, size_t size, const Device& device, const std::string& what,
-                        const LoadLimits& limits) {
-  const std::string w = what + ": paint volume (" + kVolumeEntry + ")";
+                        const LoadLimits& limits, const char* entry) {
+  const std::string w = what + ": " + (entry == kPaletteEntry ? "palette" : "paint volume") + " (" + entry + ")";
   if (size < kFixedHeader || std::memcmp(p, kVolumeMagic, 8) != 0) WB_THROW(w + " has no volume header (wrong magic)");
   const uint32_t version = get_u32(p + 8);
   if (version > kVolumeFormatVersion)
@@ -253,6 +253,7 @@ void save_painting(const std::string& path, const TileStore& canvas, const Image
   const std::vector<uint8_t> thumb_px = thumbnail(merged, options.thumbnail_px, tw, th);
   const std::vector<uint8_t> thumb = encode_png8(thumb_px.data(), tw, th, 4);
   const std::vector<uint8_t> volume = encode_volume(canvas);
+  const std::vector<uint8_t> palette = options.palette ? encode_volume(*options.palette) : std::vector<uint8_t>{};
   nlohmann::json meta = metadata.is_null() ? nlohmann::json::object() : metadata;
   const std::string meta_s = meta.dump(2);
   const std::vector<uint8_t> meta_b(meta_s.begin(), meta_s.end());
@@ -275,8 +276,9 @@ void save_painting(const std::string& path, const TileStore& canvas, const Image
   const Entry entries[] = {{"mimetype", &mimetype, true},          {"stack.xml", &stack, false},
                            {"data/paint.png", &png, true},         {"mergedimage.png", &png, true},
                            {"Thumbnails/thumbnail.png", &thumb, true}, {kVolumeEntry, &volume, true},
-                           {kMetadataEntry, &meta_b, false}};
+                           {kMetadataEntry, &meta_b, false},       {kPaletteEntry, &palette, true}};
   for (const Entry& e : entries) {
+    if (e.data == &palette && !options.palette) continue;
     zip_source_t* s = zip_source_buffer(za.get(), e.data->data(), e.data->size(), 0);
     if (!s) WB_THROW(path + ": save: " + zip_strerror(za.get()));
     const zip_int64_t idx = zip_file_add(za.get(), e.name, s, ZIP_FL_ENC_UTF_8 | ZIP_FL_OVERWRITE);
@@ -343,7 +345,12 @@ Painting load_painting_bytes(const uint8_t* bytes, size_t size, const std::strin
     WB_THROW(path + ": an OpenRaster image without a wetbrush paint volume (" + kVolumeEntry +
              "), made by another program: wetbrush needs the 3D paint");
   const auto vol = read_entry(za.get(), vi, kVolumeEntry, path, limits.max_volume_entry_bytes);
-  Painting p{decode_volume(vol.data(), vol.size(), device, path, limits), nlohmann::json::object()};
+  Painting p{decode_volume(vol.data(), vol.size(), device, path, limits), nlohmann::json::object(), std::nullopt};
+  const zip_int64_t pi = zip_name_locate(za.get(), kPaletteEntry, 0);
+  if (pi >= 0) {
+    const auto pal = read_entry(za.get(), pi, kPaletteEntry, path, limits.max_volume_entry_bytes);
+    p.palette.emplace(decode_volume(pal.data(), pal.size(), device, path, limits, kPaletteEntry));
+  }
   const zip_int64_t mi = zip_name_locate(za.get(), kMetadataEntry, 0);
   if (mi >= 0) {
     const auto m = read_entry(za.get(), mi, kMetadataEntry, path, limits.max_metadata_bytes);

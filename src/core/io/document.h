@@ -6,6 +6,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,10 +22,13 @@ inline constexpr uint32_t kVolumeFormatVersion = 1;
 inline constexpr const char* kOraMimetype = "image/openraster";
 inline constexpr const char* kVolumeEntry = "wetbrush/volume.bin";
 inline constexpr const char* kMetadataEntry = "wetbrush/metadata.json";
+/// The studio's palette (a small canvas of its own), in the volume entry's format.
+inline constexpr const char* kPaletteEntry = "wetbrush/palette.bin";
 
 struct Painting {
   TileStore canvas;
   nlohmann::json metadata;
+  std::optional<TileStore> palette;  ///< the palette saved with the painting, if any
 };
 
 struct SaveOptions {
@@ -32,6 +36,7 @@ struct SaveOptions {
   /// a hook that throws makes the save fail there (tests of atomicity).
   std::function<void(const std::string& stage)> fault_hook;
   int thumbnail_px = 256;  ///< longest side of Thumbnails/thumbnail.png
+  const TileStore* palette = nullptr;  ///< saved as wetbrush/palette.bin when given
 };
 
 /// Writes the painting atomically: the whole file goes to a temporary file in the same
@@ -65,7 +70,8 @@ Painting load_painting_bytes(const uint8_t* bytes, size_t size, const std::strin
 
 /// The volume entry alone (exposed for tests and tools).
 std::vector<uint8_t> encode_volume(const TileStore& canvas);
+/// `entry` names the archive entry in messages (the volume or the palette).
 TileStore decode_volume(const uint8_t* bytes, size_t size, const Device& device, const std::string& what,
-                        const LoadLimits& limits = {});
+                        const LoadLimits& limits = {}, const char* entry = kVolumeEntry);
 
 }  // namespace wb

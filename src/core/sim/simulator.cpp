@@ -261,6 +261,14 @@ TileStore Simulator::settled_canvas_copy(const Device& device) {
   return copy;
 }
 
+BristleLoadHost Simulator::brush_paint() const { return load_->to_host(); }
+
+void Simulator::set_brush_paint(const BristleLoadHost& paint) {
+  const double before = load_->total_mass(ws_);
+  load_->from_host(paint);
+  books_.external(load_->total_mass(ws_) - before);
+}
+
 void Simulator::lay_ground(const CanvasGround& ground, Vec3 primer_ryb) {
   if (ground.weave == Weave::Smooth) return;
   const WeaveField w = weave_field(ground, config_.params.grid.cell_size, primer_ryb);

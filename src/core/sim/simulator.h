@@ -99,6 +99,12 @@ class Simulator {
   /// A palette event of a stroke file or the studio: dip, wipe, clean or dry (the one mapping).
   void apply(const StrokeEvent& e);
 
+  /// The paint on the brush, sample by sample (a brush carried to another simulator of the same
+  /// brush: the studio's palette).
+  BristleLoadHost brush_paint() const;
+  /// The brush takes this paint, sample by sample (brush_paint of a simulator with the same
+  /// brush); the books record the change as paint that entered or left from outside.
+  void set_brush_paint(const BristleLoadHost& paint);
   /// "Let it dry": flushes the window, dries every painted cell of the canvas, reloads.
   void dry_canvas();
   /// Primes the empty canvas (throws wb::Error if it holds paint) with a woven ground of the primer's pigment (ground.h); the books
