@@ -72,40 +72,64 @@ std::vector<ScriptPoint> line_points(QPointF a, QPointF b, int n, float pressure
 namespace wb::studio {
 
 double run_demo_painting(MainWindow& w) {
+  // A small painting on linen, 8 x 6 cm: two colours put out on the palette and mixed there, a
+  // stroke of the mix, one of a well's paint across it while it is wet, and a light pass of a
+  // lightly loaded brush that catches the weave.
+  const int W = 400, H = 300;
+  w.new_canvas(W, H, QColor(236, 229, 212), CanvasGround::of(Weave::Linen));
+  w.settle();
   CanvasView* v = w.view();
-  const QSize c = v->canvas_size();
-  const double W = c.width(), H = c.height();
-  struct Pass {
-    int well;
-    double y;
-    double amp;
-    float pressure;
-    float tilt;
+  v->fit();
+  PalettePanel* pal = w.palette();
+  const QSize ps = pal->view()->canvas_size();
+  const double pw = ps.width(), ph = ps.height();
+  const auto well = [&](int i, float load) {
+    PaintLoad paint = w.paint_panel()->current_paint();
+    const auto ryb = qcolor_to_ryb(w.paint_panel()->well_color(i));
+    for (int k = 0; k < 3; ++k) paint.ryb[k] = ryb[k];
+    paint.load = load;
+    return paint;
   };
-  // Well 0 and well 2 of the default palette; the third stroke crosses the wet first one.
-  const Pass passes[] = {{0, 0.40, 0.06, 0.6f, 20.f}, {2, 0.55, 0.08, 0.75f, -15.f}, {0, 0.66, 0.05, 0.5f, 25.f}};
+  pal->put_paint(QPointF(0.35 * pw, 0.5 * ph), well(0, 1.f));
+  pal->put_paint(QPointF(0.65 * pw, 0.5 * ph), well(2, 1.f));
+  w.clean_brush();
+  w.settle();
   QElapsedTimer pen;
   double pen_s = 0.0;
+  const auto timed = [&](CanvasView* view, const std::vector<ScriptPoint>& pts) {
+    pen.start();
+    tablet_stroke(view, pts, 16);
+    pen_s += pen.elapsed() / 1000.0;
+    w.settle();
+  };
+  // Scrubbed together on the palette: the brush comes away with the mix.
+  for (int k = 0; k < 3; ++k) {
+    const double y = ph * (0.5 + 0.04 * (k - 1));
+    timed(pal->view(), line_points(QPointF(pw * (k % 2 ? 0.8 : 0.2), y), QPointF(pw * (k % 2 ? 0.2 : 0.8), y), 40,
+                                   0.6f, k % 2 ? -15.f : 15.f));
+  }
+  struct Pass {
+    int well;      ///< -1: the brush as it comes from the palette
+    float load;
+    double y, amp;
+    float pressure, tilt;
+  };
+  const Pass passes[] = {{-1, 0.f, 0.38, 0.06, 0.6f, 20.f}, {2, 1.f, 0.52, 0.08, 0.75f, -15.f}, {0, 0.3f, 0.68, 0.04, 0.2f, 25.f}};
   for (const Pass& p : passes) {
-    PaintLoad paint = w.paint_panel()->current_paint();
-    const QColor col = w.paint_panel()->well_color(p.well);
-    const auto ryb = qcolor_to_ryb(col);
-    for (int k = 0; k < 3; ++k) paint.ryb[k] = ryb[k];
-    w.clean_brush();
-    w.dip(paint);
+    if (p.well >= 0) {
+      w.clean_brush();
+      w.dip(well(p.well, p.load));
+    }
     std::vector<ScriptPoint> pts;
     const int n = 60;
     for (int i = 0; i < n; ++i) {
       const double s = double(i) / (n - 1);
-      const double x = W * (0.30 + 0.4 * s);
+      const double x = W * (0.15 + 0.7 * s);
       const double y = H * (p.y + p.amp * std::sin(s * 6.28318 * 1.1));
       const float pr = p.pressure * float(0.6 + 0.4 * std::sin(s * 3.14159));
       pts.push_back({QPointF(x, y), pr, p.tilt, 0.f, 0.f});
     }
-    pen.start();
-    tablet_stroke(v, pts, 16);
-    pen_s += pen.elapsed() / 1000.0;
-    w.settle();
+    timed(v, pts);
   }
   return pen_s;
 }

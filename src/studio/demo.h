@@ -27,9 +27,9 @@ std::vector<ScriptPoint> line_points(QPointF a, QPointF b, int n, float pressure
 
 namespace wb::studio {
 class MainWindow;
-/// A small scripted painting: three curved strokes in two colours dipped from the palette, with
-/// varying pressure and tilt (the README screenshot and the frame-rate measurement). Returns
-/// the seconds the pen spent on the canvas.
+/// A small scripted painting on linen: two wells' paint put out on the palette and mixed there,
+/// three curved strokes (the mix, a well's paint, a dry-brush pass) with varying pressure and tilt
+/// (the README screenshot and the frame-rate measurement). Returns the seconds the pen spent down.
 double run_demo_painting(MainWindow& w);
 /// Stroke k of an endless scripted session (`--paint-loop`, the autosave and recovery test): a
 /// dip, then a straight stroke of about a second across row k mod 5 of the canvas, alternating in

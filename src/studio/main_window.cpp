@@ -231,7 +231,7 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   };
   dock(brush_panel_, "Brush");
   dock(paint_panel_, "Paint");
-  dock(palette_, "Palette");
+  dock(palette_, "Palette (Ctrl + click: put out paint)");
   brush_preview_ = new BrushPreview;
   dock(brush_preview_, "Brush preview");
   dock(view_panel_, "View and input");

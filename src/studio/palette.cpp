@@ -1,6 +1,5 @@
 #include "studio/palette.h"
 
-#include <QLabel>
 #include <QVBoxLayout>
 
 #include <algorithm>
@@ -62,15 +61,13 @@ PalettePanel::PalettePanel(const SimConfig& config, const RenderParams& render, 
   view_->set_canvas_size(width, height);
   view_->set_cursor_radius(c.brush.width * 0.5f);
   view_->set_place_paint(true);
-  view_->setMinimumSize(240, 150);
+  view_->setMinimumSize(320, 200);
+  view_->setToolTip("Ctrl + click: put out the selected well's paint. Paint here to mix; the brush carries its "
+                    "paint between palette and canvas. Alt + click: eyedropper.");
   connect(sim_.get(), &SimThread::frameReady, view_, qOverload<>(&QWidget::update));
-  auto* hint = new QLabel("Ctrl + click: put out the selected well's paint. Paint on the palette to mix; "
-                          "the brush carries its paint between palette and canvas.");
-  hint->setWordWrap(true);
   auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(2, 2, 2, 2);
   layout->addWidget(view_, 1);
-  layout->addWidget(hint);
 
   connect(view_, &CanvasView::penPress, this, [this](PenInput p, double t) {
     Q_EMIT aboutToPaint();

@@ -94,6 +94,33 @@ TEST_F(DocumentTest, SaveLoadRoundTripIsExact) {
   fs::remove_all(dir);
 }
 
+TEST_F(DocumentTest, PaletteRoundTripsAndADamagedOneIsNamed) {
+  const std::string dir = fresh_dir("palette");
+  TileStore c = random_canvas(CanvasDims{64, 48, 8}, 3), pal = random_canvas(CanvasDims{40, 24, 8}, 5);
+  SaveOptions with_palette;
+  with_palette.palette = &pal;
+  save_painting(dir + "/p.ora", c, merged_for(c), nullptr, with_palette);
+  Painting p = load_painting(dir + "/p.ora", device_);
+  expect_same_volume(c, p.canvas);
+  ASSERT_TRUE(p.palette.has_value());
+  expect_same_volume(pal, *p.palette);
+  save_painting(dir + "/n.ora", c, merged_for(c), nullptr);
+  EXPECT_FALSE(load_painting(dir + "/n.ora", device_).palette.has_value()) << "no palette saved, none read";
+  // A damaged palette is refused, and the message says it is the palette.
+  std::vector<uint8_t> file = read_file(dir + "/p.ora");
+  const std::vector<uint8_t> v = encode_volume(pal);
+  const auto at = std::search(file.begin(), file.end(), v.begin(), v.end());
+  ASSERT_NE(at, file.end()) << "the palette is stored uncompressed";
+  file[size_t(at - file.begin()) + v.size() / 2] ^= 0x5a;
+  try {
+    load_painting_bytes(file.data(), file.size(), "damaged.ora", device_);
+    ADD_FAILURE() << "a damaged palette was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("damaged.ora: palette (wetbrush/palette.bin)"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
 TEST_F(DocumentTest, FileIsAnOpenRasterImage) {
   const std::string dir = fresh_dir("ora");
   TileStore c = random_canvas(CanvasDims{600, 300, 2}, 7);

@@ -187,6 +187,29 @@ class LayerPropertiesTest : public SimulatorTest {
     sim.canvas().gather(w);
     return w.to_host();
   }
+
+  /// New paint per column (row-major, cell volumes): the cells that are not dried, where a layer
+  /// written dried, or a dried ground, lies under what a stroke laid.
+  std::vector<double> fresh_columns(Simulator& sim) {
+    const CanvasDims d = sim.canvas().dims();
+    const auto f = canvas_fields(sim);
+    const size_t dryness = 5;  // PaintWindow fields: density, r, y, b, oil, dryness
+    std::vector<double> col(size_t(d.width) * d.height, 0.0);
+    for (int z = 0; z < d.depth; ++z)
+      for (size_t i = 0; i < col.size(); ++i) {
+        const size_t id = size_t(z) * col.size() + i;
+        if (f[dryness][id] < sim.config().params.grid.dry_threshold) col[i] += f[0][id];
+      }
+    return col;
+  }
+
+  /// The scumble's light brush: white (RYB 0), a third of its capacity.
+  static void load_light_white(Simulator& sim, float load = 0.3f) {
+    PaintLoad white;
+    white.ryb[0] = white.ryb[1] = white.ryb[2] = 0.f;
+    white.load = load;
+    sim.load_paint(white);
+  }
 };
 
 // --- pick-up -----------------------------------------------------------------------------------
@@ -332,27 +355,19 @@ TEST_F(LayerPropertiesTest, LightBrushScumblesTheTopsOfADriedRidgedLayer) {
     }
     return p;
   });
-  PaintLoad white;
-  white.ryb[0] = white.ryb[1] = white.ryb[2] = 0.f;
-  white.load = env_or("WB_LAYER_LOAD", 0.3f);
-  sim.load_paint(white);
+  load_light_white(sim, env_or("WB_LAYER_LOAD", 0.3f));
   Books books;
   books.open(sim);
   drag(sim, kX0, kX1, 300.f, env_or("WB_LAYER_PRESSURE", 0.1f));
   EXPECT_LT(books.max_drift(sim), 1e-4);
   EXPECT_EQ(sim.counters().nonfinite_events, 0);
   // New paint: the cells that are not dried (the layer's cells all are).
-  const auto f = canvas_fields(sim);
-  const size_t dryness = 5;  // PaintWindow fields: density, r, y, b, oil, dryness
+  const std::vector<double> col = fresh_columns(sim);
   double tops = 0, valleys = 0;
   int n_tops = 0, n_valleys = 0;
   for (int y = int(kY) - 4; y <= int(kY) + 4; ++y)
     for (int x = int(kX0) + 24; x < int(kX1) - 16; ++x) {
-      double fresh = 0;
-      for (int z = 0; z < kDepth; ++z) {
-        const size_t id = (size_t(z) * kH + y) * kW + x;
-        if (f[dryness][id] < c.params.grid.dry_threshold) fresh += f[0][id];
-      }
+      const double fresh = col[size_t(y) * kW + x];
       (ridge(x) ? tops : valleys) += fresh;
       (ridge(x) ? n_tops : n_valleys) += 1;
     }
@@ -386,21 +401,14 @@ TEST_F(LayerPropertiesTest, LightBrushPaintsOnADriedStrokeWhateverItsHeight) {
       if (d > 0.f) p.density = d, p.pigment_r = 0.1f, p.pigment_y = 0.15f, p.pigment_b = 0.85f, p.oil = 0.3f, p.dryness = 1.f;
       return p;
     });
-    PaintLoad white;
-    white.ryb[0] = white.ryb[1] = white.ryb[2] = 0.f;
-    white.load = 0.3f;
-    sim.load_paint(white);
+    load_light_white(sim);
     drag(sim, kX0, kX1, 300.f, 0.1f);
     EXPECT_EQ(sim.counters().nonfinite_events, 0);
-    const auto f = canvas_fields(sim);
-    // New paint per column (the cells that are not dried), over the track's middle rows.
+    // New paint per column, over the track's middle rows.
+    const std::vector<double> col = fresh_columns(sim);
     auto fresh = [&](int x) {
       double v = 0;
-      for (int y = int(kY) - 4; y <= int(kY) + 4; ++y)
-        for (int z = 0; z < kDepth; ++z) {
-          const size_t id = (size_t(z) * kH + y) * kW + x;
-          if (!(f[0][id] > 0.f && f[5][id] >= c.params.grid.dry_threshold)) v += f[0][id];
-        }
+      for (int y = int(kY) - 4; y <= int(kY) + 4; ++y) v += col[size_t(y) * kW + x];
       return v / 9.0;
     };
     double before = 0, on = 0, past = 0;
@@ -438,22 +446,15 @@ TEST_F(LayerPropertiesTest, DryBrushCatchesTheWeaveOfALinenCanvas) {
       EXPECT_GT(sim.canvas().total_density(), double(kW) * kH * w.base) << "the primer is laid under the hollows";
       EXPECT_EQ(sim.books().steps().size(), 0u);
     }
-    PaintLoad white;
-    white.ryb[0] = white.ryb[1] = white.ryb[2] = 0.f;
-    white.load = 0.3f;
-    sim.load_paint(white);
+    load_light_white(sim);
     drag(sim, kX0, kX1, 300.f, 0.1f);
     EXPECT_EQ(sim.counters().nonfinite_events, 0);
     EXPECT_LT(books.max_drift(sim), 1e-4);
-    const auto f = canvas_fields(sim);
+    const std::vector<double> col = fresh_columns(sim);
     int covered = 0, columns = 0, n_crowns = 0, n_hollows = 0;
     for (int y = int(kY) - 4; y <= int(kY) + 4; ++y)
       for (int x = int(kX0) + 24; x < int(kX1) - 16; ++x) {
-        double fresh = 0;
-        for (int z = 0; z < kDepth; ++z) {
-          const size_t id = (size_t(z) * kH + y) * kW + x;
-          if (f[5][id] < c.params.grid.dry_threshold) fresh += f[0][id];
-        }
+        const double fresh = col[size_t(y) * kW + x];
         covered += fresh > 0.05, ++columns;
         if (weave != Weave::Linen) continue;
         // Crowns: the top third of the relief; hollows: the bottom third.
