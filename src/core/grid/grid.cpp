@@ -29,9 +29,9 @@ void advect_axis_d(const Device& d, GridView g, PaintWindowView s, PaintWindowVi
 void tiles_pass_d(const Device& d, GridDims g, PaintTiles tiles, const int32_t* before, int32_t* p) {
   WB_DISPATCH(d, grid_paint_tiles_pass(g, tiles, before, p));
 }
-void paint_tiles_d(const Device& d, GridDims g, const float* rho, int layers, int reach, int32_t* mark, int32_t* a,
-                   int32_t* h, int64_t* counts, int32_t* below) {
-  WB_DISPATCH(d, grid_paint_tiles(g, rho, layers, reach, mark, a, h, counts, below));
+void paint_tiles_d(const Device& d, GridDims g, const float* rho, const float* dryness, float dry_threshold, int layers,
+                   int reach, int32_t* mark, int32_t* a, int32_t* h, int64_t* counts, int32_t* below) {
+  WB_DISPATCH(d, grid_paint_tiles(g, rho, dryness, dry_threshold, layers, reach, mark, a, h, counts, below));
 }
 void copy_tiles_d(const Device& d, GridDims g, PaintTiles t, PaintWindowView s, PaintWindowView dst, bool reads) {
   WB_DISPATCH(d, grid_copy_paint_tiles(g, t, s, dst, reads));
@@ -354,7 +354,8 @@ void Grid::advect(float dt) {
   const int layers = std::min(g.nz, top + n);
   const int reach = (n + 1 + kPaintTile - 1) / kPaintTile;
   tile_counts_.fill_zero();
-  paint_tiles_d(d, g, paint.density.data(), layers, reach, tile_mark_.data(), tile_active_.data(),
+  paint_tiles_d(d, g, paint.density.data(), paint.dryness.data(), params_.dry_threshold, layers, reach,
+                tile_mark_.data(), tile_active_.data(),
                 tile_halo_.data(), tile_counts_.data(), pass_below_.data());
   const int tiles_x = (g.nx + kPaintTile - 1) / kPaintTile, tiles_y = (g.ny + kPaintTile - 1) / kPaintTile;
   const PaintTiles tiles{tile_active_.data(), tile_halo_.data(), tile_counts_.data(), layers, tiles_x,

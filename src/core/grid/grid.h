@@ -183,7 +183,8 @@ class Grid {
                               PaintTiles tiles, const int32_t* process, int32_t* painted, const int32_t* below,      \
                               int32_t* below_next);                                                                  \
   void grid_paint_tiles_pass(GridDims d, PaintTiles tiles, const int32_t* before, int32_t* process);                \
-  void grid_paint_tiles(GridDims d, const float* rho, int layers, int reach, int32_t* mark, int32_t* active,        \
+  void grid_paint_tiles(GridDims d, const float* rho, const float* dryness, float dry_threshold, int layers,        \
+                        int reach, int32_t* mark, int32_t* active,                                                \
                         int32_t* halo, int64_t* counts, int32_t* below);                                             \
   void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst, bool reads);   \
   void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt, int layers);                  \

@@ -132,19 +132,22 @@ struct TileCells {
 };
 }  // namespace detail
 
-void grid_paint_tiles(GridDims d, const float* rho, int layers, int reach, int32_t* mark, int32_t* active,
-                      int32_t* halo, int64_t* counts, int32_t* below) {
+void grid_paint_tiles(GridDims d, const float* rho, const float* dryness, float dry_threshold, int layers, int reach,
+                      int32_t* mark, int32_t* active, int32_t* halo, int64_t* counts, int32_t* below) {
   const int tx = (d.nx + kPaintTile - 1) / kPaintTile, ty = (d.ny + kPaintTile - 1) / kPaintTile;
   parallel_for(int64_t(tx) * ty, [=] WB_HD(int64_t t) {
     const int i0 = int(t % tx) * kPaintTile, j0 = int(t / tx) * kPaintTile;
     int32_t any = 0;
+    // Paint that can move: dried solid paint (a canvas's ground, a dried layer) stays put.
     for (int k = 0; k < layers && !any; ++k)
       for (int j = j0; j < j0 + kPaintTile && j < d.ny && !any; ++j)
-        for (int i = i0; i < i0 + kPaintTile && i < d.nx; ++i)
-          if (rho[d.cell(i, j, k)] > 0.f) {
+        for (int i = i0; i < i0 + kPaintTile && i < d.nx; ++i) {
+          const int64_t c = d.cell(i, j, k);
+          if (rho[c] > 0.f && !dried_solid(rho[c], dryness[c], dry_threshold)) {
             any = 1;
             break;
           }
+        }
     mark[t] = any;
   }, 1);
   // A tile within `reach` tiles of paint is advected; the ring beyond it is the halo the
