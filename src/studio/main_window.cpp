@@ -741,8 +741,17 @@ bool MainWindow::open_from(const QString& path) {
             Vec3(p.metadata["paper_rgb"][0].get<float>(), p.metadata["paper_rgb"][1].get<float>(),
                  p.metadata["paper_rgb"][2].get<float>());
       // The ground is in the volume already; the painting records what it is (for recordings).
-      const bool grounded = p.metadata.contains("ground") && p.metadata["ground"].is_object();
-      s.set_ground(grounded ? std::optional(ground_from_json(p.metadata["ground"], file + ": ground")) : std::nullopt);
+      // A ground entry this build cannot read costs the recordings their ground, not the painting.
+      std::optional<CanvasGround> ground;
+      if (p.metadata.contains("ground") && p.metadata["ground"].is_object()) {
+        try {
+          ground = ground_from_json(p.metadata["ground"], file + ": metadata: ground");
+        } catch (const Error& e) {
+          std::fprintf(stderr, "wetbrush-studio: warning: %s (the painting opens; recordings from it have no ground)\n",
+                       e.what());
+        }
+      }
+      s.set_ground(ground);
       SimConfig c = s.config();
       c.canvas = p.canvas.dims();
       s.rebuild(c, false);
