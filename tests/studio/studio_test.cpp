@@ -421,48 +421,72 @@ class StudioTest : public QObject {
   }
 
   void canvasTextureCatchesADryBrush() {
-    // The same lightly loaded brush dragged lightly across a smooth board and across linen: on
-    // linen it rests on the threads' crowns and bridges the hollows (docs/STUDIO.md "Canvas texture").
-    // The track runs across the weave at a slant: this brush is narrower than the weave's repeat,
-    // and one drawn along a groove between two threads sinks into it.
+    // A lightly loaded brush dragged lightly across linen in the studio (a slanted stroke, across
+    // the weave). The pen's timing follows the machine's load, so the property is measured on the
+    // session's own recording, which carries the ground: `wetbrush replay` of it, and of the same
+    // recording without its ground (a smooth board), paint the same pen input on both: on linen
+    // the brush covers less of its track and lays its paint on the threads' crowns
+    // (docs/STUDIO.md "Canvas texture").
     PaintLoad dry = w_->paint_panel()->current_paint();
     dry.load = 0.3f;
     const QColor paper(235, 228, 210);
     const CanvasGround linen = CanvasGround::of(Weave::Linen);
     const QPointF a(30.f, 45.f), b(130.f, 75.f);
-    const float nx = -(b.y() - a.y()), ny = b.x() - a.x(), nl = std::hypot(nx, ny);
+    w_->new_canvas(kW, kH, paper, linen);
+    w_->settle();
+    w_->clean_brush();
+    w_->dip(dry);
+    tablet_stroke(w_->view(), line_points(a, b, 48, 0.1f), 20);
+    w_->settle();
+    const QString rec = dir_->path() + "/linen-session.json";
+    QVERIFY(w_->save_recording(rec));
+    nlohmann::json smooth = nlohmann::json::parse(read_bytes(rec).toStdString());
+    QVERIFY2(smooth["canvas"].contains("ground"), "the recording carries the ground");
+    smooth["canvas"].erase("ground");
+    const QString rec_smooth = dir_->path() + "/smooth-session.json";
+    {
+      QFile f(rec_smooth);
+      QVERIFY(f.open(QIODevice::WriteOnly));
+      f.write(QByteArray::fromStdString(smooth.dump()));
+    }
+    const auto replay = [&](const QString& stroke) {
+      const QString out = stroke + ".ora";
+      QProcess cli;
+      QProcessEnvironment env = QProcessEnvironment::systemEnvironment();
+      env.insert("OMP_NUM_THREADS", "1");
+      cli.setProcessEnvironment(env);
+      cli.start(WB_CLI_PATH, {"replay", stroke, "--device", "cpu", "--save", out, "--quiet"});
+      const bool done = cli.waitForFinished(120000) && cli.exitStatus() == QProcess::NormalExit && cli.exitCode() == 0;
+      if (!done) qWarning("%s", cli.readAllStandardError().constData());
+      return done ? std::optional(load_painting(out.toStdString(), Device::parse("cpu"))) : std::nullopt;
+    };
+    const float nx = -float(b.y() - a.y()), ny = float(b.x() - a.x()), nl = std::hypot(nx, ny);
+    const WeaveField wf = weave_field(linen, GridParams{}.cell_size, Vec3{});
     double cover[2] = {}, crowns = 0, hollows = 0;
     for (const bool woven : {false, true}) {
-      w_->new_canvas(kW, kH, paper, woven ? linen : CanvasGround{});
-      w_->settle();
-      w_->clean_brush();
-      w_->dip(dry);
-      tablet_stroke(w_->view(), line_points(a, b, 48, 0.1f), 20);
-      w_->settle();
-      const std::vector<float> fresh = column_density(*w_, true);
-      const WeaveField wf = weave_field(linen, GridParams{}.cell_size, Vec3{});
+      std::optional<Painting> p = replay(woven ? rec : rec_smooth);
+      QVERIFY2(p.has_value(), "wetbrush replay of the session's recording");
+      const std::vector<float> fresh = column_density(p->canvas, true);
       int covered = 0, columns = 0, n_crowns = 0, n_hollows = 0;
       for (int y = 0; y < kH; ++y)
         for (int x = 40; x < 120; ++x) {
           const float d = std::abs(((x + 0.5f) - float(a.x())) * nx + ((y + 0.5f) - float(a.y())) * ny) / nl;
           if (d > 4.f) continue;  // the band under the brush
           const float v = fresh[size_t(y) * kW + x];
-          covered += v > 0.05f, ++columns;
+          if (d <= 2.f) covered += v > 0.05f, ++columns;  // coverage under the brush's middle
           if (!woven) continue;
-          const float h = (weave_height(wf, x + 0.5f, y + 0.5f) - wf.base) / wf.relief;
           // Crowns: the top third of the relief; hollows: the bottom third.
+          const float h = (weave_height(wf, x + 0.5f, y + 0.5f) - wf.base) / wf.relief;
           if (h > 0.67f) crowns += v, ++n_crowns;
           if (h < 0.33f) hollows += v, ++n_hollows;
         }
       cover[woven] = double(covered) / columns;
       if (woven) crowns /= std::max(n_crowns, 1), hollows /= std::max(n_hollows, 1);
     }
-    qInfo("dry brush: covers %.2f of the track on a smooth board, %.2f on linen; on linen %.3f cells per column on "
-          "the crowns, %.3f in the hollows", cover[0], cover[1], crowns, hollows);
-    // The pen's timing follows the machine's load, so the two strokes differ a little: the strict
-    // comparison of coverage is the core test's (LayerPropertiesTest.DryBrushCatchesTheWeaveOfALinenCanvas).
+    qInfo("dry brush (the session replayed): covers %.2f of the track on a smooth board, %.2f on linen; on linen "
+          "%.3f cells per column on the crowns, %.3f in the hollows", cover[0], cover[1], crowns, hollows);
     QVERIFY2(cover[0] > 0.25, "the light brush paints the smooth board");
-    QVERIFY2(cover[1] < cover[0], "linen's hollows stay bare under a dry brush");
+    QVERIFY2(cover[1] < 0.9 * cover[0], "linen's hollows stay bare under a dry brush");
     QVERIFY2(crowns > 1.5 * hollows, "the paint lies on the threads' crowns");
     // The ground is the painting's: saved, reopened, and in the recording of the session.
     const QString path = dir_->path() + "/linen.ora";
@@ -472,8 +496,8 @@ class StudioTest : public QObject {
     w_->settle();
     const auto ground = on_sim(*w_, [](SimThread& s) { return s.ground(); });
     QVERIFY2(ground && *ground == linen, "the painting reopens on its linen");
-    const auto rec = on_sim(*w_, [](SimThread& s) { return s.recording(); });
-    QVERIFY2(rec.ground && *rec.ground == linen, "a recording from the reopened painting keeps the ground");
+    const Stroke reopened = on_sim(*w_, [](SimThread& s) { return s.recording(); });
+    QVERIFY2(reopened.ground && *reopened.ground == linen, "a recording from the reopened painting keeps the ground");
     const std::vector<float> all = column_density(*w_);
     const float crown = weave_height(weave_field(linen, GridParams{}.cell_size, Vec3{}), 2.5f, 2.5f);
     QVERIFY2(std::abs(all[2 * kW + 2] - crown) < 0.5f, "the weave is in the reopened volume");
