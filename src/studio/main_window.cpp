@@ -552,27 +552,8 @@ std::optional<std::array<float, 3>> MainWindow::pick_color(QPointF canvas, SimTh
 }
 
 QString MainWindow::ground_refusal(int width, int height, const CanvasGround& g) const {
-  if (g.weave == Weave::Smooth) return {};
-  const float cell = GridParams{}.cell_size;
-  const int depth = options_.preset.canvas_depth;
-  const WeaveField f = weave_field(g, cell, Vec3{});
-  if (f.base + f.relief * 4.f / 3.f > 0.5f * float(depth))
-    return QString("The ground (%1 mm of primer and %2 mm of relief) is thicker than half the canvas's paint depth "
-                   "(%3 mm): choose less relief.")
-        .arg(g.priming_mm)
-        .arg(g.relief_mm)
-        .arg(depth * cell * 1e3);
-  // A woven ground is paint in every tile: the whole volume is held (and saved) from the start.
-  const uint64_t tiles = uint64_t((width + kTileSize - 1) / kTileSize) * uint64_t((height + kTileSize - 1) / kTileSize);
-  const uint64_t bytes = tiles * kTileSize * kTileSize * uint64_t(depth) * 14;
-  if (bytes > LoadLimits{}.max_paint_bytes)
-    return QString("A woven ground fills the whole canvas: %1 x %2 cells would hold %3 GiB of paint, more than a "
-                   "painting may (%4 GiB). Choose a smaller canvas or a smooth board.")
-        .arg(width)
-        .arg(height)
-        .arg(double(bytes) / double(1 << 30), 0, 'f', 1)
-        .arg(double(LoadLimits{}.max_paint_bytes) / double(1 << 30), 0, 'f', 0);
-  return {};
+  const std::string why = wb::ground_refusal(g, width, height, options_.preset.canvas_depth, GridParams{}.cell_size);
+  return why.empty() ? QString() : QString::fromStdString(why) + ". Choose less relief, a smaller canvas or a smooth board.";
 }
 
 void MainWindow::new_canvas(int width, int height, QColor paper, const CanvasGround& ground) {

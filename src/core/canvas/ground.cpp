@@ -1,6 +1,7 @@
 #include "core/canvas/ground.h"
 
 #include <algorithm>
+#include <cstdio>
 
 #include "core/exec/error.h"
 
@@ -59,6 +60,31 @@ CanvasGround ground_from_json(const nlohmann::json& j, const std::string& what) 
     WB_REQUIRE(k == "weave" || k == "thread_mm" || k == "relief_mm" || k == "priming_mm",
                what + ": unknown key '" + k + "'");
   return g;
+}
+
+std::string ground_refusal(const CanvasGround& g, int width, int height, int depth, float cell_size_m) {
+  if (g.weave == Weave::Smooth) return {};
+  const WeaveField w = weave_field(g, cell_size_m, Vec3{});
+  char buf[256];
+  // The crowns reach base + 4/3 relief (the thickest linen thread); paint needs room above.
+  if (w.base + w.relief * 4.f / 3.f > 0.5f * float(depth)) {
+    std::snprintf(buf, sizeof buf,
+                  "the ground (%.2f mm of primer under %.2f mm of relief) is thicker than half the canvas's paint "
+                  "depth (%d cells, %.1f mm)",
+                  g.priming_mm, g.relief_mm, depth, double(depth) * cell_size_m * 1e3);
+    return buf;
+  }
+  const int tile = 16;  // kTileSize (tile_store.h): a tile holds every cell of its columns
+  const uint64_t tiles = uint64_t((width + tile - 1) / tile) * uint64_t((height + tile - 1) / tile);
+  const uint64_t bytes = tiles * tile * tile * uint64_t(depth) * 14;
+  if (bytes > kMaxGroundBytes) {
+    std::snprintf(buf, sizeof buf,
+                  "a woven ground fills the whole canvas: %d x %d x %d cells would hold %.1f GiB of paint, more than "
+                  "a painting may (%.0f GiB)",
+                  width, height, depth, double(bytes) / double(1 << 30), double(kMaxGroundBytes) / double(1 << 30));
+    return buf;
+  }
+  return {};
 }
 
 WeaveField weave_field(const CanvasGround& g, float cell_size_m, Vec3 priming_ryb) {

@@ -5,6 +5,7 @@
 // loaded brush rests on the threads' crowns and leaves the valleys bare (dry brush).
 #pragma once
 #include <cmath>
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -54,6 +55,13 @@ struct WeaveField {
   float oil = 0.1f;      ///< a lean, opaque primer
 };
 WeaveField weave_field(const CanvasGround& g, float cell_size_m, Vec3 priming_ryb);
+
+/// Most paint a woven ground may lay, bytes: what a painting may hold (LoadLimits::max_paint_bytes),
+/// so that a primed canvas always opens again. A ground fills every tile of the canvas.
+inline constexpr uint64_t kMaxGroundBytes = uint64_t(4) << 30;
+/// Why a width x height x depth canvas cannot take this ground: thicker than half the paint depth,
+/// or more paint in its tiles than kMaxGroundBytes. Empty when it can (and for a smooth ground).
+std::string ground_refusal(const CanvasGround& g, int width, int height, int depth, float cell_size_m);
 
 /// A thread's thickness factor in [1 - u/3, 1 + u/3] from its index and a segment along it.
 WB_HD WB_INLINE float weave_thickness(int thread, int segment, float unevenness) {

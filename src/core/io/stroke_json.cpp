@@ -23,6 +23,7 @@
 #include "core/io/brush_json.h"
 #include "core/io/pen_pose.h"
 #include "core/io/stroke.h"
+#include "core/grid/grid_params.h"
 #include "core/io/limits.h"
 
 namespace wb {
@@ -341,7 +342,12 @@ Stroke parse_stroke_json(std::string_view text, const std::string& source) {
       c.fail("canvas " + std::to_string(st.canvas.width) + " x " + std::to_string(st.canvas.height) + " has more than " +
              std::to_string(kMaxCanvasCells) + " cells (16384 x 16384): refused");
     if (c.has("paper_rgb")) st.paper_rgb = c.triple("paper_rgb", 0.0, 1.0);
-    if (c.has("ground")) st.ground = ground_from_json(root.at("canvas").at("ground"), source + ": canvas.ground");
+    if (c.has("ground")) {
+      st.ground = ground_from_json(root.at("canvas").at("ground"), source + ": canvas.ground");
+      const std::string why =
+          ground_refusal(*st.ground, st.canvas.width, st.canvas.height, st.canvas.depth, GridParams{}.cell_size);
+      if (!why.empty()) c.fail(why + ": refused", "ground");
+    }
     c.warn_unknown(st.warnings);
   }
   if (top.has("brush")) st.brush = brush_from_json(root.at("brush"), source + ": brush", &st.warnings);

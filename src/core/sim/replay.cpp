@@ -1,8 +1,9 @@
-#include "core/color/ryb.h"
 #include "core/sim/replay.h"
 
 #include <algorithm>
 #include <cmath>
+
+#include "core/color/ryb.h"
 
 namespace wb {
 

@@ -271,11 +271,10 @@ void Simulator::set_brush_paint(const BristleLoadHost& paint) {
 
 void Simulator::lay_ground(const CanvasGround& ground, Vec3 primer_ryb) {
   if (ground.weave == Weave::Smooth) return;
+  const CanvasDims& d = config_.canvas;
+  const std::string why = ground_refusal(ground, d.width, d.height, d.depth, config_.params.grid.cell_size);
+  WB_REQUIRE(why.empty(), why);
   const WeaveField w = weave_field(ground, config_.params.grid.cell_size, primer_ryb);
-  // The crowns reach base + 4/3 relief (the thickest linen thread); paint needs room above.
-  WB_REQUIRE(w.base + w.relief * 4.f / 3.f <= 0.5f * float(config_.canvas.depth),
-             "the ground (" + std::to_string(ground.priming_mm + ground.relief_mm) + " mm) is thicker than half the " +
-                 std::to_string(config_.canvas.depth) + "-cell canvas depth");
   replace_canvas([&](TileStore& canvas) { canvas.lay_weave(w); });
 }
 
