@@ -147,7 +147,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"number-overflow.json", {":5:31:", "number overflow"}},
         BadCase{"absurd-magnitude.json", {"samples[1].twist", "not a plausible value"}},
         BadCase{"unknown-event.json", {"events[1].type", "unknown event type \"splash\""}},
-        BadCase{"not-an-object.json", {"top level: expected an object, found an array"}}),
+        BadCase{"not-an-object.json", {"top level: expected an object, found an array"}},
+        BadCase{"ground-unknown-weave.json", {"canvas.ground: unknown weave 'burlap'"}},
+        BadCase{"ground-too-thick.json", {"canvas.ground", "thicker than half the canvas's paint depth", "refused"}},
+        BadCase{"ground-too-large.json", {"canvas.ground", "224.0 GiB of paint", "refused"}}),
     [](const ::testing::TestParamInfo<BadCase>& info) {
       std::string n = info.param.file;
       for (char& ch : n)
@@ -159,7 +162,7 @@ TEST(StrokeBad, EveryFixtureIsCovered) {
   // A new bad fixture must get an expectation above.
   size_t files = 0;
   for (const auto& e : std::filesystem::directory_iterator(fixture("bad"))) files += e.is_regular_file();
-  EXPECT_EQ(files, 22u);
+  EXPECT_EQ(files, 25u);
 }
 
 TEST(StrokeJson, MissingFileNamesIt) {
