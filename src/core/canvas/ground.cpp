@@ -66,8 +66,8 @@ std::string ground_refusal(const CanvasGround& g, int width, int height, int dep
   if (g.weave == Weave::Smooth) return {};
   const WeaveField w = weave_field(g, cell_size_m, Vec3{});
   char buf[256];
-  // The crowns reach base + 4/3 relief (the thickest linen thread); paint needs room above.
-  if (w.base + w.relief * 4.f / 3.f > 0.5f * float(depth)) {
+  // The crowns reach base + relief times the thickest thread; paint needs room above.
+  if (w.base + w.relief * (1.f + kThreadVariation) > 0.5f * float(depth)) {
     std::snprintf(buf, sizeof buf,
                   "the ground (%.2f mm of primer under %.2f mm of relief) is thicker than half the canvas's paint "
                   "depth (%d cells, %.1f mm)",

@@ -63,6 +63,8 @@ inline constexpr uint64_t kMaxGroundBytes = uint64_t(4) << 30;
 /// or more paint in its tiles than kMaxGroundBytes. Empty when it can (and for a smooth ground).
 std::string ground_refusal(const CanvasGround& g, int width, int height, int depth, float cell_size_m);
 
+/// Linen's threads vary by up to a third of their thickness either way (weave_thickness).
+inline constexpr float kThreadVariation = 1.f / 3.f;
 /// A thread's thickness factor in [1 - u/3, 1 + u/3] from its index and a segment along it.
 WB_HD WB_INLINE float weave_thickness(int thread, int segment, float unevenness) {
   uint32_t h = uint32_t(thread) * 0x9E3779B1u ^ (uint32_t(segment) + 0x7F4A7C15u) * 0x85EBCA77u;
@@ -70,7 +72,7 @@ WB_HD WB_INLINE float weave_thickness(int thread, int segment, float unevenness)
   h *= 0x2C1B3C6Du;
   h ^= h >> 12;
   const float r = float(h & 0xFFFFu) * (1.f / 65535.f);  // [0, 1]
-  return 1.f + unevenness * (r - 0.5f) * (2.f / 3.f);
+  return 1.f + unevenness * (r - 0.5f) * (2.f * kThreadVariation);
 }
 
 /// Height of the ground at canvas point (x, y), cells: a plain weave, the warp along x and the
