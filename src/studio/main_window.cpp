@@ -726,7 +726,7 @@ bool MainWindow::open_from(const QString& path) {
       std::optional<CanvasGround> ground;
       if (p.metadata.contains("ground") && p.metadata["ground"].is_object()) {
         try {
-          ground = ground_from_json(p.metadata["ground"], file + ": metadata: ground");
+          ground = ground_from_json(p.metadata["ground"], file, "metadata.ground");
         } catch (const Error& e) {
           std::fprintf(stderr, "wetbrush-studio: warning: %s (the painting opens; recordings from it have no ground)\n",
                        e.what());

@@ -141,19 +141,7 @@ void SimThread::receive_brush_paint(const BristleLoadHost& paint) {
   sim_->set_brush_paint(paint);
   // The recording goes on from here with the brush as it came (its steps load nothing); a replay
   // of it starts with the carried paint's mean colour, oil and fill on every sample.
-  double m = 0, cap = 0, oil = 0;
-  Vec3 ryb{};
-  for (size_t j = 0; j < paint.m.size(); ++j) {
-    const double mj = paint.m[j];
-    m += mj, cap += paint.potential[j], oil += mj * paint.oil[j];
-    ryb = ryb + Vec3(paint.pigment_r[j], paint.pigment_y[j], paint.pigment_b[j]) * float(mj);
-  }
-  PaintLoad carried = paint_;
-  if (m > 0) {
-    carried.ryb[0] = ryb.x / float(m), carried.ryb[1] = ryb.y / float(m), carried.ryb[2] = ryb.z / float(m);
-    carried.oil = float(oil / m);
-  }
-  carried.load = cap > 0 ? float(std::min(1.0, m / cap)) : 0.f;
+  const PaintLoad carried = sim_->brush_mean_paint(paint_);
   const PaintLoad well = paint_;
   paint_ = carried;
   restart_recording(false);

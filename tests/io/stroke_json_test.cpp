@@ -148,7 +148,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"absurd-magnitude.json", {"samples[1].twist", "not a plausible value"}},
         BadCase{"unknown-event.json", {"events[1].type", "unknown event type \"splash\""}},
         BadCase{"not-an-object.json", {"top level: expected an object, found an array"}},
-        BadCase{"ground-unknown-weave.json", {"canvas.ground: unknown weave 'burlap'"}},
+        BadCase{"ground-unknown-weave.json", {"canvas.ground.weave: unknown weave 'burlap'"}},
         BadCase{"ground-too-thick.json", {"canvas.ground", "thicker than half the canvas's paint depth", "refused"}},
         BadCase{"ground-too-large.json", {"canvas.ground", "224.0 GiB of paint", "refused"}}),
     [](const ::testing::TestParamInfo<BadCase>& info) {

@@ -63,6 +63,13 @@ TEST_F(BristleLoadTest, DipMixesIntoWhatIsThere) {
   const Vec3 rgb = ryb_to_rgb(load.mean_color(ws_));
   EXPECT_GT(rgb.y, rgb.x);
   EXPECT_GT(rgb.y, rgb.z);
+  // As one well (what a recording starting with this brush loads): the mix, its oil, full.
+  const PaintLoad well = load.mean_paint(ws_, paint(blue, 0.2f, 0.5f));
+  const Vec3 mean = load.mean_color(ws_);
+  EXPECT_NEAR(well.ryb[1], mean.y, 1e-6f);
+  EXPECT_NEAR(well.ryb[2], mean.z, 1e-6f);
+  EXPECT_NEAR(well.oil, 0.4f, 1e-5f);
+  EXPECT_NEAR(well.load, 1.f, 1e-5f);
   // A full brush takes no more paint, and its colour stays.
   EXPECT_EQ(load.dip(paint(Vec3(1.f, 0.f, 0.f), 0.3f, 0.7f)), 0.0);
   EXPECT_NEAR(load.to_host().pigment_r[0], 0.f, 1e-6f);
@@ -84,6 +91,10 @@ TEST_F(BristleLoadTest, WipeRemovesTheFractionAndCleanEmpties) {
   const Vec3 w = load.mean_color(ws_);
   EXPECT_EQ(w.x + w.y + w.z, 0.f);
   EXPECT_EQ(load.mean_oil(ws_), 0.f);
+  const PaintLoad clean = load.mean_paint(ws_, paint(Vec3(0.f, 1.f, 0.f), 0.6f, 0.8f));
+  EXPECT_EQ(clean.load, 0.f) << "a clean brush carries no paint";
+  EXPECT_EQ(clean.ryb[1], 1.f) << "and keeps the well's colour for its next load";
+  EXPECT_EQ(clean.oil, 0.6f);
 }
 
 TEST_F(BristleLoadTest, BadInputIsRejected) {

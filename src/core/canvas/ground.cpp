@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "core/canvas/tile_store.h"
 #include "core/exec/error.h"
+#include "core/io/json_reader.h"
 
 namespace wb {
 
@@ -37,28 +39,14 @@ nlohmann::json ground_to_json(const CanvasGround& g) {
           {"priming_mm", g.priming_mm}};
 }
 
-CanvasGround ground_from_json(const nlohmann::json& j, const std::string& what) {
-  WB_REQUIRE(j.is_object(), what + ": the ground must be an object");
+CanvasGround ground_from_json(const nlohmann::json& j, const std::string& source, const std::string& path) {
+  ObjectReader r(j, source, path);
   CanvasGround g;
-  auto number = [&](const char* key, float fallback, float lo, float hi) {
-    if (!j.contains(key)) return fallback;
-    const nlohmann::json& v = j.at(key);
-    WB_REQUIRE(v.is_number(), what + ": " + key + " must be a number");
-    const double x = v.get<double>();
-    WB_REQUIRE(std::isfinite(x) && x >= lo && x <= hi, what + ": " + key + " = " + v.dump() + " is outside [" +
-                                                         std::to_string(lo) + ", " + std::to_string(hi) + "] mm");
-    return float(x);
-  };
-  if (j.contains("weave")) {
-    WB_REQUIRE(j.at("weave").is_string(), what + ": weave must be a name");
-    g = CanvasGround::of(weave_from_name(j.at("weave").get<std::string>(), what));
-  }
-  g.thread_mm = number("thread_mm", g.thread_mm, kThreadMmMin, kThreadMmMax);
-  g.relief_mm = number("relief_mm", g.relief_mm, kReliefMmMin, kReliefMmMax);
-  g.priming_mm = number("priming_mm", g.priming_mm, 0.f, kPrimingMmMax);
-  for (const auto& [k, v] : j.items())
-    WB_REQUIRE(k == "weave" || k == "thread_mm" || k == "relief_mm" || k == "priming_mm",
-               what + ": unknown key '" + k + "'");
+  if (r.has("weave")) g = CanvasGround::of(weave_from_name(r.string("weave"), source + ": " + r.where("weave")));
+  g.thread_mm = float(r.number_or("thread_mm", g.thread_mm, kThreadMmMin, kThreadMmMax));
+  g.relief_mm = float(r.number_or("relief_mm", g.relief_mm, kReliefMmMin, kReliefMmMax));
+  g.priming_mm = float(r.number_or("priming_mm", g.priming_mm, 0.f, kPrimingMmMax));
+  r.refuse_unknown();
   return g;
 }
 
@@ -74,9 +62,9 @@ std::string ground_refusal(const CanvasGround& g, int width, int height, int dep
                   g.priming_mm, g.relief_mm, depth, double(depth) * cell_size_m * 1e3);
     return buf;
   }
-  const int tile = 16;  // kTileSize (tile_store.h): a tile holds every cell of its columns
-  const uint64_t tiles = uint64_t((width + tile - 1) / tile) * uint64_t((height + tile - 1) / tile);
-  const uint64_t bytes = tiles * tile * tile * uint64_t(depth) * 14;
+  // A tile holds every cell of its columns.
+  const uint64_t tiles = uint64_t((width + kTileSize - 1) / kTileSize) * uint64_t((height + kTileSize - 1) / kTileSize);
+  const uint64_t bytes = tiles * kTileSize * kTileSize * uint64_t(depth) * kCellBytes;
   if (bytes > kMaxGroundBytes) {
     std::snprintf(buf, sizeof buf,
                   "a woven ground fills the whole canvas: %d x %d x %d cells would hold %.1f GiB of paint, more than "

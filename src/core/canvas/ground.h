@@ -40,8 +40,9 @@ inline constexpr float kReliefMmMin = 0.f, kReliefMmMax = 2.f;
 inline constexpr float kPrimingMmMax = 2.f;
 
 nlohmann::json ground_to_json(const CanvasGround& g);
-/// Reads and validates a ground (names `what` in errors; throws wb::Error).
-CanvasGround ground_from_json(const nlohmann::json& j, const std::string& what);
+/// Reads and validates a ground, the object at `path` of file `source` (named in errors; throws
+/// wb::Error). Values in mm within the ranges above; unknown keys are refused.
+CanvasGround ground_from_json(const nlohmann::json& j, const std::string& source, const std::string& path);
 /// "smooth", "linen", "cotton_duck"; throws wb::Error naming `what` for other names.
 Weave weave_from_name(const std::string& name, const std::string& what);
 

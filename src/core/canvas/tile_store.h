@@ -22,6 +22,9 @@
 namespace wb {
 
 inline constexpr int kTileSize = 16;
+/// Bytes a cell of paint takes in the pool and in a painting's volume: the density (float) and
+/// four pigment/oil fields and the dryness (unorm16 each).
+inline constexpr int kCellBytes = int(sizeof(float) + 5 * sizeof(uint16_t));
 
 struct CanvasDims {
   int width = 4096;

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/exec/error.h"
+#include "core/io/json_reader.h"
 
 namespace wb {
 namespace {
@@ -72,26 +73,6 @@ void set_value(BrushSpec& b, const Member& m, double v) {
       m);
 }
 
-std::string fmt(double v) {
-  std::ostringstream os;
-  os.precision(9);
-  os << v;
-  return os.str();
-}
-
-std::string json_type_name(const nlohmann::json& v) {
-  if (v.is_string()) return "a string (" + v.dump() + ")";
-  return std::string(v.type_name());
-}
-
-/// Float written as the shortest decimal that reads back to the same float, so files
-/// show 0.1 rather than 0.10000000149011612.
-double float_for_json(float v) {
-  char buf[32];
-  auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::strtod(std::string(buf, r.ptr).c_str(), nullptr);
-}
-
 }  // namespace
 
 const std::vector<BrushFieldRange>& brush_field_ranges() {
@@ -126,8 +107,8 @@ void validate_brush(const BrushSpec& brush, const std::string& context) {
   for (const Field& f : fields()) {
     const double v = get_value(brush, f.member);
     if (!std::isfinite(v) || v < f.range.min || v > f.range.max)
-      WB_THROW(context + "." + f.range.key + ": " + fmt(v) + " is outside [" + fmt(f.range.min) + ", " +
-               fmt(f.range.max) + "]");
+      WB_THROW(context + "." + f.range.key + ": " + json_number_text(v) + " is outside [" + json_number_text(f.range.min) + ", " +
+               json_number_text(f.range.max) + "]");
   }
 }
 
@@ -160,9 +141,9 @@ BrushSpec brush_from_json(const nlohmann::json& j, const std::string& context, s
     if (!v.is_number()) WB_THROW(where + ": expected a number, found " + json_type_name(v));
     const double d = v.get<double>();
     if (!std::isfinite(d)) WB_THROW(where + ": not a finite number");
-    if (field->range.integer && d != std::floor(d)) WB_THROW(where + ": expected an integer, found " + fmt(d));
+    if (field->range.integer && d != std::floor(d)) WB_THROW(where + ": expected an integer, found " + json_number_text(d));
     if (d < field->range.min || d > field->range.max)
-      WB_THROW(where + ": " + fmt(d) + " is outside [" + fmt(field->range.min) + ", " + fmt(field->range.max) + "]");
+      WB_THROW(where + ": " + json_number_text(d) + " is outside [" + json_number_text(field->range.min) + ", " + json_number_text(field->range.max) + "]");
     set_value(b, field->member, d);
   }
   return b;

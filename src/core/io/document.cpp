@@ -47,7 +47,7 @@ uint32_t crc(const uint8_t* p, size_t n) { return uint32_t(crc32(crc32(0L, Z_NUL
 std::vector<uint8_t> pack_tile(const TileData& t) {
   const size_t n = t.density.size();
   std::vector<uint8_t> raw;
-  raw.reserve(n * 14);
+  raw.reserve(n * kCellBytes);
   for (float f : t.density) {
     uint32_t u;
     std::memcpy(&u, &f, 4);
@@ -192,7 +192,7 @@ TileStore decode_volume(const uint8_t* p, size_t size, const Device& device, con
   if (fields != uint32_t(kPaintFieldCount)) WB_THROW(w + ": " + std::to_string(fields) + " fields per cell, expected 6");
   // Every tile decodes to 16 x 16 x depth cells, whatever its compressed size: the paint the
   // table declares is known here, before anything is allocated or decompressed.
-  const uint64_t tile_bytes = uint64_t(kTileSize) * kTileSize * depth * 14;
+  const uint64_t tile_bytes = uint64_t(kTileSize) * kTileSize * depth * kCellBytes;
   const uint64_t paint_bytes = uint64_t(count) * tile_bytes;
   if (paint_bytes > limits.max_paint_bytes)
     WB_THROW(w + ": " + std::to_string(count) + " tiles of a " + std::to_string(depth) + "-cell-deep canvas hold " +
@@ -201,7 +201,7 @@ TileStore decode_volume(const uint8_t* p, size_t size, const Device& device, con
 
   TileStore canvas(device, CanvasDims{int(width), int(height), int(depth)});
   const size_t n = size_t(canvas.tile_cells());
-  const size_t raw_size = n * 14;
+  const size_t raw_size = n * kCellBytes;
   std::vector<uint8_t> raw(raw_size);
   std::set<int> seen;
   const uint8_t* data = p + header;

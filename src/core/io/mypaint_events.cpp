@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/exec/error.h"
+#include "core/io/json_reader.h"
 #include "core/io/stroke.h"
 
 namespace wb {
@@ -16,14 +17,6 @@ namespace {
 /// MyPaint stores tilt normalised to [-1, 1]; +-1 is taken as +-60 degrees, the range of
 /// common pen tablets (Wacom reports about +-60..64 degrees).
 constexpr float kMyPaintTiltDeg = 60.f;
-constexpr double kAbsurd = 1e7;
-
-std::string fmt(double v) {
-  std::ostringstream os;
-  os.precision(10);
-  os << v;
-  return os.str();
-}
 
 /// One clamp kind: how many, and the first line it happened on.
 struct ClampCount {
@@ -85,7 +78,7 @@ Stroke parse_mypaint_events(std::string_view text, const std::string& source) {
       if (r.ec != std::errc() || r.ptr != e)
         WB_THROW(where + "column " + std::to_string(c + 1) + " (" + kColumns[c] + "): '" + std::string(tok) +
                  "' is not a number");
-      if (!std::isfinite(v[c]) || std::fabs(v[c]) > kAbsurd)
+      if (!std::isfinite(v[c]) || std::fabs(v[c]) > kAbsurdJsonValue)
         WB_THROW(where + "column " + std::to_string(c + 1) + " (" + kColumns[c] + "): '" + std::string(tok) +
                  "' is not a finite, plausible value (|v| <= 1e7)");
     }
@@ -121,7 +114,7 @@ Stroke parse_mypaint_events(std::string_view text, const std::string& source) {
     if (!st.samples.empty()) {
       const double prev = st.samples.back().t;
       if (s.t < prev)
-        WB_THROW(where + "t = " + fmt(s.t) + " is earlier than the previous event's t = " + fmt(prev) + " (line " +
+        WB_THROW(where + "t = " + json_number_text(s.t) + " is earlier than the previous event's t = " + json_number_text(prev) + " (line " +
                  std::to_string(last_line) + "): events must be in time order");
       if (s.t == prev) {
         // Drivers emit bursts with one timestamp; the latest state wins.

@@ -21,6 +21,7 @@
 #include "core/exec/error.h"
 #include "core/io/atomic_file.h"
 #include "core/io/brush_json.h"
+#include "core/io/json_reader.h"
 #include "core/io/pen_pose.h"
 #include "core/io/stroke.h"
 #include "core/grid/grid_params.h"
@@ -33,122 +34,6 @@ using nlohmann::json;
 namespace {
 
 constexpr const char* kFormatName = "wetbrush-stroke";
-/// Larger magnitudes are not measurements but corrupt data (no canvas is 10^7 cells).
-constexpr double kAbsurd = 1e7;
-
-std::string fmt(double v) {
-  std::ostringstream os;
-  os.precision(10);
-  os << v;
-  return os.str();
-}
-
-std::string type_name(const json& v) {
-  if (v.is_string()) return "a string (" + v.dump() + ")";
-  if (v.is_null()) return "null";
-  if (v.is_boolean()) return "a boolean";
-  if (v.is_array()) return "an array";
-  if (v.is_object()) return "an object";
-  return "a number";
-}
-
-double float_for_json(float v) {
-  char buf[32];
-  auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::strtod(std::string(buf, r.ptr).c_str(), nullptr);
-}
-
-/// Reads values of one JSON object, naming `source: path.key` in every message and
-/// collecting unknown keys.
-class ObjectReader {
- public:
-  ObjectReader(const json& j, std::string source, std::string path) : j_(j), source_(std::move(source)), path_(std::move(path)) {
-    if (!j_.is_object()) fail("expected an object, found " + type_name(j_));
-  }
-
-  [[noreturn]] void fail(const std::string& msg, const char* key = nullptr) const {
-    WB_THROW(source_ + ": " + where(key) + ": " + msg);
-  }
-  std::string where(const char* key) const {
-    if (!key) return path_.empty() ? "top level" : path_;
-    return path_.empty() ? std::string(key) : path_ + "." + key;
-  }
-
-  bool has(const char* key) {
-    seen_.push_back(key);
-    return j_.contains(key);
-  }
-  const json& raw(const char* key) {
-    if (!has(key)) fail("missing required key '" + std::string(key) + "'");
-    return j_.at(key);
-  }
-
-  double number(const char* key, double lo, double hi) { return check_number(raw(key), key, lo, hi); }
-  double number_or(const char* key, double def, double lo, double hi) {
-    return has(key) ? check_number(j_.at(key), key, lo, hi) : def;
-  }
-  int integer(const char* key, int lo, int hi) { return check_integer(raw(key), key, lo, hi); }
-  int integer_or(const char* key, int def, int lo, int hi) {
-    return has(key) ? check_integer(j_.at(key), key, lo, hi) : def;
-  }
-  bool boolean_or(const char* key, bool def) {
-    if (!has(key)) return def;
-    const json& v = j_.at(key);
-    if (!v.is_boolean()) fail("expected true or false, found " + type_name(v), key);
-    return v.get<bool>();
-  }
-  std::string string(const char* key) {
-    const json& v = raw(key);
-    if (!v.is_string()) fail("expected a string, found " + type_name(v), key);
-    return v.get<std::string>();
-  }
-  /// Array of 3 numbers in [lo, hi].
-  std::array<float, 3> triple(const char* key, double lo, double hi) {
-    const json& v = raw(key);
-    if (!v.is_array() || v.size() != 3) fail("expected an array of 3 numbers, found " + type_name(v), key);
-    std::array<float, 3> out{};
-    for (int i = 0; i < 3; ++i) {
-      const std::string k = std::string(key) + "[" + std::to_string(i) + "]";
-      out[i] = float(check_number(v[i], k.c_str(), lo, hi));
-    }
-    return out;
-  }
-
-  double check_number(const json& v, const char* key, double lo, double hi) const {
-    if (!v.is_number()) fail("expected a number, found " + type_name(v), key);
-    const double d = v.get<double>();
-    if (!std::isfinite(d) || std::fabs(d) > kAbsurd) fail(fmt(d) + " is not a plausible value (|v| > 1e7)", key);
-    if (d < lo || d > hi) fail(fmt(d) + " is outside [" + fmt(lo) + ", " + fmt(hi) + "]", key);
-    return d;
-  }
-  int check_integer(const json& v, const char* key, int lo, int hi) const {
-    const double d = check_number(v, key, lo, hi);
-    if (d != std::floor(d)) fail("expected an integer, found " + fmt(d), key);
-    return int(d);
-  }
-
-  /// Keys present but never asked for.
-  std::vector<std::string> unknown_keys() const {
-    std::vector<std::string> out;
-    for (auto it = j_.begin(); it != j_.end(); ++it) {
-      bool known = false;
-      for (const std::string& s : seen_) known = known || s == it.key();
-      if (!known) out.push_back(it.key());
-    }
-    return out;
-  }
-  void warn_unknown(std::vector<std::string>& warnings) const {
-    for (const std::string& k : unknown_keys())
-      warnings.push_back(source_ + ": " + where(nullptr) + ": unknown key '" + k + "' ignored");
-  }
-
- private:
-  const json& j_;
-  std::string source_;
-  std::string path_;
-  std::vector<std::string> seen_;
-};
-
 /// 1-based line and column of the character that nlohmann's parse_error::byte (1-based) points at.
 std::pair<size_t, size_t> line_column(std::string_view text, size_t byte) {
   size_t line = 1, col = 1;
@@ -188,7 +73,7 @@ StrokeEventKind event_kind_from(const std::string& s, const ObjectReader& r) {
 
 void read_samples(const json& arr, Stroke& st) {
   const std::string& src = st.source;
-  if (!arr.is_array()) WB_THROW(src + ": samples: expected an array, found " + type_name(arr));
+  if (!arr.is_array()) WB_THROW(src + ": samples: expected an array, found " + json_type_name(arr));
   if (arr.empty()) WB_THROW(src + ": samples: empty (a stroke needs at least one sample)");
   st.samples.reserve(arr.size());
   std::map<std::string, std::pair<size_t, size_t>> unknown;  // key -> (first sample, count)
@@ -196,13 +81,13 @@ void read_samples(const json& arr, Stroke& st) {
   for (size_t i = 0; i < arr.size(); ++i) {
     ObjectReader r(arr[i], src, "samples[" + std::to_string(i) + "]");
     PenSample s;
-    s.t = r.number("t", 0.0, kAbsurd);
-    s.x = float(r.number("x", -kAbsurd, kAbsurd));
-    s.y = float(r.number("y", -kAbsurd, kAbsurd));
+    s.t = r.number("t", 0.0, kAbsurdJsonValue);
+    s.x = float(r.number("x", -kAbsurdJsonValue, kAbsurdJsonValue));
+    s.y = float(r.number("y", -kAbsurdJsonValue, kAbsurdJsonValue));
     s.pressure = float(r.number("pressure", 0.0, 1.0));
     s.tilt_x = float(r.number_or("tilt_x", 0.0, -90.0, 90.0));
     s.tilt_y = float(r.number_or("tilt_y", 0.0, -90.0, 90.0));
-    s.twist = float(r.number_or("twist", 0.0, -kAbsurd, kAbsurd));
+    s.twist = float(r.number_or("twist", 0.0, -kAbsurdJsonValue, kAbsurdJsonValue));
     s.down = r.boolean_or("down", true);
     if (std::fabs(s.tilt_x) > kMaxTiltDeg || std::fabs(s.tilt_y) > kMaxTiltDeg) {
       if (tilt_clamped++ == 0) first_tilt_clamped = i;
@@ -218,18 +103,18 @@ void read_samples(const json& arr, Stroke& st) {
                           std::to_string(v.second) + " samples)");
   if (tilt_clamped)
     st.warnings.push_back(src + ": samples[" + std::to_string(first_tilt_clamped) + "]: tilt beyond " +
-                          fmt(kMaxTiltDeg) + " degrees is clamped to it (" + std::to_string(tilt_clamped) +
+                          json_number_text(kMaxTiltDeg) + " degrees is clamped to it (" + std::to_string(tilt_clamped) +
                           " samples)");
 }
 
 void read_events(const json& arr, Stroke& st) {
   const std::string& src = st.source;
-  if (!arr.is_array()) WB_THROW(src + ": events: expected an array, found " + type_name(arr));
+  if (!arr.is_array()) WB_THROW(src + ": events: expected an array, found " + json_type_name(arr));
   for (size_t i = 0; i < arr.size(); ++i) {
     ObjectReader r(arr[i], src, "events[" + std::to_string(i) + "]");
     StrokeEvent e;
     e.kind = event_kind_from(r.string("type"), r);
-    e.t = r.number("t", 0.0, kAbsurd);
+    e.t = r.number("t", 0.0, kAbsurdJsonValue);
     if (e.kind == StrokeEventKind::Dip) {
       const auto ryb = r.triple("ryb", 0.0, 1.0);
       for (int c = 0; c < 3; ++c) e.ryb[c] = ryb[c];
@@ -259,7 +144,7 @@ void validate_stroke(const Stroke& st) {
   const std::string& src = st.source.empty() ? std::string("<stroke>") : st.source;
   const auto sample = [&](size_t i) { return src + ": samples[" + std::to_string(i) + "]: "; };
   if (st.samples.empty()) WB_THROW(src + ": no samples (a stroke needs at least one)");
-  WB_REQUIRE(st.dt >= 1e-4 && st.dt <= 0.1, src + ": simulation.dt = " + fmt(st.dt) + " is outside [0.0001, 0.1]");
+  WB_REQUIRE(st.dt >= 1e-4 && st.dt <= 0.1, src + ": simulation.dt = " + json_number_text(st.dt) + " is outside [0.0001, 0.1]");
   WB_REQUIRE(st.max_move_per_substep >= 0.1f && st.max_move_per_substep <= 100.f,
              src + ": simulation.max_move_per_substep is outside [0.1, 100]");
   WB_REQUIRE(st.max_substeps >= 1 && st.max_substeps <= 1024, src + ": simulation.max_substeps is outside [1, 1024]");
@@ -270,23 +155,23 @@ void validate_stroke(const Stroke& st) {
     if (!std::isfinite(s.t) || !std::isfinite(s.x) || !std::isfinite(s.y) || !std::isfinite(s.pressure) ||
         !std::isfinite(s.tilt_x) || !std::isfinite(s.tilt_y) || !std::isfinite(s.twist))
       WB_THROW(sample(i) + "a value is not finite");
-    if (s.pressure < 0.f || s.pressure > 1.f) WB_THROW(sample(i) + "pressure " + fmt(s.pressure) + " is outside [0, 1]");
+    if (s.pressure < 0.f || s.pressure > 1.f) WB_THROW(sample(i) + "pressure " + json_number_text(s.pressure) + " is outside [0, 1]");
     if (s.x < 0.f || s.y < 0.f || s.x > float(st.canvas.width) || s.y > float(st.canvas.height))
-      WB_THROW(sample(i) + "(" + fmt(s.x) + ", " + fmt(s.y) + ") is off the " + std::to_string(st.canvas.width) + " x " +
+      WB_THROW(sample(i) + "(" + json_number_text(s.x) + ", " + json_number_text(s.y) + ") is off the " + std::to_string(st.canvas.width) + " x " +
                std::to_string(st.canvas.height) + " canvas");
     if (i > 0 && !(s.t > st.samples[i - 1].t))
-      WB_THROW(sample(i) + "t = " + fmt(s.t) + " is not after samples[" + std::to_string(i - 1) +
-               "].t = " + fmt(st.samples[i - 1].t) + " (samples must be strictly increasing in time)");
+      WB_THROW(sample(i) + "t = " + json_number_text(s.t) + " is not after samples[" + std::to_string(i - 1) +
+               "].t = " + json_number_text(st.samples[i - 1].t) + " (samples must be strictly increasing in time)");
   }
   for (size_t i = 0; i < st.events.size(); ++i) {
     const StrokeEvent& e = st.events[i];
     const std::string where = src + ": events[" + std::to_string(i) + "]: ";
     if (!std::isfinite(e.t) || e.t < 0) WB_THROW(where + "t must be a finite time >= 0");
     if (i > 0 && e.t < st.events[i - 1].t)
-      WB_THROW(where + "t = " + fmt(e.t) + " is before events[" + std::to_string(i - 1) + "].t = " +
-               fmt(st.events[i - 1].t) + " (events must be in time order)");
+      WB_THROW(where + "t = " + json_number_text(e.t) + " is before events[" + std::to_string(i - 1) + "].t = " +
+               json_number_text(st.events[i - 1].t) + " (events must be in time order)");
     if (e.t > st.samples.back().t)
-      WB_THROW(where + "t = " + fmt(e.t) + " is after the last sample (t = " + fmt(st.samples.back().t) + ")");
+      WB_THROW(where + "t = " + json_number_text(e.t) + " is after the last sample (t = " + json_number_text(st.samples.back().t) + ")");
   }
 }
 
@@ -323,7 +208,7 @@ Stroke parse_stroke_json(std::string_view text, const std::string& source) {
     top.fail("format is " + root.at("format").dump() + ", expected \"" + kFormatName + "\"", "format");
   {
     const json& v = top.raw("version");
-    if (!v.is_number_integer()) top.fail("expected an integer version, found " + type_name(v), "version");
+    if (!v.is_number_integer()) top.fail("expected an integer version, found " + json_type_name(v), "version");
     const int64_t version = v.get<int64_t>();
     if (version > kStrokeFormatVersion)
       top.fail("version " + std::to_string(version) + " was written by a newer wetbrush (this build reads version " +
@@ -343,7 +228,7 @@ Stroke parse_stroke_json(std::string_view text, const std::string& source) {
              std::to_string(kMaxCanvasCells) + " cells (16384 x 16384): refused");
     if (c.has("paper_rgb")) st.paper_rgb = c.triple("paper_rgb", 0.0, 1.0);
     if (c.has("ground")) {
-      st.ground = ground_from_json(root.at("canvas").at("ground"), source + ": canvas.ground");
+      st.ground = ground_from_json(root.at("canvas").at("ground"), source, "canvas.ground");
       const std::string why =
           ground_refusal(*st.ground, st.canvas.width, st.canvas.height, st.canvas.depth, GridParams{}.cell_size);
       if (!why.empty()) c.fail(why + ": refused", "ground");

@@ -42,7 +42,7 @@ TileSnapshot snapshot_tile(const TileStore& canvas, int tile_id) {
   if (!s.present) return s;
   const TileData d = canvas.read_tile(tile_id);
   std::vector<uint8_t> raw;
-  raw.reserve(size_t(canvas.tile_cells()) * 14);
+  raw.reserve(size_t(canvas.tile_cells()) * kCellBytes);
   append(raw, d.density);
   append(raw, d.pigment_r);
   append(raw, d.pigment_y);
@@ -69,7 +69,7 @@ void restore_tile(TileStore& canvas, const TileSnapshot& snap) {
     canvas.write_tile(d);
     return;
   }
-  std::vector<uint8_t> raw(cells * 14);
+  std::vector<uint8_t> raw(cells * kCellBytes);
   const size_t n = ZSTD_decompress(raw.data(), raw.size(), snap.zdata.data(), snap.zdata.size());
   if (ZSTD_isError(n) || n != raw.size()) WB_THROW("undo tile snapshot: corrupted data");
   size_t at = 0;

@@ -269,6 +269,8 @@ void Simulator::set_brush_paint(const BristleLoadHost& paint) {
   books_.external(load_->total_mass(ws_) - before);
 }
 
+PaintLoad Simulator::brush_mean_paint(const PaintLoad& clean) { return load_->mean_paint(ws_, clean); }
+
 void Simulator::lay_ground(const CanvasGround& ground, Vec3 primer_ryb) {
   if (ground.weave == Weave::Smooth) return;
   const CanvasDims& d = config_.canvas;

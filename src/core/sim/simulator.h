@@ -105,6 +105,9 @@ class Simulator {
   /// The brush takes this paint, sample by sample (brush_paint of a simulator with the same
   /// brush); the books record the change as paint that entered or left from outside.
   void set_brush_paint(const BristleLoadHost& paint);
+  /// The brush's paint as one well (BristleLoad::mean_paint): what a recording that starts with
+  /// this brush loads on every sample. A clean brush gives `clean` with no load.
+  PaintLoad brush_mean_paint(const PaintLoad& clean);
   /// "Let it dry": flushes the window, dries every painted cell of the canvas, reloads.
   void dry_canvas();
   /// Primes the empty canvas (throws wb::Error if it holds paint) with a woven ground of the primer's pigment (ground.h); the books

@@ -1,6 +1,7 @@
 // The paint on the brush (paper §5.1): loading, dipping, wiping, cleaning and the UI sums.
 #include "core/transfer/bristle_load.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -116,6 +117,18 @@ float BristleLoad::mean_oil(Workspace& ws) {
   if (!(w > 0.0)) return 0.f;
   d_product(device_, m.data(), oil.data(), scratch_.data(), count_);
   return float(reduce_sum(device_, scratch_.data(), count_, ws) / w);
+}
+
+PaintLoad BristleLoad::mean_paint(Workspace& ws, const PaintLoad& clean) {
+  PaintLoad out = clean;
+  const double mass = total_mass(ws), capacity = reduce_sum(device_, potential.data(), count_, ws);
+  out.load = capacity > 0.0 ? float(std::min(1.0, mass / capacity)) : 0.f;
+  if (mass > 0.0) {
+    const Vec3 c = mean_color(ws);
+    out.ryb[0] = c.x, out.ryb[1] = c.y, out.ryb[2] = c.z;
+    out.oil = mean_oil(ws);
+  }
+  return out;
 }
 
 BristleLoadHost BristleLoad::to_host() const {

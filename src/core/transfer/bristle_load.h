@@ -75,6 +75,10 @@ class BristleLoad {
   Vec3 mean_color(Workspace& ws);
   /// Mass-weighted oil fraction of the load (0 when clean).
   float mean_oil(Workspace& ws);
+  /// The whole load as one well of paint: mean_color, mean_oil and the fill of the brush's
+  /// capacity (sum of M_j over sum of M'_j, Eq. 12). A clean brush keeps `clean`'s pigment and oil
+  /// with no load.
+  PaintLoad mean_paint(Workspace& ws, const PaintLoad& clean);
 
   BristleLoadHost to_host() const;
   /// Replaces every field (each size() long); throws wb::Error on a size mismatch or a
