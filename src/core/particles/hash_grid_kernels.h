@@ -135,8 +135,9 @@ WB_HD WB_INLINE NearestSample nearest_sample(const HashGridView& g, Vec3 p, floa
       const uint32_t end = g.cell_end[bucket];
       for (uint32_t s = g.cell_start[bucket]; s < end; ++s) {
         const float d2 = length2(g.sorted_x[s] - p);
+        if (!(d2 <= best_d2)) continue;  // most samples (and a NaN): one compare, no index read
         const int32_t idx = int32_t(g.sorted_index[s]);
-        if (d2 < best_d2 || (d2 == best_d2 && best >= 0 && idx < best)) {
+        if (d2 < best_d2 || (best >= 0 && idx < best)) {
           best_d2 = d2;
           best = idx;
         }
