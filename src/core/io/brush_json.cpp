@@ -2,11 +2,9 @@
 // validation (paper §4.1; bristle counts and sizes per docs/FORMATS.md).
 #include "core/io/brush_json.h"
 
-#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
-#include <sstream>
 #include <variant>
 
 #include <nlohmann/json.hpp>
@@ -107,8 +105,8 @@ void validate_brush(const BrushSpec& brush, const std::string& context) {
   for (const Field& f : fields()) {
     const double v = get_value(brush, f.member);
     if (!std::isfinite(v) || v < f.range.min || v > f.range.max)
-      WB_THROW(context + "." + f.range.key + ": " + json_number_text(v) + " is outside [" + json_number_text(f.range.min) + ", " +
-               json_number_text(f.range.max) + "]");
+      WB_THROW(context + "." + f.range.key + ": " + number_text(v) + " is outside [" + number_text(f.range.min) + ", " +
+               number_text(f.range.max) + "]");
   }
 }
 
@@ -141,9 +139,10 @@ BrushSpec brush_from_json(const nlohmann::json& j, const std::string& context, s
     if (!v.is_number()) WB_THROW(where + ": expected a number, found " + json_type_name(v));
     const double d = v.get<double>();
     if (!std::isfinite(d)) WB_THROW(where + ": not a finite number");
-    if (field->range.integer && d != std::floor(d)) WB_THROW(where + ": expected an integer, found " + json_number_text(d));
+    if (field->range.integer && d != std::floor(d)) WB_THROW(where + ": expected an integer, found " + number_text(d));
     if (d < field->range.min || d > field->range.max)
-      WB_THROW(where + ": " + json_number_text(d) + " is outside [" + json_number_text(field->range.min) + ", " + json_number_text(field->range.max) + "]");
+      WB_THROW(where + ": " + number_text(d) + " is outside [" + number_text(field->range.min) + ", " +
+               number_text(field->range.max) + "]");
     set_value(b, field->member, d);
   }
   return b;

@@ -11,7 +11,7 @@ namespace wb {
 
 using nlohmann::json;
 
-std::string json_number_text(double v) {
+std::string number_text(double v) {
   std::ostringstream os;
   os.precision(10);
   os << v;
@@ -84,15 +84,15 @@ std::array<float, 3> ObjectReader::triple(const char* key, double lo, double hi)
 double ObjectReader::check_number(const json& v, const char* key, double lo, double hi) const {
   if (!v.is_number()) fail("expected a number, found " + json_type_name(v), key);
   const double d = v.get<double>();
-  if (!std::isfinite(d) || std::fabs(d) > kAbsurdJsonValue)
-    fail(json_number_text(d) + " is not a plausible value (|v| > 1e7)", key);
-  if (d < lo || d > hi) fail(json_number_text(d) + " is outside [" + json_number_text(lo) + ", " + json_number_text(hi) + "]", key);
+  if (!std::isfinite(d) || std::fabs(d) > kAbsurdValue)
+    fail(number_text(d) + " is not a plausible value (|v| > 1e7)", key);
+  if (d < lo || d > hi) fail(number_text(d) + " is outside [" + number_text(lo) + ", " + number_text(hi) + "]", key);
   return d;
 }
 
 int ObjectReader::check_integer(const json& v, const char* key, int lo, int hi) const {
   const double d = check_number(v, key, lo, hi);
-  if (d != std::floor(d)) fail("expected an integer, found " + json_number_text(d), key);
+  if (d != std::floor(d)) fail("expected an integer, found " + number_text(d), key);
   return int(d);
 }
 

@@ -11,10 +11,10 @@
 namespace wb {
 
 /// Larger magnitudes are not measurements but corrupt data (no canvas is 10^7 cells).
-constexpr double kAbsurdJsonValue = 1e7;
+constexpr double kAbsurdValue = 1e7;
 
 /// v with up to 10 significant digits, for messages.
-std::string json_number_text(double v);
+std::string number_text(double v);
 /// "a string ("..."), null, a boolean, an array, an object or a number", for messages.
 std::string json_type_name(const nlohmann::json& v);
 /// Float written as the shortest decimal that reads back to the same float, so files show 0.1

@@ -4,7 +4,6 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
-#include <sstream>
 #include <vector>
 
 #include "core/exec/error.h"
@@ -78,7 +77,7 @@ Stroke parse_mypaint_events(std::string_view text, const std::string& source) {
       if (r.ec != std::errc() || r.ptr != e)
         WB_THROW(where + "column " + std::to_string(c + 1) + " (" + kColumns[c] + "): '" + std::string(tok) +
                  "' is not a number");
-      if (!std::isfinite(v[c]) || std::fabs(v[c]) > kAbsurdJsonValue)
+      if (!std::isfinite(v[c]) || std::fabs(v[c]) > kAbsurdValue)
         WB_THROW(where + "column " + std::to_string(c + 1) + " (" + kColumns[c] + "): '" + std::string(tok) +
                  "' is not a finite, plausible value (|v| <= 1e7)");
     }
@@ -114,7 +113,8 @@ Stroke parse_mypaint_events(std::string_view text, const std::string& source) {
     if (!st.samples.empty()) {
       const double prev = st.samples.back().t;
       if (s.t < prev)
-        WB_THROW(where + "t = " + json_number_text(s.t) + " is earlier than the previous event's t = " + json_number_text(prev) + " (line " +
+        WB_THROW(where + "t = " + number_text(s.t) + " is earlier than the previous event's t = " + number_text(prev) +
+                 " (line " +
                  std::to_string(last_line) + "): events must be in time order");
       if (s.t == prev) {
         // Drivers emit bursts with one timestamp; the latest state wins.

@@ -6,7 +6,6 @@
 
 #include <cctype>
 #include <cerrno>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -14,7 +13,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -81,13 +79,13 @@ void read_samples(const json& arr, Stroke& st) {
   for (size_t i = 0; i < arr.size(); ++i) {
     ObjectReader r(arr[i], src, "samples[" + std::to_string(i) + "]");
     PenSample s;
-    s.t = r.number("t", 0.0, kAbsurdJsonValue);
-    s.x = float(r.number("x", -kAbsurdJsonValue, kAbsurdJsonValue));
-    s.y = float(r.number("y", -kAbsurdJsonValue, kAbsurdJsonValue));
+    s.t = r.number("t", 0.0, kAbsurdValue);
+    s.x = float(r.number("x", -kAbsurdValue, kAbsurdValue));
+    s.y = float(r.number("y", -kAbsurdValue, kAbsurdValue));
     s.pressure = float(r.number("pressure", 0.0, 1.0));
     s.tilt_x = float(r.number_or("tilt_x", 0.0, -90.0, 90.0));
     s.tilt_y = float(r.number_or("tilt_y", 0.0, -90.0, 90.0));
-    s.twist = float(r.number_or("twist", 0.0, -kAbsurdJsonValue, kAbsurdJsonValue));
+    s.twist = float(r.number_or("twist", 0.0, -kAbsurdValue, kAbsurdValue));
     s.down = r.boolean_or("down", true);
     if (std::fabs(s.tilt_x) > kMaxTiltDeg || std::fabs(s.tilt_y) > kMaxTiltDeg) {
       if (tilt_clamped++ == 0) first_tilt_clamped = i;
@@ -103,7 +101,7 @@ void read_samples(const json& arr, Stroke& st) {
                           std::to_string(v.second) + " samples)");
   if (tilt_clamped)
     st.warnings.push_back(src + ": samples[" + std::to_string(first_tilt_clamped) + "]: tilt beyond " +
-                          json_number_text(kMaxTiltDeg) + " degrees is clamped to it (" + std::to_string(tilt_clamped) +
+                          number_text(kMaxTiltDeg) + " degrees is clamped to it (" + std::to_string(tilt_clamped) +
                           " samples)");
 }
 
@@ -114,7 +112,7 @@ void read_events(const json& arr, Stroke& st) {
     ObjectReader r(arr[i], src, "events[" + std::to_string(i) + "]");
     StrokeEvent e;
     e.kind = event_kind_from(r.string("type"), r);
-    e.t = r.number("t", 0.0, kAbsurdJsonValue);
+    e.t = r.number("t", 0.0, kAbsurdValue);
     if (e.kind == StrokeEventKind::Dip) {
       const auto ryb = r.triple("ryb", 0.0, 1.0);
       for (int c = 0; c < 3; ++c) e.ryb[c] = ryb[c];
@@ -144,7 +142,8 @@ void validate_stroke(const Stroke& st) {
   const std::string& src = st.source.empty() ? std::string("<stroke>") : st.source;
   const auto sample = [&](size_t i) { return src + ": samples[" + std::to_string(i) + "]: "; };
   if (st.samples.empty()) WB_THROW(src + ": no samples (a stroke needs at least one)");
-  WB_REQUIRE(st.dt >= 1e-4 && st.dt <= 0.1, src + ": simulation.dt = " + json_number_text(st.dt) + " is outside [0.0001, 0.1]");
+  WB_REQUIRE(st.dt >= 1e-4 && st.dt <= 0.1,
+             src + ": simulation.dt = " + number_text(st.dt) + " is outside [0.0001, 0.1]");
   WB_REQUIRE(st.max_move_per_substep >= 0.1f && st.max_move_per_substep <= 100.f,
              src + ": simulation.max_move_per_substep is outside [0.1, 100]");
   WB_REQUIRE(st.max_substeps >= 1 && st.max_substeps <= 1024, src + ": simulation.max_substeps is outside [1, 1024]");
@@ -155,23 +154,25 @@ void validate_stroke(const Stroke& st) {
     if (!std::isfinite(s.t) || !std::isfinite(s.x) || !std::isfinite(s.y) || !std::isfinite(s.pressure) ||
         !std::isfinite(s.tilt_x) || !std::isfinite(s.tilt_y) || !std::isfinite(s.twist))
       WB_THROW(sample(i) + "a value is not finite");
-    if (s.pressure < 0.f || s.pressure > 1.f) WB_THROW(sample(i) + "pressure " + json_number_text(s.pressure) + " is outside [0, 1]");
+    if (s.pressure < 0.f || s.pressure > 1.f)
+      WB_THROW(sample(i) + "pressure " + number_text(s.pressure) + " is outside [0, 1]");
     if (s.x < 0.f || s.y < 0.f || s.x > float(st.canvas.width) || s.y > float(st.canvas.height))
-      WB_THROW(sample(i) + "(" + json_number_text(s.x) + ", " + json_number_text(s.y) + ") is off the " + std::to_string(st.canvas.width) + " x " +
-               std::to_string(st.canvas.height) + " canvas");
+      WB_THROW(sample(i) + "(" + number_text(s.x) + ", " + number_text(s.y) + ") is off the " +
+               std::to_string(st.canvas.width) + " x " + std::to_string(st.canvas.height) + " canvas");
     if (i > 0 && !(s.t > st.samples[i - 1].t))
-      WB_THROW(sample(i) + "t = " + json_number_text(s.t) + " is not after samples[" + std::to_string(i - 1) +
-               "].t = " + json_number_text(st.samples[i - 1].t) + " (samples must be strictly increasing in time)");
+      WB_THROW(sample(i) + "t = " + number_text(s.t) + " is not after samples[" + std::to_string(i - 1) +
+               "].t = " + number_text(st.samples[i - 1].t) + " (samples must be strictly increasing in time)");
   }
   for (size_t i = 0; i < st.events.size(); ++i) {
     const StrokeEvent& e = st.events[i];
     const std::string where = src + ": events[" + std::to_string(i) + "]: ";
     if (!std::isfinite(e.t) || e.t < 0) WB_THROW(where + "t must be a finite time >= 0");
     if (i > 0 && e.t < st.events[i - 1].t)
-      WB_THROW(where + "t = " + json_number_text(e.t) + " is before events[" + std::to_string(i - 1) + "].t = " +
-               json_number_text(st.events[i - 1].t) + " (events must be in time order)");
+      WB_THROW(where + "t = " + number_text(e.t) + " is before events[" + std::to_string(i - 1) + "].t = " +
+               number_text(st.events[i - 1].t) + " (events must be in time order)");
     if (e.t > st.samples.back().t)
-      WB_THROW(where + "t = " + json_number_text(e.t) + " is after the last sample (t = " + json_number_text(st.samples.back().t) + ")");
+      WB_THROW(where + "t = " + number_text(e.t) + " is after the last sample (t = " +
+               number_text(st.samples.back().t) + ")");
   }
 }
 
