@@ -113,7 +113,7 @@ BrushPanel::BrushPanel(QWidget* parent) : QWidget(parent) {
     QFile f(path);
     if (!f.open(QIODevice::ReadOnly)) return;
     try {
-      BrushSpec b = brush_from_json(nlohmann::json::parse(f.readAll().toStdString()), path.toStdString());
+      BrushSpec b = brush_from_json(nlohmann::json::parse(f.readAll().toStdString()), path.toStdString(), "");
       set_brush(b);
       emit_changed();
     } catch (const std::exception& e) {

@@ -10,9 +10,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (j.is_discarded()) return 0;  // not JSON: the caller reports nlohmann's parse error
   wb::fuzz::expect_clean([&] {
     std::vector<std::string> warnings;
-    const wb::BrushSpec b = wb::brush_from_json(j, "fuzz-preset.json", &warnings);
+    const wb::BrushSpec b = wb::brush_from_json(j, "fuzz-preset.json", "", &warnings);
     // What was accepted writes and reads back to the same brush.
-    if (!(wb::brush_from_json(wb::brush_to_json(b), "round trip") == b)) __builtin_trap();
+    if (!(wb::brush_from_json(wb::brush_to_json(b), "round trip", "") == b)) __builtin_trap();
   });
   return 0;
 }

@@ -63,7 +63,7 @@ TEST_F(FuzzRegressions, MyPaintDumps) {
 
 TEST_F(FuzzRegressions, BrushPresets) {
   for (const fs::path& f : findings("brush_json"))
-    expect_clean_error(f, [&] { brush_from_json(nlohmann::json::parse(text_of(f)), f.string()); });
+    expect_clean_error(f, [&] { brush_from_json(nlohmann::json::parse(text_of(f)), f.string(), ""); });
 }
 
 TEST_F(FuzzRegressions, ParameterFiles) {

@@ -283,15 +283,17 @@ TEST(BrushJson, RoundTripAndOverrides) {
   BrushSpec b = default_brush(BrushShape::Fan);
   b.bristles = 555;
   b.beta_B = 0.02f;
-  EXPECT_EQ(brush_from_json(brush_to_json(b), "b"), b);
+  EXPECT_EQ(brush_from_json(brush_to_json(b), "b", ""), b);
   const auto j = nlohmann::json::parse(R"({"shape": "rigger", "length": 150})");
   BrushSpec want = default_brush(BrushShape::Rigger);
   want.length = 150.f;
-  EXPECT_EQ(brush_from_json(j, "b"), want);
-  EXPECT_THROW(brush_from_json(nlohmann::json::parse(R"({"bristles": 100.5})"), "b"), Error);
-  EXPECT_THROW(brush_from_json(nlohmann::json::parse(R"({"length": "long"})"), "b"), Error);
-  EXPECT_THROW(brush_from_json(nlohmann::json::parse(R"({"length": 0})"), "b"), Error);
-  EXPECT_THROW(brush_from_json(nlohmann::json::parse(R"([1])"), "b"), Error);
+  EXPECT_EQ(brush_from_json(j, "b", ""), want);
+  EXPECT_THROW(brush_from_json(nlohmann::json::parse(R"({"bristles": 100.5})"), "b", ""), Error);
+  EXPECT_THROW(brush_from_json(nlohmann::json::parse(R"({"length": "long"})"), "b", ""), Error);
+  EXPECT_THROW(brush_from_json(nlohmann::json::parse(R"({"length": 0})"), "b", ""), Error);
+  EXPECT_THROW(brush_from_json(nlohmann::json::parse(R"([1])"), "b", ""), Error);
+  // A seed's range is wider than the readers' plausibility bound (1e7) and is honoured.
+  EXPECT_EQ(brush_from_json(nlohmann::json::parse(R"({"seed": 3000000000})"), "b", "").seed, 3000000000u);
   // Every shape's defaults lie in the documented ranges.
   for (BrushShape s : {BrushShape::Round, BrushShape::Flat, BrushShape::Fan, BrushShape::Filbert, BrushShape::Angular,
                        BrushShape::Mop, BrushShape::Rigger})

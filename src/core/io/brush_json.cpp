@@ -110,41 +110,28 @@ void validate_brush(const BrushSpec& brush, const std::string& context) {
   }
 }
 
-BrushSpec brush_from_json(const nlohmann::json& j, const std::string& context, std::vector<std::string>* warnings) {
-  if (!j.is_object()) WB_THROW(context + ": expected an object, found " + json_type_name(j));
+BrushSpec brush_from_json(const nlohmann::json& j, const std::string& source, const std::string& path,
+                          std::vector<std::string>* warnings) {
+  ObjectReader r(j, source, path);
   BrushShape shape = BrushShape::Round;
-  if (auto it = j.find("shape"); it != j.end()) {
-    if (!it->is_string()) WB_THROW(context + ".shape: expected a string, found " + json_type_name(*it));
+  if (r.has("shape")) {
     try {
-      shape = brush_shape_from_string(it->get<std::string>());
+      shape = brush_shape_from_string(r.string("shape"));
     } catch (const Error& e) {
       std::string msg = e.what();
       if (const size_t tag = msg.rfind(" ["); tag != std::string::npos && msg.back() == ']') msg.resize(tag);
-      WB_THROW(context + ".shape: " + msg);
+      r.fail(msg, "shape");
     }
   }
   BrushSpec b = default_brush(shape);
-  for (auto it = j.begin(); it != j.end(); ++it) {
-    const std::string& key = it.key();
-    if (key == "shape") continue;
-    const Field* field = nullptr;
-    for (const Field& f : fields())
-      if (key == f.range.key) field = &f;
-    if (!field) {
-      if (warnings) warnings->push_back(context + ": unknown key '" + key + "' ignored");
-      continue;
-    }
-    const nlohmann::json& v = *it;
-    const std::string where = context + "." + key;
-    if (!v.is_number()) WB_THROW(where + ": expected a number, found " + json_type_name(v));
-    const double d = v.get<double>();
-    if (!std::isfinite(d)) WB_THROW(where + ": not a finite number");
-    if (field->range.integer && d != std::floor(d)) WB_THROW(where + ": expected an integer, found " + number_text(d));
-    if (d < field->range.min || d > field->range.max)
-      WB_THROW(where + ": " + number_text(d) + " is outside [" + number_text(field->range.min) + ", " +
-               number_text(field->range.max) + "]");
-    set_value(b, field->member, d);
+  for (const Field& f : fields()) {
+    const BrushFieldRange& range = f.range;
+    if (!r.has(range.key)) continue;
+    const double v = r.number(range.key, range.min, range.max);  // a seed's range exceeds an int's
+    if (range.integer && v != std::floor(v)) r.fail("expected an integer, found " + number_text(v), range.key);
+    set_value(b, f.member, v);
   }
+  if (warnings) r.warn_unknown(*warnings);
   return b;
 }
 

@@ -14,9 +14,10 @@ namespace wb {
 nlohmann::json brush_to_json(const BrushSpec& brush);
 
 /// Starts from default_brush(shape) ("shape" optional, default "round") and overrides the
-/// fields given. `context` prefixes messages (e.g. "stroke.json: brush"). Unknown keys are
-/// appended to `warnings` (when given); wrong types and out-of-range values throw wb::Error.
-BrushSpec brush_from_json(const nlohmann::json& j, const std::string& context,
+/// fields given, the object at `path` of file `source` (both named in messages; path "" for a
+/// preset file's top level). Unknown keys are appended to `warnings` (when given); wrong types and
+/// out-of-range values throw wb::Error.
+BrushSpec brush_from_json(const nlohmann::json& j, const std::string& source, const std::string& path,
                           std::vector<std::string>* warnings = nullptr);
 
 /// Throws wb::Error (prefixed by `context`) if a field is outside its documented range.

@@ -84,9 +84,11 @@ std::array<float, 3> ObjectReader::triple(const char* key, double lo, double hi)
 double ObjectReader::check_number(const json& v, const char* key, double lo, double hi) const {
   if (!v.is_number()) fail("expected a number, found " + json_type_name(v), key);
   const double d = v.get<double>();
-  if (!std::isfinite(d) || std::fabs(d) > kAbsurdValue)
+  // Corrupt data gets its own message; a range wider than kAbsurdValue (a brush's seed) is honoured.
+  const bool in_range = d >= lo && d <= hi;
+  if (!std::isfinite(d) || (std::fabs(d) > kAbsurdValue && !in_range))
     fail(number_text(d) + " is not a plausible value (|v| > 1e7)", key);
-  if (d < lo || d > hi) fail(number_text(d) + " is outside [" + number_text(lo) + ", " + number_text(hi) + "]", key);
+  if (!in_range) fail(number_text(d) + " is outside [" + number_text(lo) + ", " + number_text(hi) + "]", key);
   return d;
 }
 

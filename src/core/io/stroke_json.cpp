@@ -236,7 +236,7 @@ Stroke parse_stroke_json(std::string_view text, const std::string& source) {
     }
     c.warn_unknown(st.warnings);
   }
-  if (top.has("brush")) st.brush = brush_from_json(root.at("brush"), source + ": brush", &st.warnings);
+  if (top.has("brush")) st.brush = brush_from_json(root.at("brush"), source, "brush", &st.warnings);
   else st.brush = default_brush(BrushShape::Round);
   if (top.has("paint")) {
     ObjectReader p(root.at("paint"), source, "paint");
