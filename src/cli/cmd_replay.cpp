@@ -91,7 +91,7 @@ void apply_overrides(const ReplayArgs& a, Stroke& stroke) {
 /// Per step of a bench run: the viscous solve's CG iterations and the residual it reached,
 /// and the paint advection's sub-steps.
 struct SolveLog {
-  std::vector<double> iterations, residual, substeps;
+  std::vector<double> iterations, residual, substeps, passes;
 };
 
 void report_bench(const ReplayArgs& a, const Simulator& sim, const Stroke& stroke, const Device& device,
@@ -144,8 +144,9 @@ void report_bench(const ReplayArgs& a, const Simulator& sim, const Stroke& strok
   const double res_med = pct(solve.residual, 0.5), res_max = pct(solve.residual, 1.0);
   std::printf("viscous solve: %.0f CG iterations median, %.0f most; residual %.2e median, %.2e worst (tolerance %.0e)\n",
               it_med, it_max, res_med, res_max, double(sim.config().params.grid.viscosity_tolerance));
-  std::printf("paint advection: %.0f sub-steps median, %.0f most (work bound %d)\n", pct(solve.substeps, 0.5),
-              pct(solve.substeps, 1.0), sim.config().params.grid.advect_max_substeps);
+  std::printf("paint advection: %.0f sub-steps median, %.0f most (work bound %d); %.0f one-axis passes median\n",
+              pct(solve.substeps, 0.5), pct(solve.substeps, 1.0), sim.config().params.grid.advect_max_substeps,
+              pct(solve.passes, 0.5));
   std::printf("step timed whole: %.3f ms median (stages timed: %.3f ms)\n", whole_ms, step_ms);
   std::printf("host waits: %.1f a step (mean; reads of device results, column `reads`); launches: %.0f a step\n",
               waits, launches);
@@ -166,6 +167,7 @@ void report_bench(const ReplayArgs& a, const Simulator& sim, const Stroke& strok
                        {"residual_median", res_med},
                        {"residual_max", res_max}}},
                      {"advection_substeps", {{"median", pct(solve.substeps, 0.5)}, {"max", pct(solve.substeps, 1.0)}}},
+                     {"advection_passes", {{"median", pct(solve.passes, 0.5)}, {"max", pct(solve.passes, 1.0)}}},
                      {"stages", stages}};
     write_file_atomic(a.bench_json, j.dump(2) + "\n");
   }
@@ -239,6 +241,7 @@ int run_replay(const ReplayArgs& a) {
       solve.iterations.push_back(sim.grid().stats().viscosity_iterations);
       solve.residual.push_back(sim.grid().stats().viscosity_residual);
       solve.substeps.push_back(sim.grid().stats().advect_substeps);
+      solve.passes.push_back(sim.grid().stats().advect_passes);
     }
     if (!a.frames_dir.empty() && done % a.every == 0) {
       char name[64];

@@ -559,6 +559,50 @@ TEST_F(GridStepTest, AdvectionKeepsMassWithoutAnyCorrection) {
               worst, lowest, c1.x - c0.x, most);
 }
 
+TEST_F(GridStepTest, EachAxisTakesThePassesItsOwnFlowNeeds) {
+  TileStore canvas(device_, CanvasDims{128, 128, 16});
+  GridParams p;
+  Grid g(canvas, p, Int3{64, 48, 8}, Int3{0, 0, 0});
+  const GridDims d = g.dims();
+  // A block of paint carried fast along x, slowly along y, not at all along z: a stroke's drag.
+  paint_cells(g, [](int i, int j, int k) { return (i >= 8 && i < 20 && j >= 16 && j < 28 && k < 3) ? 1.f : 0.f; });
+  const float dt = 1.f / 64.f, U = 160.f, V = 20.f;  // 2.5 and 0.31 cells a step
+  std::vector<float> u(size_t(d.nu()), U), v(size_t(d.nv()), V), w(size_t(d.nw()), 0.f);
+  const auto rho0 = host_density(g);
+  const double m0 = sum(rho0);
+  const Vec3 c0 = centroid(d, rho0);
+  const int steps = 8;
+  double worst = 0;
+  float lo = 0.f, hi = 0.f;
+  for (int s = 0; s < steps; ++s) {
+    g.window().velocity(0).copy_from_host(u);
+    g.window().velocity(1).copy_from_host(v);
+    g.window().velocity(2).copy_from_host(w);
+    g.classify();
+    g.advect(dt);
+    // x: outflow 2.5 cells a step, 0.5 a pass: 5 passes; y: 0.31, one pass; z: no flow, none.
+    EXPECT_EQ(g.stats().advect_substeps, 5) << "step " << s;
+    EXPECT_EQ(g.stats().advect_passes, 6) << "step " << s;
+    EXPECT_LE(g.stats().advect_courant, p.advect_courant * (1.f + 1e-6f));
+    const auto rho = host_density(g);
+    worst = std::max(worst, std::fabs(sum(rho) - m0) / m0);
+    for (float r : rho) {
+      lo = std::min(lo, r);
+      hi = std::max(hi, r);
+    }
+  }
+  const Vec3 c1 = centroid(d, host_density(g));
+  EXPECT_LT(worst, 1e-6);
+  EXPECT_GE(lo, -1e-7f) << "round-off only";
+  EXPECT_LE(hi, 1.f + 1e-5f) << "a uniform flow makes no new maximum";
+  // Each axis carries the paint its whole way over the step, whatever its number of passes.
+  EXPECT_NEAR(c1.x - c0.x, U * dt * float(steps), 0.1f);
+  EXPECT_NEAR(c1.y - c0.y, V * dt * float(steps), 0.05f);
+  EXPECT_NEAR(c1.z - c0.z, 0.f, 1e-4f);
+  std::printf("[ passes ] x %.3f of %.3f cells, y %.3f of %.3f in 6 passes a step (15 with every axis at x's count)\n",
+              c1.x - c0.x, U * dt * float(steps), c1.y - c0.y, V * dt * float(steps));
+}
+
 TEST_F(GridStepTest, SwirlKeepsMassAndBoundsAndTurnsThePaint) {
   TileStore canvas(device_, CanvasDims{128, 128, 16});
   GridParams p;

@@ -116,17 +116,13 @@ WB_HD WB_INLINE float face_paint_flux(const GridView& g, const float* rho, int c
   return out > held ? F * ((held / out) * (1.f - 1e-6f)) : F;
 }
 
-/// Largest one-axis outflow of a cell holding paint, cells/s: along each axis, the flux out
-/// through its two faces of that axis; 0 for empty cells. The paint's sub-steps are sized by it.
-WB_HD WB_INLINE float cell_outflow_rate(const GridView& g, const float* rho, int i, int j, int k) {
+/// Outflow of a cell holding paint along axis c, cells/s: the flux out through its two faces of
+/// that axis; 0 for empty cells. The axis's passes of the paint's advection are sized by it.
+WB_HD WB_INLINE float cell_axis_outflow(const GridView& g, const float* rho, int c, int i, int j, int k) {
   if (!(rho[g.d.cell(i, j, k)] > 0.f)) return 0.f;
-  float worst = 0.f;
-  for (int c = 0; c < 3; ++c) {
-    const float lo = face_volume_flux(g, c, i, j, k);
-    const float hi = face_volume_flux(g, c, i + (c == 0), j + (c == 1), k + (c == 2));
-    worst = maxf(worst, maxf(hi, 0.f) + maxf(-lo, 0.f));
-  }
-  return worst;
+  const float lo = face_volume_flux(g, c, i, j, k);
+  const float hi = face_volume_flux(g, c, i + (c == 0), j + (c == 1), k + (c == 2));
+  return maxf(hi, 0.f) + maxf(-lo, 0.f);
 }
 
 /// Position of face (i,j,k) of component c, window cells.

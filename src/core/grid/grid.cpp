@@ -272,7 +272,7 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   cg_sums_.set_device(d);
   cg_sums_.resize(5);
   advect_max_.set_device(d);
-  advect_max_.resize(4);
+  advect_max_.resize(6);
   const size_t tiles = size_t((g.nx + kPaintTile - 1) / kPaintTile) * size_t((g.ny + kPaintTile - 1) / kPaintTile);
   for (auto* b : {&tile_mark_, &tile_active_, &tile_halo_, &tile_painted_[0], &tile_painted_[1], &tile_process_}) {
     b->set_device(d);
@@ -328,31 +328,60 @@ void Grid::advect(float dt) {
   PaintWindow& paint = window_.paint();
   paint_tmp_.set_origin(paint.origin());
   GridView v = view();
-  // Paint: flux form on the faces of the last step's velocity, one axis at a time (Strang order
-  // x y z, then z y x), in sub-steps that keep each axis's outflow Courant number at most
-  // advect_courant: no cell gives more than it holds, and no global correction is needed.
-  outflow_d(d, v, paint.density.data(), particle_density_, cell_tmp_.data(), face_tmp_.data(), rhs_.data());
-  // The maxima in one copy: the outflow rate, the layers holding paint and those holding paint
-  // or particles.
-  reduce_max_into(d, cell_tmp_.data(), g.cells(), advect_max_.data(), ws_);
-  reduce_max_into(d, face_tmp_.data(), g.cells(), advect_max_.data() + 1, ws_);
-  reduce_max_into(d, rhs_.data(), g.cells(), advect_max_.data() + 2, ws_);
-  float maxima[3];
-  advect_max_.copy_to_host(maxima, 3);
-  const float rate = maxima[0];
-  const int top = int(maxima[1]), joint_top = int(maxima[2]);
-  const float courant = std::isfinite(rate) ? rate * dt : 0.f;
-  const int n = std::clamp(int(std::ceil(courant / params_.advect_courant)), 1, params_.advect_max_substeps);
+  // Paint: flux form on the faces of the last step's velocity, one axis at a time, each axis in
+  // passes that keep its outflow Courant number at most advect_courant: no cell gives more than
+  // it holds, and no global correction is needed. An axis takes as many passes as its own flow
+  // needs (a stroke along x moves paint fast along x and slowly up), spread evenly over the
+  // step's sub-steps, which alternate the order x y z and z y x (Strang).
+  const int64_t cells = g.cells();
+  outflow_d(d, v, paint.density.data(), particle_density_, face_tmp_.data(), cell_tmp_.data(), rhs_.data());
+  // The maxima in one copy: the outflow rate along each axis, the layers holding paint and
+  // those holding paint or particles.
+  for (int a = 0; a < 3; ++a) reduce_max_into(d, face_tmp_.data() + a * cells, cells, advect_max_.data() + a, ws_);
+  reduce_max_into(d, cell_tmp_.data(), cells, advect_max_.data() + 3, ws_);
+  reduce_max_into(d, rhs_.data(), cells, advect_max_.data() + 4, ws_);
+  float maxima[5];
+  advect_max_.copy_to_host(maxima, 5);
+  int passes[3];
+  float courant = 0.f;
+  for (int a = 0; a < 3; ++a) {
+    const float c = std::isfinite(maxima[a]) ? maxima[a] * dt : 0.f;
+    // No pass along an axis where no face of a painted cell carries flow: it would copy.
+    passes[a] = c > 0.f ? std::clamp(int(std::ceil(c / params_.advect_courant)), 1, params_.advect_max_substeps) : 0;
+    if (passes[a] > 0) courant = std::max(courant, c / float(passes[a]));
+  }
+  const int top = int(maxima[3]), joint_top = int(maxima[4]);
+  const int n = std::max({passes[0], passes[1], passes[2]});
   stats_.advect_substeps = n;
-  stats_.advect_courant = courant / float(n);
+  stats_.advect_passes = passes[0] + passes[1] + passes[2];
+  stats_.advect_courant = courant;
+  if (n > 0) advect_paint(dt, passes, top);
+  // Velocity: backtrace every open face through a copy of the field, up to the layers that can
+  // hold liquid in this step (paint or particles, the paint risen at most a cell a z pass) and the
+  // stencils that reach them. Above, no face is fluid before the projection's extrapolation
+  // writes it again, and nothing in the step reads it where there is no paint (docs/GRID.md).
+  for (int c = 0; c < 3; ++c)
+    mem::copy_on_device(d, vel_tmp_[c].data(), v.vel[c], size_t(g.faces(c)) * sizeof(float));
+  v = view();
+  advect_vel_d(d, v, vel_tmp_[0].data(), vel_tmp_[1].data(), vel_tmp_[2].data(), dt,
+               std::min(g.nz, joint_top + passes[2] + 2));
+}
+
+void Grid::advect_paint(float dt, const int passes[3], int top) {
+  const Device& d = device();
+  const GridDims g = dims();
+  PaintWindow& paint = window_.paint();
+  const GridView v = view();
+  const int n = std::max({passes[0], passes[1], passes[2]});
   // Work in proportion to the paint: a pass moves paint at most one cell along its axis, so in
-  // this step's n passes per axis the paint reaches at most n cells from where it is, and no
-  // cell beyond n + 1 cells of it computes a flux. The passes visit the columns of the tiles
-  // within that reach (and the layers below top + n); the advected cells read at most two cells
-  // further (donor and slope), in the ring of halo tiles and the two layers above, which the
-  // scratch copy takes from the paint once (docs/GRID.md "Work in proportion to the paint").
-  const int layers = std::min(g.nz, top + n);
-  const int reach = (n + 1 + kPaintTile - 1) / kPaintTile;
+  // this step's passes the paint reaches at most passes[a] cells from where it is along a, and
+  // no cell beyond that (plus one) computes a flux. The passes visit the columns of the tiles
+  // within that reach (and the layers below top + passes[z]); the advected cells read at most
+  // two cells further (donor and slope), in the ring of halo tiles and the two layers above,
+  // which the scratch copy takes from the paint once (docs/GRID.md "Work in proportion to the
+  // paint").
+  const int layers = std::min(g.nz, top + passes[2]);
+  const int reach = (std::max(passes[0], passes[1]) + 1 + kPaintTile - 1) / kPaintTile;
   tile_counts_.fill_zero();
   paint_tiles_d(d, g, paint.density.data(), paint.dryness.data(), params_.dry_threshold, layers, reach,
                 tile_mark_.data(), tile_active_.data(),
@@ -366,22 +395,28 @@ void Grid::advect(float dt) {
   int32_t* below[2] = {pass_below_.data(), pass_below_.data() + 1};
   const size_t tile_bytes = tile_mark_.size() * sizeof(int32_t);
   mem::copy_on_device(d, painted[0], tile_mark_.data(), tile_bytes);
-  const float h = dt / float(n);
+  int done[3] = {0, 0, 0}, made = 0;
   for (int s = 0; s < n; ++s)
     for (int a = 0; a < 3; ++a) {
       const int axis = (s % 2 == 0) ? a : 2 - a;
+      // The axis's passes due by the end of sub-step s: passes[axis] spread evenly over n, each
+      // at the middle of its share (one pass of n: at the middle sub-step).
+      const int due = int((int64_t(2) * (s + 1) * passes[axis] + n) / (int64_t(2) * n));
+      if (done[axis] == due) continue;
+      ++done[axis];
+      ++made;
       tiles_pass_d(d, g, tiles, painted[0], tile_process_.data());
       mem::fill_zero(d, painted[1], tile_bytes);
       mem::fill_zero(d, below[1], sizeof(int32_t));
-      advect_axis_d(d, v, paint.view(), paint_tmp_.view(), axis, h, tiles, tile_process_.data(), painted[1], below[0],
-                    below[1]);
+      advect_axis_d(d, v, paint.view(), paint_tmp_.view(), axis, dt / float(passes[axis]), tiles,
+                    tile_process_.data(), painted[1], below[0], below[1]);
       std::swap(painted[0], painted[1]);
       std::swap(below[0], below[1]);
 #define WB_X(name, doc) paint.name.swap(paint_tmp_.name);
       WB_PAINT_FIELDS(WB_X)
 #undef WB_X
     }
-  if (n % 2 == 1) {
+  if (made % 2 == 1) {
     // An odd number of passes left the result in the scratch buffers, complete only where the
     // passes wrote: the paint's own buffers are complete elsewhere, so they take the tiles back.
 #define WB_X(name, doc) paint.name.swap(paint_tmp_.name);
@@ -389,22 +424,13 @@ void Grid::advect(float dt) {
 #undef WB_X
     copy_tiles_d(d, g, tiles, paint_tmp_.view(), paint.view(), false);
   }
-  // Velocity: backtrace every open face through a copy of the field, up to the layers that can
-  // hold liquid in this step (paint or particles, the paint moved up by at most n cells) and the
-  // stencils that reach them. Above, no face is fluid before the projection's extrapolation
-  // writes it again, and nothing in the step reads it where there is no paint (docs/GRID.md).
-  for (int c = 0; c < 3; ++c)
-    mem::copy_on_device(d, vel_tmp_[c].data(), v.vel[c], size_t(g.faces(c)) * sizeof(float));
-  v = view();
-  advect_vel_d(d, v, vel_tmp_[0].data(), vel_tmp_[1].data(), vel_tmp_[2].data(), dt,
-               std::min(g.nz, joint_top + n + 2));
 }
 
 void Grid::find_extent() {
   const GridDims g = dims();
   layer_top_d(device(), g, window_.paint().density.data(), particle_density_, cell_tmp_.data());
-  reduce_max_into(device(), cell_tmp_.data(), g.cells(), advect_max_.data() + 3, ws_);
-  extent_d(device(), g, advect_max_.data() + 2, advect_max_.data() + 3, extent_.data());
+  reduce_max_into(device(), cell_tmp_.data(), g.cells(), advect_max_.data() + 5, ws_);
+  extent_d(device(), g, advect_max_.data() + 4, advect_max_.data() + 5, extent_.data());
 }
 
 void Grid::rheology() {

@@ -18,6 +18,7 @@ namespace wb {
 /// One step's counts and solver figures (the mass books are the simulator's, PaintBooks).
 struct GridStats {
   int advect_substeps = 0;      ///< sub-steps the paint's flux-form advection took (Courant <= advect_courant)
+  int advect_passes = 0;        ///< one-axis passes over those sub-steps (each axis as many as its flow needs)
   float advect_courant = 0;     ///< largest one-axis outflow Courant number of a sub-step that moved paint
   double rhs_norm = 0;          ///< with projection_norms: ||rhs||_2 over liquid cells before the projection
   double residual_norm = 0;     ///< with projection_norms: ||residual||_2 after it
@@ -156,8 +157,8 @@ class Grid {
   /// The CG's scalars on the device: r.z of the two latest iterations, p.Ap, b.D^-1 b.
   DeviceBuffer<double> cg_sums_;
   int cg_last_iterations_ = 0;  ///< the last viscous solve's CG iterations: the next one plans on them
-  /// The advection's outflow rate and top layers (paint, joint) in one copy, then the joint
-  /// top after the particles joined (find_extent).
+  /// The advection's outflow rate along each axis and top layers (paint, joint) in one copy,
+  /// then the joint top after the particles joined (find_extent).
   DeviceBuffer<float> advect_max_;
   DeviceBuffer<int32_t> tile_mark_, tile_active_, tile_halo_;  ///< the advection's tiles (PaintTiles)
   /// Per tile: whether it held paint after the last pass and after this one (swapped each
@@ -169,6 +170,8 @@ class Grid {
   const GridExtent* stage_extent_ = nullptr;  ///< extent_ while step() runs those stages, else null
   /// The layers holding paint or particles now, or liquid before the advection: extent_.
   void find_extent();
+  /// The paint's flux-form passes of advect(): passes[a] along axis a, the paint below layer top.
+  void advect_paint(float dt, const int passes[3], int top);
   PaintWindow paint_tmp_;
   SolverScratch scratch_;
   Workspace ws_;

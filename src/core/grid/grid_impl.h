@@ -93,10 +93,11 @@ constexpr float kTraceDensity = 1e-6f;
 void grid_paint_outflow(GridView g, const float* rho, const float* particle_density, float* out, float* top,
                         float* joint_top) {
   const GridDims d = g.d;
-  parallel_for(d.cells(), [=] WB_HD(int64_t c) {
+  const int64_t n = d.cells();
+  parallel_for(n, [=] WB_HD(int64_t c) {
     int i, j, k;
     d.decompose_cell(c, i, j, k);
-    out[c] = cell_outflow_rate(g, rho, i, j, k);
+    for (int a = 0; a < 3; ++a) out[a * n + c] = cell_axis_outflow(g, rho, a, i, j, k);
     // Traces (a millionth of a cell, carried up by a lifting bristle a fraction of a cell a
     // sub-step) do not count: above the top they stay where they are for the step.
     const bool paint = rho[c] > kTraceDensity;
