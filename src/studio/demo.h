@@ -27,10 +27,16 @@ std::vector<ScriptPoint> line_points(QPointF a, QPointF b, int n, float pressure
 
 namespace wb::studio {
 class MainWindow;
+/// Wall seconds of a scripted painting: the pen down, and each surface's strokes from the pen's
+/// press until its simulation has caught up (so a rate is that surface's own).
+struct DemoTimes {
+  double pen_s = 0.0;
+  double canvas_s = 0.0, palette_s = 0.0;
+};
 /// A small scripted painting on linen: two wells' paint put out on the palette and mixed there,
 /// three curved strokes (the mix, a well's paint, a dry-brush pass) with varying pressure and tilt
-/// (the README screenshot and the frame-rate measurement). Returns the seconds the pen spent down.
-double run_demo_painting(MainWindow& w);
+/// (the README screenshot and the frame-rate measurement).
+DemoTimes run_demo_painting(MainWindow& w);
 /// Stroke k of an endless scripted session (`--paint-loop`, the autosave and recovery test): a
 /// dip, then a straight stroke of about a second across row k mod 5 of the canvas, alternating in
 /// direction. Returns once the simulation has caught up with it.

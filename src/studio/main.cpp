@@ -79,39 +79,51 @@ int main(int argc, char** argv) {
       QElapsedTimer timer;
       timer.start();
       const int64_t frames0 = w.view()->frames_drawn();
-      const SimStatus st0 = w.sim()->status();
-      const int64_t steps0 = st0.steps;
-      const double pen_s = run_demo_painting(w);
+      const SimStatus st0 = w.sim()->status(), pal0 = w.palette()->sim()->status();
+      const DemoTimes t = run_demo_painting(w);
       w.settle();
       QApplication::processEvents();
       const double secs = timer.elapsed() / 1000.0;
-      const SimStatus st = w.sim()->status();
-      const int64_t frames = w.view()->frames_drawn() - frames0, steps = st.steps - steps0;
-      const double sim_s = double(steps) * kStepDt;
-      std::printf("demo: %.1f s wall (pen on the canvas %.1f s), %lld view frames (%.1f fps), %lld simulation steps "
-                  "(%.2f steps/s, real-time factor %.3f, median %.1f ms/step), %lld particles at the end, device %s, "
+      const SimStatus st = w.sim()->status(), pal = w.palette()->sim()->status();
+      const int64_t frames = w.view()->frames_drawn() - frames0, steps = st.steps - st0.steps,
+                    pal_steps = pal.steps - pal0.steps;
+      // Each surface's rate over its own strokes (pen down until its simulation caught up): the
+      // canvas's is the painter's real-time factor; the palette's mixing is reported beside it.
+      const double sim_s = double(steps) * kStepDt, pal_sim_s = double(pal_steps) * kStepDt;
+      const double rtf = t.canvas_s > 0 ? sim_s / t.canvas_s : 0.0;
+      const double pal_rtf = t.palette_s > 0 ? pal_sim_s / t.palette_s : 0.0;
+      std::printf("demo: %.1f s wall (pen on the canvas or palette %.1f s), %lld view frames (%.1f fps), device %s, "
                   "preset %s\n",
-                  secs, pen_s, (long long)frames, frames / secs, (long long)steps, steps / secs, sim_s / secs,
-                  st.step_ms, (long long)st.particles, st.device.c_str(), opt.preset.name.c_str());
-      std::printf("demo: simulation thread, s: step %.1f, render %.1f, undo %.1f, player %.1f, commands %.1f, "
-                  "idle %.1f\n",
-                  st.times.step - st0.times.step, st.times.render - st0.times.render, st.times.undo - st0.times.undo,
-                  st.times.player - st0.times.player, st.times.commands - st0.times.commands,
-                  st.times.idle - st0.times.idle);
+                  secs, t.pen_s, (long long)frames, frames / secs, st.device.c_str(), opt.preset.name.c_str());
+      std::printf("demo: canvas: %lld simulation steps in %.1f s of its strokes (real-time factor %.3f, median "
+                  "%.1f ms/step), %lld particles at the end\n",
+                  (long long)steps, t.canvas_s, rtf, st.step_ms, (long long)st.particles);
+      std::printf("demo: palette: %lld simulation steps in %.1f s of its strokes (real-time factor %.3f, median "
+                  "%.1f ms/step)\n",
+                  (long long)pal_steps, t.palette_s, pal_rtf, pal.step_ms);
+      const auto times = [](const SimStatus& a, const SimStatus& b) {
+        return nlohmann::json{{"commands", b.times.commands - a.times.commands},
+                              {"player", b.times.player - a.times.player},
+                              {"undo", b.times.undo - a.times.undo},
+                              {"step", b.times.step - a.times.step},
+                              {"render", b.times.render - a.times.render},
+                              {"idle", b.times.idle - a.times.idle}};
+      };
+      const nlohmann::json worker = times(st0, st), pal_worker = times(pal0, pal);
+      std::printf("demo: canvas's simulation thread, s: %s\ndemo: palette's simulation thread, s: %s\n",
+                  worker.dump().c_str(), pal_worker.dump().c_str());
       try {
         if (!stats.isEmpty()) {
           const nlohmann::json j = {{"preset", opt.preset.name}, {"device", st.device},
-                                    {"wall_s", secs},         {"pen_s", pen_s},
+                                    {"wall_s", secs},         {"pen_s", t.pen_s},
                                     {"view_frames", frames},  {"view_fps", frames / secs},
-                                    {"steps", steps},         {"steps_per_s", steps / secs},
-                                    {"simulated_s", sim_s},   {"real_time_factor", sim_s / secs},
+                                    {"canvas_s", t.canvas_s}, {"steps", steps},
+                                    {"simulated_s", sim_s},   {"real_time_factor", rtf},
                                     {"median_step_ms", st.step_ms}, {"particles_end", st.particles},
-                                    {"worker_s", {{"commands", st.times.commands - st0.times.commands},
-                                                  {"player", st.times.player - st0.times.player},
-                                                  {"undo", st.times.undo - st0.times.undo},
-                                                  {"step", st.times.step - st0.times.step},
-                                                  {"render", st.times.render - st0.times.render},
-                                                  {"idle", st.times.idle - st0.times.idle}}}};
+                                    {"worker_s", worker},
+                                    {"palette", {{"strokes_s", t.palette_s}, {"steps", pal_steps},
+                                                 {"simulated_s", pal_sim_s}, {"real_time_factor", pal_rtf},
+                                                 {"median_step_ms", pal.step_ms}, {"worker_s", pal_worker}}}};
           wb::write_file_atomic(stats.toStdString(), j.dump(2) + "\n");
         }
         // The picture: the painting under a raking light, with the oblique view beside it.

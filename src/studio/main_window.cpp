@@ -99,6 +99,7 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   cfg.brush = q.start_brush();
   if (options_.brush) cfg.brush = *options_.brush;
   cfg.window = Int3{q.window_xy, q.window_xy, std::min(q.window_z, q.canvas_depth)};
+  cfg.params.transfer.candidate_split = q.candidate_split;
   RenderParams rp;
   rp.ao_rays = q.ao_rays;
   sim_ = std::make_unique<SimThread>(cfg, rp);

@@ -18,6 +18,8 @@ struct QualityPreset {
   int ao_rays = 12;
   int window_xy = 128, window_z = 32;  ///< active simulation window, cells (paper: 128 x 128 x 32)
   float brush_length = 0.f, brush_width = 0.f;  ///< starting round brush size, cells (0: the shape's default)
+  /// Candidates per cell axis of Eq. 15's sampling (transfer.candidate_split; 3: the paper's 27).
+  int candidate_split = 3;
   /// The starting brush: a round brush with the preset's bristles, samples and size.
   BrushSpec start_brush() const;
   static QualityPreset cpu();

@@ -172,6 +172,45 @@ TEST_F(GridParticleTest, ClampOnAnIsolatedCellCreatesNoPaint) {
     if (i != c) EXPECT_EQ(after[0][i], 0.f);
 }
 
+TEST_F(GridParticleTest, CandidateSplitSetsTheParticlesACellGives) {
+  // A full cell among full cells, near a bristle: split^3 candidates, one in each sub-cell of the
+  // n x n x n split, each carrying its share; the paint they take is the paint the cells lose.
+  for (int split = 1; split <= 3; ++split) {
+    PaintWindow w = make_window({16, 16, 8}, {0, 0, 0},
+                                [](int i, int j, int k) { return i >= 6 && i <= 10 && j >= 6 && j <= 10 && k <= 4 ? 1.f : 0.f; },
+                                Vec3(1.f, 0.f, 0.f));
+    HostSamples h = vertical_brush(1, 4, 0.8f, 8.5f, 8.5f, 3.f, 1.f);
+    DeviceSamples s(device_);
+    s.upload(h);
+    TransferParams prm;
+    prm.candidate_split = split;
+    Transfer t(device_, prm);
+    ParticleStore p(device_);
+    TransferEnv env = env_for(w, 1.f);  // the bristle's own cells and their neighbours
+    const double before = w.total_density(ws_) * prm.cell_mass();
+    t.update_distance(s.view(), env);
+    TransferRecord rec;
+    t.grid_to_particles(p, env, rec);
+    t.collect(rec);
+    ASSERT_GT(rec.to_particles_count, 0) << split;
+    const ParticleHost ph = p.to_host();
+    // The particles of the centre cell (8, 8, 2): one per sub-cell.
+    std::vector<int> per_sub(size_t(split * split * split), 0);
+    int in_cell = 0;
+    for (const Vec3& x : ph.x) {
+      if (int(std::floor(x.x)) != 8 || int(std::floor(x.y)) != 8 || int(std::floor(x.z)) != 2) continue;
+      ++in_cell;
+      const int a = int((x.x - 8.f) * float(split)), b = int((x.y - 8.f) * float(split)), c = int((x.z - 2.f) * float(split));
+      ++per_sub[size_t((c * split + b) * split + a)];
+    }
+    EXPECT_EQ(in_cell, split * split * split) << split;
+    for (int n : per_sub) EXPECT_EQ(n, 1) << "split " << split;
+    const double after = w.total_density(ws_) * prm.cell_mass();
+    EXPECT_NEAR(p.total_mass(ws_), before - after, 1e-5 * before) << split;
+    EXPECT_LT(rec.max_closure_error(), 1e-6) << split;
+  }
+}
+
 TEST_F(GridParticleTest, SlowFarParticlesReturnAndMixColour) {
   // Yellow paint, half full, in k = 0..1; blue particles at rest at the centres of k = 1 cells.
   PaintWindow w = make_window({16, 16, 8}, {0, 0, 0}, [](int, int, int k) { return k < 2 ? 0.5f : 0.f; },

@@ -119,6 +119,8 @@ std::vector<ParamInfo> build_table() {
       WB_PARAM(transfer.bleed, "Colour bleeding", "", "§5.1", 0, 1, "Colour exchanged with particles a full sample does not absorb"),
       WB_PARAM(transfer.split, "Film split", "", "Eq. 13", 0, 1,
                "Share of the paint a sliding bristle sweeps over a surface that stays there (0: the paper's model)"),
+      WB_PARAM(transfer.candidate_split, "Candidates per cell axis", "", "§5.2", 1, 3,
+               "A cell near the bristles is sampled into up to this cubed particles a step (the paper: 3, 27 candidates)"),
       WB_PARAM(transfer.slow_speed, "Slow speed", "cells/s", "§5.2", 0, 1e4, "Particles slower than this go back to the grid"),
       WB_PARAM(transfer.return_margin, "Return margin", "cells", "§5.2", 0, 100, "Particles go back to the grid only this far beyond D0"),
       WB_PARAM(transfer.wick_rate, "Wicking", "1/s", "", 0, 1e6, "Capillary flow of paint along a bristle towards its emptier samples"),

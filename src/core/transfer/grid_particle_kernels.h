@@ -12,8 +12,6 @@
 
 namespace wb {
 
-/// Number of stratified candidates per cell (3 x 3 x 3), §5.2.
-inline constexpr int kCandidatesPerCell = 27;
 /// Squared distance standing for "no sample anywhere" in the distance transform.
 inline constexpr float kFarDistance2 = 1e20f;
 
@@ -114,19 +112,19 @@ WB_HD WB_INLINE uint32_t transfer_hash(uint32_t x) {
   return x;
 }
 
-/// Candidate s (0..26) of the canvas cell (cx, cy, cz): the centre of sub-cell (s%3, s/3%3, s/9)
-/// of the 3x3x3 split, jittered within the sub-cell by up to +-1/3 of its size, deterministically
-/// from the canvas cell and s (§5.2 "stratified sampling ... 27 particle candidates"). Returns
-/// the offset inside the cell, in [0,1)^3.
-WB_HD WB_INLINE Vec3 candidate_offset(int cx, int cy, int cz, int s) {
+/// Candidate s (0..n^3-1) of the canvas cell (cx, cy, cz): the centre of sub-cell (s%n, s/n%n,
+/// s/n^2) of the n x n x n split, jittered within the sub-cell by up to +-1/3 of its size,
+/// deterministically from the canvas cell and s (§5.2 "stratified sampling ... 27 particle
+/// candidates": n = 3). Returns the offset inside the cell, in [0,1)^3.
+WB_HD WB_INLINE Vec3 candidate_offset(int cx, int cy, int cz, int s, int n) {
   const uint32_t seed = transfer_hash(uint32_t(cx) * 73856093u ^ uint32_t(cy) * 19349663u ^ uint32_t(cz) * 83492791u ^
                                       uint32_t(s) * 2654435761u);
   const float jx = float(seed & 1023u) / 1023.f - 0.5f;
   const float jy = float((seed >> 10) & 1023u) / 1023.f - 0.5f;
   const float jz = float((seed >> 20) & 1023u) / 1023.f - 0.5f;
-  const float third = 1.f / 3.f;
-  return Vec3((float(s % 3) + 0.5f + jx * 0.666f) * third, (float((s / 3) % 3) + 0.5f + jy * 0.666f) * third,
-              (float(s / 9) + 0.5f + jz * 0.666f) * third);
+  const float part = 1.f / float(n);
+  return Vec3((float(s % n) + 0.5f + jx * 0.666f) * part, (float((s / n) % n) + 0.5f + jy * 0.666f) * part,
+              (float(s / (n * n)) + 0.5f + jz * 0.666f) * part);
 }
 
 /// Tent weight of one axis: max(1 - |d| / h, 0).

@@ -112,6 +112,7 @@ void validate(const TransferParams& p) {
   WB_REQUIRE(in(p.kernel_h, 0.5f, 2.f), "TransferParams: kernel_h must lie in [0.5, 2] cells");
   WB_REQUIRE(in(p.slow_speed, 0.f, 1e4f), "TransferParams: slow_speed must lie in [0, 1e4] cells/s");
   WB_REQUIRE(in(p.min_cell_density, 0.f, 1.f), "TransferParams: min_cell_density must lie in [0, 1]");
+  WB_REQUIRE(p.candidate_split >= 1 && p.candidate_split <= 3, "TransferParams: candidate_split must lie in [1, 3]");
   WB_REQUIRE(p.distance_block >= 1 && p.distance_block <= 16, "TransferParams: distance_block must lie in [1, 16]");
 }
 

@@ -433,6 +433,7 @@ void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, cons
 void transfer_grid_count(PaintWindowView pw, DistanceBlocks db, KeepBox keep, TransferParams prm,
                          float dry_threshold, uint32_t* count) {
   const float min_rho = prm.min_cell_density;
+  const int split = prm.candidate_split, candidates = split * split * split;
   parallel_for(pw.size(), [=] WB_HD(int64_t c) {
     count[c] = 0u;
     const float rho = pw.density[c];
@@ -442,8 +443,8 @@ void transfer_grid_count(PaintWindowView pw, DistanceBlocks db, KeepBox keep, Tr
     // Paint outside the keep box stays grid paint: particles there would go straight back.
     if (!keep.contains(i, j, k) || !db.near(Vec3(float(i) + 0.5f, float(j) + 0.5f, float(k) + 0.5f))) return;
     uint32_t n = 0;
-    for (int s = 0; s < kCandidatesPerCell; ++s) {
-      const Vec3 q = Vec3(float(i), float(j), float(k)) + candidate_offset(i + pw.ox, j + pw.oy, k + pw.oz, s);
+    for (int s = 0; s < candidates; ++s) {
+      const Vec3 q = Vec3(float(i), float(j), float(k)) + candidate_offset(i + pw.ox, j + pw.oy, k + pw.oz, s, split);
       if (liquid_density_at(pw, q, dry_threshold) > 0.f) ++n;
     }
     count[c] = n;
@@ -453,7 +454,8 @@ void transfer_grid_count(PaintWindowView pw, DistanceBlocks db, KeepBox keep, Tr
 void transfer_grid_emit(PaintWindowView pw, MacView vel, ParticleView p, const uint32_t* count, const uint32_t* offset,
                         int64_t first, int64_t room, TransferParams prm, float dry_threshold, float* demand) {
   const float h = prm.kernel_h, cm = prm.cell_mass();
-  const float share = 1.f / float(kCandidatesPerCell);
+  const int split = prm.candidate_split, candidates = split * split * split;
+  const float share = 1.f / float(candidates);
   parallel_for(pw.size(), [=] WB_HD(int64_t c) {
     if (count[c] == 0u) return;
     const int64_t off = int64_t(offset[c]);
@@ -462,8 +464,8 @@ void transfer_grid_emit(PaintWindowView pw, MacView vel, ParticleView p, const u
     const Vec3 cell_c(pw.pigment_r[c], pw.pigment_y[c], pw.pigment_b[c]);
     const float oil = pw.oil[c], dry = pw.dryness[c];
     int64_t t = 0;
-    for (int s = 0; s < kCandidatesPerCell && off + t < room; ++s) {
-      const Vec3 q = Vec3(float(i), float(j), float(k)) + candidate_offset(i + pw.ox, j + pw.oy, k + pw.oz, s);
+    for (int s = 0; s < candidates && off + t < room; ++s) {
+      const Vec3 q = Vec3(float(i), float(j), float(k)) + candidate_offset(i + pw.ox, j + pw.oy, k + pw.oz, s, split);
       const float rho_q = liquid_density_at(pw, q, dry_threshold);
       if (!(rho_q > 0.f)) continue;
       const int64_t pk = first + off + t;

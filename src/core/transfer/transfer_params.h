@@ -95,6 +95,9 @@ struct TransferParams {
   float return_margin = 8.f;
   /// Cells with less density than this are not sampled into particles. Default 1e-3, range [0, 1].
   float min_cell_density = 1e-3f;
+  /// Candidates per cell axis of the stratified sampling of Eq. 15: a cell within D0 gives up
+  /// to split^3 particles a step. Default 3 (the paper's 27), range [1, 3]. §5.2.
+  int candidate_split = 3;
   /// Block size of the coarse bristle distance field that decides "within D0", cells; the
   /// distance is exact between block centres, so within +-block*sqrt(3) of the true one.
   /// Default 4, range [1, 16]. §5.2.
