@@ -83,15 +83,23 @@ BENCHMARK(BM_SampleHashBuild)->Arg(4)->Unit(benchmark::kMicrosecond);
 void BM_NearestSampleQuery(benchmark::State& state) {
   Scene& s = scene();
   s.grid.build(s.ds.view(), float(state.range(0)), s.ws, s.dt);
-  const float range = state.range(1) ? s.prm.D0 : s.prm.D1;
+  // 0: D1 (Eq. 10), 1: D0, 2: one cell (the absorption's load spheres, Eq. 14)
+  const float range = state.range(1) == 0 ? s.prm.D1 : (state.range(1) == 1 ? s.prm.D0 : 1.f);
   for (auto _ : state) {
     s.grid.query_nearest(s.store.view(), range);
     s.d.synchronize();
   }
   state.SetItemsProcessed(state.iterations() * s.store.size());
 }
-// cell size (cells) x range (0: D1 = 15, 1: D0 = 50)
-BENCHMARK(BM_NearestSampleQuery)->Args({2, 0})->Args({4, 0})->Args({8, 0})->Args({4, 1})->Args({8, 1})->Unit(benchmark::kMillisecond);
+// cell size (cells) x range (0: D1 = 15, 1: D0 = 50, 2: 1 cell)
+BENCHMARK(BM_NearestSampleQuery)
+    ->Args({2, 0})
+    ->Args({4, 0})
+    ->Args({8, 0})
+    ->Args({4, 1})
+    ->Args({8, 1})
+    ->Args({2, 2})
+    ->Unit(benchmark::kMillisecond);
 
 void BM_AdhesionStep(benchmark::State& state) {
   Scene& s = scene();

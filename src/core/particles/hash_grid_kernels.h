@@ -83,9 +83,11 @@ WB_HD WB_INLINE void for_shell(int cx, int cy, int cz, int R, const int lo[3], c
 }
 
 /// Nearest sample to p within max_range. Shells of cells at Chebyshev ring R = 0, 1, ...
-/// around p's cell are visited in order, clipped to the samples' cell bounding box; after
-/// ring R every unvisited sample is farther than R h, so the search stops once the best
-/// distance is below R h, R h reaches max_range, or the shell has left the box. Ties go to
+/// around p's cell are visited in order, clipped to the samples' cell bounding box and to the
+/// cells the cube of half-side max_range around p reaches; after
+/// ring R every unvisited sample is farther than R h plus p's distance to the nearest face of
+/// its cell, so the search stops once the best distance is below that, R h reaches max_range,
+/// or the shell has left the box. Ties go to
 /// the lower sample index, so the answer does not depend on the order buckets are visited.
 ///
 /// The rings that hold no sample are skipped first on the coarse occupancy: when the coarse
@@ -104,15 +106,25 @@ WB_HD WB_INLINE NearestSample nearest_sample(const HashGridView& g, Vec3 p, floa
   // ends taken in the order that makes it non-negative: nvcc 13.0 (sm_90) folded the
   // equivalent nested max(lo, -hi, 0) of the negated differences wrongly (the query then
   // skipped ring 0).
-  const int lo[3] = {g.bounds[0], g.bounds[1], g.bounds[2]}, hi[3] = {g.bounds[3], g.bounds[4], g.bounds[5]};
+  const int blo[3] = {g.bounds[0], g.bounds[1], g.bounds[2]}, bhi[3] = {g.bounds[3], g.bounds[4], g.bounds[5]};
+  // The cells visited: those of the samples' box that the cube of half-side max_range around p
+  // reaches (no sample within max_range lies outside it). For a short range this is a few cells
+  // of ring 1, not the whole ring.
+  const float pc[3] = {p.x, p.y, p.z};
+  int lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = imax(blo[a], hash_coord((pc[a] - max_range) * inv_h));
+    hi[a] = imin(bhi[a], hash_coord((pc[a] + max_range) * inv_h));
+    if (lo[a] > hi[a]) return out;  // no sample's cell within reach
+  }
   const int r_box = imax(imax(ring_far(lo[0], hi[0], cx), ring_far(lo[1], hi[1], cy)), ring_far(lo[2], hi[2], cz));
   int r_start = imax(imax(ring_near(lo[0], hi[0], cx), ring_near(lo[1], hi[1], cy)), ring_near(lo[2], hi[2], cz));
   {
     // Coarse rings out to K_max, where 4 K_max h >= max_range: beyond it nothing is in range.
     const int k_max = int(ceilf(max_range * inv_h / float(kCoarseCells)));
     const int ccx = cx >> kCoarseShift, ccy = cy >> kCoarseShift, ccz = cz >> kCoarseShift;
-    const int clo[3] = {lo[0] >> kCoarseShift, lo[1] >> kCoarseShift, lo[2] >> kCoarseShift};
-    const int chi[3] = {hi[0] >> kCoarseShift, hi[1] >> kCoarseShift, hi[2] >> kCoarseShift};
+    const int clo[3] = {blo[0] >> kCoarseShift, blo[1] >> kCoarseShift, blo[2] >> kCoarseShift};
+    const int chi[3] = {bhi[0] >> kCoarseShift, bhi[1] >> kCoarseShift, bhi[2] >> kCoarseShift};
     int first = -1;
     for (int K = 0; K <= k_max && first < 0; ++K) {
       bool occupied = false;
@@ -126,6 +138,14 @@ WB_HD WB_INLINE NearestSample nearest_sample(const HashGridView& g, Vec3 p, floa
   }
   float best_d2 = max_range * max_range;
   int32_t best = -1;
+  // After ring R every unvisited cell lies beyond the cube of rings 0..R, at least R h plus
+  // p's distance to the nearest face of its own cell away.
+  float edge = g.h;
+  for (int a = 0; a < 3; ++a) {
+    const float in_cell = pc[a] - float(a == 0 ? cx : (a == 1 ? cy : cz)) * g.h;
+    edge = fminf(edge, fminf(in_cell, g.h - in_cell));
+  }
+  edge = fmaxf(edge - 1e-3f * g.h, 0.f);  // less the round-off of p - c h far from the origin
   // Cells of ring R hold points at distance <= max_range only while (R - 1) h < max_range.
   const int r_max = imin(int(ceilf(max_range * inv_h)) + 1, r_box);
   for (int R = r_start; R <= r_max; ++R) {
@@ -143,7 +163,7 @@ WB_HD WB_INLINE NearestSample nearest_sample(const HashGridView& g, Vec3 p, floa
         }
       }
     });
-    const float reach = float(R) * g.h;
+    const float reach = float(R) * g.h + edge;
     if (best >= 0 && best_d2 < reach * reach) break;
   }
   if (best >= 0 && best_d2 < max_range * max_range) {
