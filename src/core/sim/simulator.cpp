@@ -67,6 +67,7 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
   extent_.resize(5);
   box_ = samples_box();
   grid_->move_window(place_window(box_, box_));
+  counters_ = SimCounters{};  // the first placement is not a step's
   step_sums_ = DeviceBuffer<StepSums>(d, 1);
   step_sums_.fill_zero();
   transfer_->set_sums(&step_sums_.data()->transfer);
