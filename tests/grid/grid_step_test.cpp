@@ -16,6 +16,36 @@ namespace wb::test {
 
 class GridStepTest : public BackendTest {};
 
+/// What paint advected through a fixed flow kept: the worst relative change of its mass and the
+/// lowest and highest density over the steps.
+struct FlowRun {
+  double worst = 0;
+  float lo = 0.f, hi = 0.f;
+};
+
+/// Advects g's paint `steps` steps through the face velocities (u, v, w), set again before each
+/// step; `each(step)` sees g after each.
+FlowRun advect_in_flow(Grid& g, const std::vector<float>& u, const std::vector<float>& v, const std::vector<float>& w,
+                       float dt, int steps, const std::function<void(int)>& each) {
+  const double m0 = sum(host_density(g));
+  FlowRun run;
+  for (int s = 0; s < steps; ++s) {
+    g.window().velocity(0).copy_from_host(u);
+    g.window().velocity(1).copy_from_host(v);
+    g.window().velocity(2).copy_from_host(w);
+    g.classify();
+    g.advect(dt);
+    const auto rho = host_density(g);
+    run.worst = std::max(run.worst, std::fabs(sum(rho) - m0) / m0);
+    for (float r : rho) {
+      run.lo = std::min(run.lo, r);
+      run.hi = std::max(run.hi, r);
+    }
+    each(s);
+  }
+  return run;
+}
+
 TEST_F(GridStepTest, StillPaintLayerStaysStill) {
   TileStore canvas(device_, CanvasDims{256, 256, 64});
   Grid g(canvas, GridParams{}, Int3{48, 48, 16}, Int3{64, 64, 0});
@@ -568,33 +598,18 @@ TEST_F(GridStepTest, EachAxisTakesThePassesItsOwnFlowNeeds) {
   paint_cells(g, [](int i, int j, int k) { return (i >= 8 && i < 20 && j >= 16 && j < 28 && k < 3) ? 1.f : 0.f; });
   const float dt = 1.f / 64.f, U = 160.f, V = 20.f;  // 2.5 and 0.31 cells a step
   std::vector<float> u(size_t(d.nu()), U), v(size_t(d.nv()), V), w(size_t(d.nw()), 0.f);
-  const auto rho0 = host_density(g);
-  const double m0 = sum(rho0);
-  const Vec3 c0 = centroid(d, rho0);
+  const Vec3 c0 = centroid(d, host_density(g));
   const int steps = 8;
-  double worst = 0;
-  float lo = 0.f, hi = 0.f;
-  for (int s = 0; s < steps; ++s) {
-    g.window().velocity(0).copy_from_host(u);
-    g.window().velocity(1).copy_from_host(v);
-    g.window().velocity(2).copy_from_host(w);
-    g.classify();
-    g.advect(dt);
+  const FlowRun run = advect_in_flow(g, u, v, w, dt, steps, [&](int s) {
     // x: outflow 2.5 cells a step, 0.5 a pass: 5 passes; y: 0.31, one pass; z: no flow, none.
     EXPECT_EQ(g.stats().advect_substeps, 5) << "step " << s;
     EXPECT_EQ(g.stats().advect_passes, 6) << "step " << s;
     EXPECT_LE(g.stats().advect_courant, p.advect_courant * (1.f + 1e-6f));
-    const auto rho = host_density(g);
-    worst = std::max(worst, std::fabs(sum(rho) - m0) / m0);
-    for (float r : rho) {
-      lo = std::min(lo, r);
-      hi = std::max(hi, r);
-    }
-  }
+  });
   const Vec3 c1 = centroid(d, host_density(g));
-  EXPECT_LT(worst, 1e-6);
-  EXPECT_GE(lo, -1e-7f) << "round-off only";
-  EXPECT_LE(hi, 1.f + 1e-5f) << "a uniform flow makes no new maximum";
+  EXPECT_LT(run.worst, 1e-6);
+  EXPECT_GE(run.lo, -1e-7f) << "round-off only";
+  EXPECT_LE(run.hi, 1.f + 1e-5f) << "a uniform flow makes no new maximum";
   // Each axis carries the paint its whole way over the step, whatever its number of passes.
   EXPECT_NEAR(c1.x - c0.x, U * dt * float(steps), 0.1f);
   EXPECT_NEAR(c1.y - c0.y, V * dt * float(steps), 0.05f);
@@ -621,36 +636,19 @@ TEST_F(GridStepTest, SwirlKeepsMassAndBoundsAndTurnsThePaint) {
   for (int k = 0; k < d.nz; ++k)
     for (int j = 0; j <= d.ny; ++j)
       for (int i = 0; i < d.nx; ++i) v[size_t(d.vidx(i, j, k))] = -(psi(float(i + 1), float(j)) - psi(float(i), float(j)));
-  const auto rho0 = host_density(g);
-  const double m0 = sum(rho0);
   const float dt = p.dt;
   const int steps = 20;  // 2 rad: a third of a turn
-  double worst = 0;
-  float lo = 0.f, hi = 0.f;
   int most = 0;
-  for (int s = 0; s < steps; ++s) {
-    g.window().velocity(0).copy_from_host(u);
-    g.window().velocity(1).copy_from_host(v);
-    g.window().velocity(2).copy_from_host(w);
-    g.classify();
-    g.advect(dt);
-    const auto rho = host_density(g);
-    worst = std::max(worst, std::fabs(sum(rho) - m0) / m0);
-    for (float r : rho) {
-      lo = std::min(lo, r);
-      hi = std::max(hi, r);
-    }
-    most = std::max(most, g.stats().advect_substeps);
-  }
+  const FlowRun run = advect_in_flow(g, u, v, w, dt, steps, [&](int) { most = std::max(most, g.stats().advect_substeps); });
   const Vec3 c1 = centroid(d, host_density(g));
   const float turned = std::atan2(c1.y - cy, c1.x - cx), expected = omega * dt * float(steps);
-  EXPECT_LT(worst, 1e-6);
-  EXPECT_GE(lo, -1e-7f) << "round-off only";
-  EXPECT_LE(hi, 1.f + 1e-5f) << "a divergence-free flow makes no new maximum";
+  EXPECT_LT(run.worst, 1e-6);
+  EXPECT_GE(run.lo, -1e-7f) << "round-off only";
+  EXPECT_LE(run.hi, 1.f + 1e-5f) << "a divergence-free flow makes no new maximum";
   EXPECT_NEAR(turned, expected, 0.1f);
   std::printf("[ mass ] swirl %.1f rad: worst relative mass change %.2e, density in [%.2e, %.6f], turned %.3f rad, "
               "at most %d sub-steps\n",
-              expected, worst, lo, hi, turned, most);
+              expected, run.worst, run.lo, run.hi, turned, most);
 }
 
 }  // namespace wb::test
