@@ -84,11 +84,11 @@ WB_HD WB_INLINE void for_shell(int cx, int cy, int cz, int R, const int lo[3], c
 
 /// Nearest sample to p within max_range. Shells of cells at Chebyshev ring R = 0, 1, ...
 /// around p's cell are visited in order, clipped to the samples' cell bounding box and to the
-/// cells the cube of half-side max_range around p reaches; after
-/// ring R every unvisited sample is farther than R h plus p's distance to the nearest face of
-/// its cell, so the search stops once the best distance is below that, R h reaches max_range,
-/// or the shell has left the box. Ties go to
-/// the lower sample index, so the answer does not depend on the order buckets are visited.
+/// cells the cube of half-side max_range around p reaches; after ring R every unvisited sample
+/// is farther than R h plus p's distance to the nearest face of its cell, so the search stops
+/// once the best distance is below that, R h reaches max_range, or the shell has left the box.
+/// Ties go to the lower sample index, so the answer does not depend on the order buckets are
+/// visited.
 ///
 /// The rings that hold no sample are skipped first on the coarse occupancy: when the coarse
 /// cells within coarse ring K - 1 of p's are all empty, every sample lies at least 4K - 3
