@@ -42,6 +42,7 @@
 #include "core/io/stroke.h"
 #include "studio/demo.h"
 #include "studio/main_window.h"
+#include "studio/pen_clock.h"
 
 using namespace wb;
 using namespace wb::studio;
@@ -425,8 +426,8 @@ class StudioTest : public QObject {
     // the weave). The property is measured on the session's own recording, which carries the
     // ground, with the stroke's timing as the script meant it: `wetbrush replay` of it, and of
     // the same recording without its ground (a smooth board), paint the same pen input on both:
-    // on linen the brush covers less of its track and lays its paint on the threads' crowns
-    // (docs/STUDIO.md "Canvas texture").
+    // on linen the hollows take less paint than the board takes there, and the paint lies on the
+    // threads' crowns (docs/STUDIO.md "Canvas texture").
     PaintLoad dry = w_->paint_panel()->current_paint();
     dry.load = 0.3f;
     const QColor paper(235, 228, 210);
@@ -459,7 +460,7 @@ class StudioTest : public QObject {
           if (down == 0) t0 = smp["t"].get<double>();
           smp["t"] = t0 + dt * down++;
         } else if (down > 0) {
-          if (shift == 0.0) shift = kept.back()["t"].get<double>() + 0.125 - smp["t"].get<double>();
+          if (shift == 0.0) shift = kept.back()["t"].get<double>() + kLiftGap - smp["t"].get<double>();
           smp["t"] = smp["t"].get<double>() + shift;
         }
         kept.push_back(smp);
