@@ -272,7 +272,7 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   cg_sums_.set_device(d);
   cg_sums_.resize(5);
   advect_max_.set_device(d);
-  advect_max_.resize(6);
+  advect_max_.resize(kAdvectMaxSlots);
   const size_t tiles = size_t((g.nx + kPaintTile - 1) / kPaintTile) * size_t((g.ny + kPaintTile - 1) / kPaintTile);
   for (auto* b : {&tile_mark_, &tile_active_, &tile_halo_, &tile_painted_[0], &tile_painted_[1], &tile_process_}) {
     b->set_device(d);
@@ -337,20 +337,22 @@ void Grid::advect(float dt) {
   outflow_d(d, v, paint.density.data(), particle_density_, face_tmp_.data(), cell_tmp_.data(), rhs_.data());
   // The maxima in one copy: the outflow rate along each axis, the layers holding paint and
   // those holding paint or particles.
-  for (int a = 0; a < 3; ++a) reduce_max_into(d, face_tmp_.data() + a * cells, cells, advect_max_.data() + a, ws_);
-  reduce_max_into(d, cell_tmp_.data(), cells, advect_max_.data() + 3, ws_);
-  reduce_max_into(d, rhs_.data(), cells, advect_max_.data() + 4, ws_);
-  float maxima[5];
-  advect_max_.copy_to_host(maxima, 5);
+  // (face_tmp_, one value per face, holds the three rates: there are more faces than 3 cells.)
+  for (int a = 0; a < 3; ++a)
+    reduce_max_into(d, face_tmp_.data() + a * cells, cells, advect_max_.data() + kRateX + a, ws_);
+  reduce_max_into(d, cell_tmp_.data(), cells, advect_max_.data() + kPaintTop, ws_);
+  reduce_max_into(d, rhs_.data(), cells, advect_max_.data() + kJointTop, ws_);
+  float maxima[kJointTop + 1];
+  advect_max_.copy_to_host(maxima, kJointTop + 1);
   int passes[3];
   float courant = 0.f;
   for (int a = 0; a < 3; ++a) {
-    const float c = std::isfinite(maxima[a]) ? maxima[a] * dt : 0.f;
+    const float c = std::isfinite(maxima[kRateX + a]) ? maxima[kRateX + a] * dt : 0.f;
     // No pass along an axis where no face of a painted cell carries flow: it would copy.
     passes[a] = c > 0.f ? std::clamp(int(std::ceil(c / params_.advect_courant)), 1, params_.advect_max_substeps) : 0;
     if (passes[a] > 0) courant = std::max(courant, c / float(passes[a]));
   }
-  const int top = int(maxima[3]), joint_top = int(maxima[4]);
+  const int top = int(maxima[kPaintTop]), joint_top = int(maxima[kJointTop]);
   const int n = std::max({passes[0], passes[1], passes[2]});
   stats_.advect_substeps = n;
   stats_.advect_passes = passes[0] + passes[1] + passes[2];
@@ -429,8 +431,8 @@ void Grid::advect_paint(float dt, const int passes[3], int top) {
 void Grid::find_extent() {
   const GridDims g = dims();
   layer_top_d(device(), g, window_.paint().density.data(), particle_density_, cell_tmp_.data());
-  reduce_max_into(device(), cell_tmp_.data(), g.cells(), advect_max_.data() + 5, ws_);
-  extent_d(device(), g, advect_max_.data() + 4, advect_max_.data() + 5, extent_.data());
+  reduce_max_into(device(), cell_tmp_.data(), g.cells(), advect_max_.data() + kExtentTop, ws_);
+  extent_d(device(), g, advect_max_.data() + kJointTop, advect_max_.data() + kExtentTop, extent_.data());
 }
 
 void Grid::rheology() {

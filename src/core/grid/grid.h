@@ -157,8 +157,10 @@ class Grid {
   /// The CG's scalars on the device: r.z of the two latest iterations, p.Ap, b.D^-1 b.
   DeviceBuffer<double> cg_sums_;
   int cg_last_iterations_ = 0;  ///< the last viscous solve's CG iterations: the next one plans on them
-  /// The advection's outflow rate along each axis and top layers (paint, joint) in one copy,
-  /// then the joint top after the particles joined (find_extent).
+  /// The advection's maxima, read in one copy: the outflow rate along each axis (slots 0-2), the
+  /// top layers holding paint and paint or particles; then the joint top after the particles
+  /// joined (find_extent, not read).
+  enum AdvectMax { kRateX = 0, kPaintTop = 3, kJointTop = 4, kExtentTop = 5, kAdvectMaxSlots = 6 };
   DeviceBuffer<float> advect_max_;
   DeviceBuffer<int32_t> tile_mark_, tile_active_, tile_halo_;  ///< the advection's tiles (PaintTiles)
   /// Per tile: whether it held paint after the last pass and after this one (swapped each

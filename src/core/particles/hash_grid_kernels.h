@@ -140,9 +140,10 @@ WB_HD WB_INLINE NearestSample nearest_sample(const HashGridView& g, Vec3 p, floa
   int32_t best = -1;
   // After ring R every unvisited cell lies beyond the cube of rings 0..R, at least R h plus
   // p's distance to the nearest face of its own cell away.
+  const int cell[3] = {cx, cy, cz};
   float edge = g.h;
   for (int a = 0; a < 3; ++a) {
-    const float in_cell = pc[a] - float(a == 0 ? cx : (a == 1 ? cy : cz)) * g.h;
+    const float in_cell = pc[a] - float(cell[a]) * g.h;
     edge = fminf(edge, fminf(in_cell, g.h - in_cell));
   }
   edge = fmaxf(edge - 1e-3f * g.h, 0.f);  // less the round-off of p - c h far from the origin

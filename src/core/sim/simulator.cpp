@@ -66,8 +66,8 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
   for (auto* b : {&extent_scratch_, &extent_}) b->set_device(d);
   extent_.resize(5);
   box_ = samples_box();
-  grid_->move_window(place_window(box_, box_));
-  counters_ = SimCounters{};  // the first placement is not a step's
+  float zone_room = 0.f;
+  grid_->move_window(place_window(box_, box_, zone_room));
   step_sums_ = DeviceBuffer<StepSums>(d, 1);
   step_sums_.fill_zero();
   transfer_->set_sums(&step_sums_.data()->transfer);
@@ -317,7 +317,8 @@ std::array<float, 4> Simulator::samples_box() {
   return {-m[1], m[0], -m[3], m[2]};
 }
 
-Int3 Simulator::place_window(const std::array<float, 4>& before, const std::array<float, 4>& after) {
+Int3 Simulator::place_window(const std::array<float, 4>& before, const std::array<float, 4>& after,
+                             float& zone_room) {
   // The window holds the samples' box over the step (the swept contact lays paint from where
   // each sample was to where it is), centred on it. The particle zone must end inside the kept
   // box: a zone cut by it returns its particles in a strip at every move of the window, a band
@@ -337,10 +338,7 @@ Int3 Simulator::place_window(const std::array<float, 4>& before, const std::arra
   const float D0 = config_.params.particles.D0;
   const float floor_D0 = std::min(D0, transfer_->params().absorb_range() + block_error);
   zone_D0_ = std::clamp(room, floor_D0, D0);
-  if (config_.particles) {
-    counters_.zone_cut_steps += room < floor_D0;
-    counters_.zone_room_min = std::min(counters_.zone_room_min, room - floor_D0);
-  }
+  zone_room = room - floor_D0;
   return grid_->window().origin_for(Vec3(0.5f * (x0 + x1), 0.5f * (y0 + y1), 0.f), config_.params.grid.window_snap);
 }
 
@@ -454,7 +452,12 @@ void Simulator::step(const BrushPose* pen_poses, int substeps, float dt) {
   {
     WB_PROFILE_SCOPE("window");
     box_ = samples_box();
-    const Int3 next = place_window(box_before, box_);
+    float zone_room = 0.f;
+    const Int3 next = place_window(box_before, box_, zone_room);
+    if (config_.particles) {
+      counters_.zone_cut_steps += zone_room < 0.f;
+      counters_.zone_room_min = std::min(counters_.zone_room_min, zone_room);
+    }
     if (particles_.size() > 0) deposit_leaving_particles(next);
     grid_->move_window(next);
     brush_->rasterize(grid_->window().origin(), grid_->window().dims(), psi_.data(), bristle_v_[0].data(),

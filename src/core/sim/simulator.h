@@ -175,8 +175,9 @@ class Simulator {
   /// ground_ for the next step. One read for both.
   std::array<float, 4> samples_box();
   /// Window origin for the samples' box over the step (the union of `before` and `after`), and
-  /// the D0 that keeps the particle zone inside its kept box.
-  Int3 place_window(const std::array<float, 4>& before, const std::array<float, 4>& after);
+  /// the D0 that keeps the particle zone inside its kept box; `zone_room` is the room left for
+  /// the zone at D0's floor, cells (negative: the window cuts it).
+  Int3 place_window(const std::array<float, 4>& before, const std::array<float, 4>& after, float& zone_room);
 
   SimConfig config_;
   Profiler profiler_;
