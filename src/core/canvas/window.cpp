@@ -1,5 +1,7 @@
 #include "core/canvas/window.h"
 
+#include <cstdint>
+
 #include "core/exec/algorithms.h"
 
 namespace wb {
@@ -7,6 +9,9 @@ namespace wb {
 PaintWindow::PaintWindow(const Device& device, Int3 dims) : device_(device), dims_(dims) {
   WB_REQUIRE(dims.x > 0 && dims.y > 0 && dims.z > 0 && dims.x <= 4096 && dims.y <= 4096 && dims.z <= 1024,
              "window dimensions out of range");
+  // The grid's kernels index cells and faces in 32 bits (GridDims::split).
+  WB_REQUIRE(int64_t(dims.x + 1) * (dims.y + 1) * (dims.z + 1) <= int64_t(UINT32_MAX),
+             "window of more than 2^32 cells");
 #define WB_X(name, doc) \
   name.set_device(device); \
   name.resize(size_t(cell_count()));

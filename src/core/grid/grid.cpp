@@ -19,9 +19,13 @@ void classify_d(const Device& d, GridView g, PaintWindowView pw, BristleField br
                 float lt, float dt) {
   WB_DISPATCH(d, grid_classify(g, pw, br, pd, cd.width, cd.height, cd.depth, lt, dt));
 }
-void outflow_d(const Device& d, GridView g, const float* rho, const float* pd, float* out, float* top, float* jt) {
-  WB_DISPATCH(d, grid_paint_outflow(g, rho, pd, out, top, jt));
+void tops_d(const Device& d, GridDims g, const float* rho, const float* pd, float* top, float* jt) {
+  WB_DISPATCH(d, grid_paint_tops(g, rho, pd, top, jt));
 }
+void first_extent_d(const Device& d, GridDims g, const float* jt, GridExtent* e) {
+  WB_DISPATCH(d, grid_first_extent(g, jt, e));
+}
+void outflow_d(const Device& d, GridView g, const float* rho, float* out) { WB_DISPATCH(d, grid_paint_outflow(g, rho, out)); }
 void advect_axis_d(const Device& d, GridView g, PaintWindowView s, PaintWindowView t, int axis, float dt,
                    PaintTiles tiles, const int32_t* process, int32_t* painted, const int32_t* below, int32_t* next) {
   WB_DISPATCH(d, grid_advect_paint_axis(g, s, t, axis, dt, tiles, process, painted, below, next));
@@ -283,9 +287,13 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   pass_below_.set_device(d);
   pass_below_.resize(2);
   // Every layer until the first step has found the paint's (its stages then visit them all once).
-  const GridExtent all{g.cells(), g.nu() + g.nv() + g.nw(), g.nz, g.nz};
+  GridExtent all{};
+  set_layers(all, g, g.nz);
+  all.dirty = g.nz;
   extent_.set_device(d);
   extent_.copy_from_host(&all, 1);
+  advect_extent_.set_device(d);
+  advect_extent_.resize(2);
   paint_tmp_ = PaintWindow(d, dims);
   scratch_.reserve(d, g.cells());
   classify();
@@ -334,14 +342,21 @@ void Grid::advect(float dt) {
   // needs (a stroke along x moves paint fast along x and slowly up), spread evenly over the
   // step's sub-steps, which alternate the order x y z and z y x (Strang).
   const int64_t cells = g.cells();
-  outflow_d(d, v, paint.density.data(), particle_density_, face_tmp_.data(), cell_tmp_.data(), rhs_.data());
+  // The classes and face fractions the advection reads (solids for the backtrace, dried paint
+  // never moved) lie in the layers of the paint and particles and a few above: those below the
+  // joint top first, found on the device, for the outflow rates; the rest once the one read has
+  // told how far the paint rises (below). Above, nothing in the step reads them (docs/GRID.md).
+  tops_d(d, g, paint.density.data(), particle_density_, cell_tmp_.data(), rhs_.data());
+  reduce_max_into(d, cell_tmp_.data(), cells, advect_max_.data() + kPaintTop, ws_);
+  reduce_max_into(d, rhs_.data(), cells, advect_max_.data() + kJointTop, ws_);
+  first_extent_d(d, g, advect_max_.data() + kJointTop, advect_extent_.data());
+  within(advect_extent_.data(), [&] { classify(); });
+  outflow_d(d, view(), paint.density.data(), face_tmp_.data());
   // The maxima in one copy: the outflow rate along each axis, the layers holding paint and
   // those holding paint or particles.
   // (face_tmp_, one value per face, holds the three rates: there are more faces than 3 cells.)
   for (int a = 0; a < 3; ++a)
     reduce_max_into(d, face_tmp_.data() + a * cells, cells, advect_max_.data() + kRateX + a, ws_);
-  reduce_max_into(d, cell_tmp_.data(), cells, advect_max_.data() + kPaintTop, ws_);
-  reduce_max_into(d, rhs_.data(), cells, advect_max_.data() + kJointTop, ws_);
   float maxima[kJointTop + 1];
   advect_max_.copy_to_host(maxima, kJointTop + 1);
   int passes[3];
@@ -353,20 +368,28 @@ void Grid::advect(float dt) {
     if (passes[a] > 0) courant = std::max(courant, c / float(passes[a]));
   }
   const int top = int(maxima[kPaintTop]), joint_top = int(maxima[kJointTop]);
+  // The velocity's layers (below): the paint's and particles', risen a cell a z pass, and the
+  // stencils that reach them. The paint's passes read less (the paint's top plus its z passes,
+  // and the donor and slope cells beyond).
+  const int layers = std::min(g.nz, joint_top + passes[2] + 2);
+  if (layers > joint_top) {
+    GridExtent e{};
+    set_layers(e, g, layers);
+    advect_extent_.copy_range_from_host(&e, 1, 1);
+    within(advect_extent_.data() + 1, [&] { classify(); });
+  }
   const int n = std::max({passes[0], passes[1], passes[2]});
   stats_.advect_substeps = n;
   stats_.advect_passes = passes[0] + passes[1] + passes[2];
   stats_.advect_courant = courant;
   if (n > 0) advect_paint(dt, passes, top);
   // Velocity: backtrace every open face through a copy of the field, up to the layers that can
-  // hold liquid in this step (paint or particles, the paint risen at most a cell a z pass) and the
-  // stencils that reach them. Above, no face is fluid before the projection's extrapolation
+  // hold liquid in this step. Above, no face is fluid before the projection's extrapolation
   // writes it again, and nothing in the step reads it where there is no paint (docs/GRID.md).
   for (int c = 0; c < 3; ++c)
     mem::copy_on_device(d, vel_tmp_[c].data(), v.vel[c], size_t(g.faces(c)) * sizeof(float));
   v = view();
-  advect_vel_d(d, v, vel_tmp_[0].data(), vel_tmp_[1].data(), vel_tmp_[2].data(), dt,
-               std::min(g.nz, joint_top + passes[2] + 2));
+  advect_vel_d(d, v, vel_tmp_[0].data(), vel_tmp_[1].data(), vel_tmp_[2].data(), dt, layers);
 }
 
 void Grid::advect_paint(float dt, const int passes[3], int top) {
@@ -574,22 +597,18 @@ void Grid::step(float dt, const std::function<void()>& after_advection) {
   WB_PROFILE_SCOPE("grid.step");
   WB_REQUIRE(dt > 0.f && dt <= 0.1f, "Grid::step: dt must be in (0, 0.1] s");
   check_params(params_);
-  classify();  // solids for the backtrace (dried paint is never moved)
   advect(dt);
   if (after_advection) after_advection();  // the simulator joins the particles' fields here
   // From here on the stages visit only the layers that can hold liquid (docs/GRID.md "Work in
-  // proportion to the paint"): above them the first classification stands and nothing moves.
+  // proportion to the paint"): above them no face is fluid and nothing moves.
   find_extent();
-  struct Bounded {  // back to the whole window when the step ends, thrown out of or not
-    const GridExtent*& at;
-    ~Bounded() { at = nullptr; }
-  } bounded{stage_extent_};
-  stage_extent_ = extent_.data();
-  classify();  // liquid where the paint now is
-  rheology();
-  add_external_forces(dt);
-  apply_viscosity(dt);
-  project(dt);
+  within(extent_.data(), [&] {
+    classify();  // liquid where the paint now is
+    rheology();
+    add_external_forces(dt);
+    apply_viscosity(dt);
+    project(dt);
+  });
   dry(dt);  // the window's paint, whatever the extent
 }
 

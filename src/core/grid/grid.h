@@ -88,7 +88,8 @@ class Grid {
   bool move_window(Int3 new_origin);
   /// Cell classes and open face fractions from paint, dryness and bristles.
   void classify();
-  /// Semi-Lagrangian advection (RK2 backtrace, trilinear) of the paint fields and the velocity.
+  /// Advection of the paint fields (flux form) and the velocity (semi-Lagrangian, RK2 backtrace),
+  /// after classifying the layers it reads: those of the paint and particles and a few above.
   void advect(float dt);
   /// Apparent viscosity of each liquid cell (rheology.h) at the strain rate of the flow, before
   /// this step's forces: a force the paint resists below its yield stress must not yield it. One
@@ -106,9 +107,9 @@ class Grid {
   /// Dryness += dry_rate * dt in every cell holding paint: the window's, and the canvas's by
   /// its drying clock (TileStore::advance_drying).
   void dry(float dt);
-  /// classify, advect, after_advection (the simulator joins the particles' density and momentum
-  /// to the grid there, §4.3), classify, rheology, add_external_forces, apply_viscosity, project,
-  /// dry. The one step driver of the grid stage.
+  /// advect (with its classification), after_advection (the simulator joins the particles'
+  /// density and momentum to the grid there, §4.3), classify, rheology, add_external_forces,
+  /// apply_viscosity, project, dry. The one step driver of the grid stage.
   void step(float dt, const std::function<void()>& after_advection = {});
 
   // --- for the particles (FLIP/PIC, Eq. 11) ---
@@ -169,7 +170,21 @@ class Grid {
   DeviceBuffer<int32_t> pass_below_;  ///< the layers the last pass and this one visit (two values, swapped)
   DeviceBuffer<int64_t> tile_counts_;
   DeviceBuffer<GridExtent> extent_;  ///< the layers the stages after the joint fields visit (device)
-  const GridExtent* stage_extent_ = nullptr;  ///< extent_ while step() runs those stages, else null
+  /// The advection's classifications: the layers holding paint or particles, then those the
+  /// step's advection reads (advect()).
+  DeviceBuffer<GridExtent> advect_extent_;
+  const GridExtent* stage_extent_ = nullptr;  ///< the extent the stages visit now; null: the whole window
+  /// Runs fn with the stages bounded by e (null: the whole window), the bound undone however fn ends.
+  template <class F>
+  void within(const GridExtent* e, F fn) {
+    struct Bound {
+      const GridExtent*& at;
+      const GridExtent* was;
+      ~Bound() { at = was; }
+    } bound{stage_extent_, stage_extent_};
+    stage_extent_ = e;
+    fn();
+  }
   /// The layers holding paint or particles now, or liquid before the advection: extent_.
   void find_extent();
   /// The paint's flux-form passes of advect(): passes[a] along axis a, the paint below layer top.
@@ -183,7 +198,9 @@ class Grid {
 #define WB_GRID_BACKEND_DECLS                                                                                        \
   void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float* particle_density, int canvas_w, int canvas_h, int canvas_d,     \
                      float liquid_threshold, float dry_threshold);                                                   \
-  void grid_paint_outflow(GridView g, const float* rho, const float* pd, float* out, float* top, float* jt);                                     \
+  void grid_paint_tops(GridDims d, const float* rho, const float* particle_density, float* top, float* joint_top); \
+  void grid_first_extent(GridDims d, const float* joint_top, GridExtent* e);                                       \
+  void grid_paint_outflow(GridView g, const float* rho, float* out);                                                \
   void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt,             \
                               PaintTiles tiles, const int32_t* process, int32_t* painted, const int32_t* below,      \
                               int32_t* below_next);                                                                  \

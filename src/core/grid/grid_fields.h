@@ -52,17 +52,21 @@ struct GridDims {
     ey = ny + (c == 1);
     ez = nz + (c == 2);
   }
+  /// A window's cell and face indices fit in 32 bits (PaintWindow requires it), and two 32-bit
+  /// divisions cost a fraction of three 64-bit ones (a GPU emulates those in software).
   WB_HD void decompose_face(int c, int64_t f, int& i, int& j, int& k) const {
     int ex, ey, ez;
     face_extent(c, ex, ey, ez);
-    i = int(f % ex);
-    j = int((f / ex) % ey);
-    k = int(f / (int64_t(ex) * ey));
+    split(uint32_t(f), uint32_t(ex), uint32_t(ey), i, j, k);
   }
   WB_HD void decompose_cell(int64_t c, int& i, int& j, int& k) const {
-    i = int(c % nx);
-    j = int((c / nx) % ny);
-    k = int(c / (int64_t(nx) * ny));
+    split(uint32_t(c), uint32_t(nx), uint32_t(ny), i, j, k);
+  }
+  WB_HD static void split(uint32_t t, uint32_t ex, uint32_t ey, int& i, int& j, int& k) {
+    const uint32_t row = t / ex, layer = row / ey;
+    i = int(t - row * ex);
+    j = int(row - layer * ey);
+    k = int(layer);
   }
 };
 
@@ -73,10 +77,11 @@ struct GridDims {
 /// extent leave the rest as it was, and the layers the last step used (`dirty`) are visited once
 /// more, so that what they held goes back to its value for cells without liquid.
 struct GridExtent {
-  int64_t cells;   ///< nx ny layers
-  int64_t faces;   ///< the faces of those cells: u and v below `layers`, w up to layer `layers`
-  int32_t layers;  ///< cells with k < layers
-  int32_t dirty;   ///< the layers holding liquid at the last step
+  int64_t cells;    ///< nx ny layers
+  int64_t faces;    ///< the faces of those cells: u and v below `layers`, w up to layer `layers`
+  int32_t layers;   ///< cells with k < layers
+  int32_t dirty;    ///< the layers holding liquid at the last step
+  int64_t classes;  ///< the cells classify writes: one layer more, whose class the top faces read
 };
 
 /// The oil fraction of the joint paint (§4.3: grid and particles) in a cell, mass-weighted: the
@@ -125,6 +130,14 @@ struct PaintTiles {
 WB_HD WB_INLINE int64_t faces_below(int nx, int ny, int nz, int layers) {
   const int w_layers = layers < nz ? layers + 1 : nz + 1;
   return int64_t(nx + 1) * ny * layers + int64_t(nx) * (ny + 1) * layers + int64_t(nx) * ny * w_layers;
+}
+
+/// An extent of `layers` layers (dirty unchanged).
+WB_HD WB_INLINE void set_layers(GridExtent& e, const GridDims& d, int layers) {
+  e.layers = layers;
+  e.cells = int64_t(d.nx) * d.ny * layers;
+  e.faces = faces_below(d.nx, d.ny, d.nz, layers);
+  e.classes = int64_t(d.nx) * d.ny * (layers < d.nz ? layers + 1 : d.nz);
 }
 
 /// The pressure system A p = b on liquid cells (Batty et al. 2007 face fractions):

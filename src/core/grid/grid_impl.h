@@ -65,7 +65,7 @@ void for_faces(const GridDims& d, const GridExtent* e, F fn) {
 void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float* particle_density, int canvas_w,
                    int canvas_h, int canvas_d, float liquid_threshold, float dry_threshold) {
   const GridDims d = g.d;
-  for_cells(d, g.extent, [=] WB_HD(int64_t c) {
+  const auto cell = [=] WB_HD(int64_t c) {
     int i, j, k;
     d.decompose_cell(c, i, j, k);
     const int cx = i + pw.ox, cy = j + pw.oy, cz = k + pw.oz;
@@ -73,7 +73,12 @@ void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float*
     // Joint density (§4.3): the particles' rasterised volume counts as liquid too.
     const float joint = pw.density[c] + (particle_density ? particle_density[c] : 0.f);
     g.cls[c] = classify_cell(joint, pw.dryness[c], on, liquid_threshold, dry_threshold);
-  });
+  };
+  // The extent's cells and the layer above them: the faces on top read its class.
+  if (g.extent)
+    parallel_for_count(&g.extent->classes, d.cells(), cell);
+  else
+    parallel_for(d.cells(), cell);
   // Open fraction, solid velocity and fluid flag of each face in one pass: the flag reads only
   // the face's own fraction and its two cells' classes.
   for_faces(d, g.extent, [=] WB_HD(int c, int64_t f) {
@@ -87,22 +92,44 @@ void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float*
   });
 }
 
-/// Density below which paint in a cell is a trace for the advection's layer bound, cells.
+/// Density below which paint in a cell is a trace, cells: it neither sets the advection's passes
+/// nor its layer bound.
 constexpr float kTraceDensity = 1e-6f;
 
-void grid_paint_outflow(GridView g, const float* rho, const float* particle_density, float* out, float* top,
-                        float* joint_top) {
-  const GridDims d = g.d;
-  const int64_t n = d.cells();
-  parallel_for(n, [=] WB_HD(int64_t c) {
-    int i, j, k;
-    d.decompose_cell(c, i, j, k);
-    for (int a = 0; a < 3; ++a) out[a * n + c] = cell_axis_outflow(g, rho, a, i, j, k);
-    // Traces (a millionth of a cell, carried up by a lifting bristle a fraction of a cell a
-    // sub-step) do not count: above the top they stay where they are for the step.
+void grid_paint_tops(GridDims d, const float* rho, const float* particle_density, float* top, float* joint_top) {
+  parallel_for(d.cells(), [=] WB_HD(int64_t c) {
+    const int k = int(uint32_t(c) / uint32_t(int64_t(d.nx) * d.ny));
+    // Traces above the top (a lifting bristle carries them up a fraction of a cell a sub-step)
+    // stay where they are for the step.
     const bool paint = rho[c] > kTraceDensity;
     top[c] = paint ? float(k + 1) : 0.f;
     joint_top[c] = paint || (particle_density && particle_density[c] > kTraceDensity) ? float(k + 1) : 0.f;
+  });
+}
+
+void grid_first_extent(GridDims d, const float* joint_top, GridExtent* e) {
+  parallel_for(1, [=] WB_HD(int64_t) {
+    // The layers holding paint or particles: the faces of their cells carry the outflow.
+    const float top = maxf(*joint_top, 0.f);
+    set_layers(*e, d, top < float(d.nz) ? int(top) : d.nz);
+  });
+}
+
+void grid_paint_outflow(GridView g, const float* rho, float* out) {
+  const GridDims d = g.d;
+  const int64_t n = d.cells();
+  parallel_for(n, [=] WB_HD(int64_t c) {
+    // Traces (a millionth of a cell) do not count. The donor limit leaves a part in 10^6 of what
+    // a cell held, so a drained cell in the bristles' fast flow keeps 1e-6, then 1e-12, ... of a
+    // cell: sized by them, the studio's stroke took 16 sub-steps a step where its paint needed 3.
+    // A trace asked for more than it holds gives what it holds (the donor limit).
+    if (!(rho[c] > kTraceDensity)) {
+      for (int a = 0; a < 3; ++a) out[a * n + c] = 0.f;
+      return;
+    }
+    int i, j, k;
+    d.decompose_cell(c, i, j, k);
+    for (int a = 0; a < 3; ++a) out[a * n + c] = cell_axis_outflow(g, rho, a, i, j, k);
   });
 }
 
@@ -513,11 +540,8 @@ void grid_extent(GridDims d, const float* top_before, const float* top_after, Gr
     // The liquid's layers, and the one above them, whose faces extrapolation writes.
     const float top = maxf(maxf(*top_before, *top_after), 0.f);
     const int now = top + 1.f < float(d.nz) ? int(top) + 1 : d.nz;
-    const int layers = now > e->dirty ? now : e->dirty;
-    e->layers = layers;
+    set_layers(*e, d, now > e->dirty ? now : e->dirty);
     e->dirty = now;
-    e->cells = int64_t(d.nx) * d.ny * layers;
-    e->faces = faces_below(d.nx, d.ny, d.nz, layers);
   });
 }
 

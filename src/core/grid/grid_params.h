@@ -86,7 +86,8 @@ struct GridParams {
 
   // --- advection and mass ---
   /// Largest outflow Courant number of a paint sub-step, per axis: the paint's flux-form
-  /// advection takes ceil(max outflow * dt / advect_courant) sub-steps. At 0.5 no cell gives more
+  /// advection takes ceil(max outflow * dt / advect_courant) sub-steps, the outflow of the cells
+  /// holding more than a trace (1e-6 of a cell). At 0.5 no cell gives more
   /// than it holds (docs/GRID.md "Advection and mass"). Default 0.5, range [0.05, 0.5].
   float advect_courant = 0.5f;
   /// Work bound of the paint's advection, sub-steps per step. Default 64, range [1, 1024].
