@@ -52,21 +52,22 @@ ClockOutput PenClock::press(const PenInput& p, double now) {
   down_ = true;
   press_session_t_ = s;
   press_arrival_ = now;
-  last_arrival_ = now;
+  last_arrival_ = last_input_ = now;
   return out;
 }
 
 ClockOutput PenClock::move(const PenInput& p, double now) {
   ClockOutput out;
   if (!down_) return out;
-  last_arrival_ = now;
+  last_arrival_ = last_input_ = now;
   push(out, sample(p, stamp(now), true));
   return out;
 }
 
 ClockOutput PenClock::hold(double now) {
   ClockOutput out;
-  if (!down_ || now - last_arrival_ < kStepDt) return out;
+  // Still once nothing came for kHoldAfter; then repeated a step apart until the pen moves.
+  if (!down_ || now - last_input_ < kHoldAfter || now - last_arrival_ < kStepDt) return out;
   PenSample s = last_;
   s.t = stamp(now);
   last_arrival_ = now;

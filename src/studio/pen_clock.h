@@ -16,6 +16,11 @@ inline constexpr double kTimeQuantum = 1.0 / 1024.0; ///< sample time resolution
 inline constexpr double kLiftGap = 0.125;             ///< hover before a press / lift after a release
 inline constexpr double kStrokeGap = 0.25;            ///< session time between two strokes
 inline constexpr double kLeadIn = 0.25;               ///< recording lead-in (the player's lead_in)
+/// Silence of the pen after which it counts as held still and its last sample is repeated.
+/// Longer than the gaps between the samples of a moving pen as the UI thread receives them (a
+/// device's interval plus the UI's stalls): a repeat inside such a gap puts the pen's next move
+/// a millisecond after it, and the brush must jump the sample's whole way in that millisecond.
+inline constexpr double kHoldAfter = 0.1;
 
 /// Pen values as the input device gives them (canvas cells, pressure after the curve).
 struct PenInput {
@@ -35,7 +40,8 @@ class PenClock {
   /// `now` is the arrival time in seconds on any monotonic clock.
   ClockOutput press(const PenInput& p, double now);
   ClockOutput move(const PenInput& p, double now);
-  /// Repeats the last sample when the pen is held still (call from a timer).
+  /// Repeats the last sample, a step apart, once the pen has been still for kHoldAfter (call
+  /// from a timer).
   ClockOutput hold(double now);
   ClockOutput release(const PenInput& p, double now);
   /// A palette event (dip, wipe, clean, dry) while the pen is up: fires in the next step.
@@ -57,7 +63,8 @@ class PenClock {
   bool any_ = false;
   double last_t_ = 0.0;
   double press_session_t_ = 0.0, press_arrival_ = 0.0;
-  double last_arrival_ = 0.0;
+  double last_arrival_ = 0.0;  ///< of the last sample, input or repeat
+  double last_input_ = 0.0;    ///< of the last input
   PenSample last_{};
 };
 

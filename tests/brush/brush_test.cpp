@@ -367,16 +367,19 @@ TEST_F(BrushTest, MinimumDensityKeepsBristlesApartWhenPressed) {
     int64_t close_pairs = 0;  ///< pairs of vertices of different bristles closer than s_min / 2
     int64_t vertices = 0;
   };
-  auto press = [&](int density_iterations) {
+  auto press = [&](int density_iterations, int substeps = 1) {
     BrushSpec spec = default_brush(BrushShape::Round);  // tapered: the tips crowd when pressed
     spec.bristles = 400;
     BrushSolverParams params;
     params.density_iterations = density_iterations;
     Brush brush(device_, spec, make_pose(Vec3(250, 250, spec.length)), params);
+    auto pose = [&](float t) {
+      return make_pose(Vec3(250 + 150 * t, 250, spec.length * std::max(0.55f, 1.f - 2.f * t)), rot_x(20));
+    };
+    std::vector<BrushPose> poses(static_cast<size_t>(substeps));
     for (int s = 1; s <= 30; ++s) {
-      const float t = float(s) * kDt;
-      brush.step(make_pose(Vec3(250 + 150 * t, 250, spec.length * std::max(0.55f, 1.f - 2.f * t)), rot_x(20)), kDt,
-                 BrushEnvironment{});
+      for (int k = 1; k <= substeps; ++k) poses[size_t(k - 1)] = pose((float(s - 1) + float(k) / float(substeps)) * kDt);
+      brush.step(poses.data(), substeps, kDt, BrushEnvironment{});
     }
     Crowding c;
     c.s_min = brush.min_spacing();
@@ -394,6 +397,15 @@ TEST_F(BrushTest, MinimumDensityKeepsBristlesApartWhenPressed) {
   EXPECT_GT(without.close_pairs, 50) << "pressed tapered bristles crowd without the constraint";
   EXPECT_LT(with.close_pairs * 10, without.close_pairs) << with.close_pairs << " vs " << without.close_pairs;
   EXPECT_LT(double(with.close_pairs), 0.005 * double(with.vertices));
+  // The same press in 8 sub-steps a step (the iterations run in each): the tips kept as far apart.
+  const Crowding sub = press(4, 8), sub_without = press(0, 8);
+  EXPECT_LT(sub.close_pairs * 10, sub_without.close_pairs) << sub.close_pairs << " vs " << sub_without.close_pairs;
+  EXPECT_LT(double(sub.close_pairs), 0.005 * double(sub.vertices));
+  std::printf("[ crowding ] pairs closer than s_min/2: %lld (4 iterations a step) vs %lld (none); in 8 sub-steps "
+              "a step %lld vs %lld, of %d vertices\n",
+              static_cast<long long>(with.close_pairs), static_cast<long long>(without.close_pairs),
+              static_cast<long long>(sub.close_pairs), static_cast<long long>(sub_without.close_pairs),
+              int(with.vertices));
 }
 
 TEST_F(BrushTest, DragFromThePaintFlowDeflectsTheBristles) {

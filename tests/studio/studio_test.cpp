@@ -356,6 +356,37 @@ class StudioTest : public QObject {
     w_->undo_stack()->clear();
   }
 
+  /// The session clock repeats a held pen's sample only after a silence longer than a moving
+  /// pen's gaps: a pen whose samples reach the UI 12 to 28 ms apart (16 ms and the UI's stalls),
+  /// with the hold timer firing every 8 ms, moves on every sample and never holds; held still,
+  /// it is repeated.
+  void penClockRepeatsAHeldPenOnlyAfterSilence() {
+    PenClock clock(400, 300);
+    std::vector<PenSample> line;
+    auto add = [&](const ClockOutput& o) { line.insert(line.end(), o.samples.begin(), o.samples.end()); };
+    double now = 100.0, next_hold = now;
+    add(clock.press(PenInput{50.f, 50.f, 0.5f}, now));
+    const size_t first_move = line.size();
+    uint32_t jitter = 12345u;
+    for (int i = 1; i <= 60; ++i) {
+      jitter = jitter * 1664525u + 1013904223u;
+      const double arrival = now + 0.012 + 0.016 * double(jitter >> 8) / double(1u << 24);
+      for (; next_hold < arrival; next_hold += 0.008) add(clock.hold(next_hold));
+      now = arrival;
+      add(clock.move(PenInput{50.f + 4.f * float(i), 50.f, 0.5f}, now));
+    }
+    QCOMPARE(line.size(), first_move + 60);  // one sample a move, no repeat between them
+    for (size_t k = first_move; k < line.size(); ++k) QVERIFY(line[k].x > line[k - 1].x);
+    // Held still: repeated once the silence passes kHoldAfter, then a step apart.
+    for (; next_hold < now + 0.5; next_hold += 0.008) add(clock.hold(next_hold));
+    const size_t held = line.size() - (first_move + 60);
+    QVERIFY2(held >= 20 && held <= 27, std::to_string(held).c_str());
+    QCOMPARE(line.back().x, line[first_move + 59].x);
+    QVERIFY(line[first_move + 60].t - line[first_move + 59].t >= kHoldAfter - 0.01);
+    for (size_t k = first_move + 61; k < line.size(); ++k)
+      QVERIFY(line[k].t - line[k - 1].t >= kStepDt - kTimeQuantum);
+  }
+
   /// A new blank canvas, with liquid particles (the hybrid paint) or grid-only paint
   /// (SimConfig::particles = false, the paper's Fig. 7a/c).
   void grid_only_canvas(bool grid_only) {
