@@ -196,6 +196,21 @@ PenInput CanvasView::input_at(QPointF pos, float pressure, float tilt_x, float t
   return p;
 }
 
+double CanvasView::event_time(const QInputEvent* e, bool press) {
+  const double now = wall_now();
+  const quint64 ms = e->timestamp();
+  if (press) last_stamp_ = 0;
+  // No timestamps, or one that goes back (another device, a clock that wrapped): the arrival.
+  if (ms == 0 || (last_stamp_ != 0 && ms < last_stamp_)) {
+    last_stamp_ = 0;
+    return now;
+  }
+  const double offset = now - double(ms) / 1000.0;
+  stamp_offset_ = last_stamp_ == 0 ? offset : std::min(stamp_offset_, offset);
+  last_stamp_ = ms;
+  return double(ms) / 1000.0 + stamp_offset_;
+}
+
 void CanvasView::tabletEvent(QTabletEvent* e) {
   cursor_ = e->position();
   const PenInput in = input_at(e->position(), float(e->pressure()), float(e->xTilt()), float(e->yTilt()),
@@ -209,13 +224,13 @@ void CanvasView::tabletEvent(QTabletEvent* e) {
       } else if (e->button() == Qt::LeftButton && !pen_down_) {
         pen_down_ = tablet_down_ = true;
         last_input_ = in;
-        Q_EMIT penPress(in, wall_now());
+        Q_EMIT penPress(in, event_time(e, true));
       }
       break;
     case QEvent::TabletMove:
       if (tablet_down_) {
         last_input_ = in;
-        Q_EMIT penMove(in, wall_now());
+        Q_EMIT penMove(in, event_time(e, false));
       }
       break;
     case QEvent::TabletRelease:
@@ -224,7 +239,7 @@ void CanvasView::tabletEvent(QTabletEvent* e) {
         PenInput r = in;
         r.pressure = last_input_.pressure;
         pen_down_ = tablet_down_ = false;
-        Q_EMIT penRelease(r, wall_now());
+        Q_EMIT penRelease(r, event_time(e, false));
       }
       break;
     default: break;
@@ -250,7 +265,7 @@ void CanvasView::mousePressEvent(QMouseEvent* e) {
     pen_down_ = true;
     const PenInput in = input_at(e->position(), mouse_pressure_, 0.f, 0.f, 0.f);
     last_input_ = in;
-    Q_EMIT penPress(in, wall_now());
+    Q_EMIT penPress(in, event_time(e, true));
   }
   update();
 }
@@ -266,7 +281,7 @@ void CanvasView::mouseMoveEvent(QMouseEvent* e) {
   } else if (pen_down_ && !tablet_down_) {
     const PenInput in = input_at(e->position(), mouse_pressure_, 0.f, 0.f, 0.f);
     last_input_ = in;
-    Q_EMIT penMove(in, wall_now());
+    Q_EMIT penMove(in, event_time(e, false));
   }
   update();
 }
@@ -279,7 +294,7 @@ void CanvasView::mouseReleaseEvent(QMouseEvent* e) {
     panning_ = false;
   } else if (pen_down_ && !tablet_down_ && e->button() == Qt::LeftButton) {
     pen_down_ = false;
-    Q_EMIT penRelease(input_at(e->position(), mouse_pressure_, 0.f, 0.f, 0.f), wall_now());
+    Q_EMIT penRelease(input_at(e->position(), mouse_pressure_, 0.f, 0.f, 0.f), event_time(e, false));
   }
   update();
 }

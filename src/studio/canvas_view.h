@@ -3,6 +3,7 @@
 // and turns tablet and mouse input into pen inputs in canvas cells.
 #pragma once
 #include <QImage>
+#include <QInputEvent>
 #include <QOpenGLBuffer>
 #include <QOpenGLFunctions>
 #include <QOpenGLShaderProgram>
@@ -50,9 +51,10 @@ class CanvasView : public QOpenGLWidget, protected QOpenGLFunctions {
   int64_t frames_drawn() const { return frames_; }
 
  Q_SIGNALS:
-  void penPress(wb::studio::PenInput p, double now);
-  void penMove(wb::studio::PenInput p, double now);
-  void penRelease(wb::studio::PenInput p, double now);
+  /// Pen input at time t, when it happened on the wall clock (event_time).
+  void penPress(wb::studio::PenInput p, double t);
+  void penMove(wb::studio::PenInput p, double t);
+  void penRelease(wb::studio::PenInput p, double t);
   /// Alt + click (mouse or pen): the eyedropper at this canvas point, cells.
   void pickColor(QPointF canvas);
   /// Ctrl + click where set_place_paint is on: put paint at this canvas point, cells.
@@ -97,6 +99,13 @@ class CanvasView : public QOpenGLWidget, protected QOpenGLFunctions {
   bool tablet_down_ = false;
   float last_pressure_ = 0.5f;
   PenInput last_input_{};
+  /// The time a pen event happened, on the wall clock (wall_now): the input's own timestamp
+  /// (milliseconds from the window system) less the least delay seen in the stroke, so that a
+  /// stroke keeps its speed when the UI thread is late to take its events; the arrival time
+  /// where events carry none. `press` starts a stroke.
+  double event_time(const QInputEvent* e, bool press);
+  double stamp_offset_ = 0.0;  ///< wall time less event time, the stroke's least
+  quint64 last_stamp_ = 0;     ///< the stroke's last event timestamp (0: none)
   bool light_drag_ = false;
   QPointF light_anchor_;
   bool panning_ = false;

@@ -24,11 +24,24 @@ const QPointingDevice* stylus() {
   return dev;
 }
 
-void send(CanvasView* view, QEvent::Type type, const ScriptPoint& p, Qt::MouseButton button, Qt::MouseButtons buttons) {
+/// Sends a tablet event stamped `ms` (the script's time of it, as a tablet stamps its samples).
+void send(CanvasView* view, QEvent::Type type, const ScriptPoint& p, Qt::MouseButton button, Qt::MouseButtons buttons,
+          quint64 ms) {
   const QPointF w = view->to_widget(p.canvas);
   QTabletEvent e(type, stylus(), w, view->mapToGlobal(w), qreal(p.pressure), p.tilt_x, p.tilt_y, 0.0, p.rotation,
                  0.0, Qt::NoModifier, button, buttons);
+  e.setTimestamp(ms);
   QApplication::sendEvent(view, &e);
+}
+
+/// Milliseconds on the steady clock (never 0: a timestamp of 0 is none).
+quint64 clock_ms() {
+  static QElapsedTimer clock = [] {
+    QElapsedTimer t;
+    t.start();
+    return t;
+  }();
+  return quint64(clock.elapsed()) + 1;
 }
 
 void pause_ms(int ms) {
@@ -44,13 +57,17 @@ void pause_ms(int ms) {
 
 void tablet_stroke(CanvasView* view, const std::vector<ScriptPoint>& points, int interval_ms) {
   if (points.empty()) return;
-  send(view, QEvent::TabletPress, points.front(), Qt::LeftButton, Qt::LeftButton);
+  // The samples are stamped as the script moves the pen, interval_ms apart, however late a
+  // loaded machine delivers them.
+  const quint64 t0 = clock_ms();
+  send(view, QEvent::TabletPress, points.front(), Qt::LeftButton, Qt::LeftButton, t0);
   for (size_t i = 1; i < points.size(); ++i) {
     pause_ms(interval_ms);
-    send(view, QEvent::TabletMove, points[i], Qt::NoButton, Qt::LeftButton);
+    send(view, QEvent::TabletMove, points[i], Qt::NoButton, Qt::LeftButton, t0 + quint64(i) * quint64(interval_ms));
   }
   pause_ms(interval_ms);
-  send(view, QEvent::TabletRelease, points.back(), Qt::LeftButton, Qt::NoButton);
+  send(view, QEvent::TabletRelease, points.back(), Qt::LeftButton, Qt::NoButton,
+       t0 + quint64(points.size()) * quint64(interval_ms));
 }
 
 std::vector<ScriptPoint> line_points(QPointF a, QPointF b, int n, float pressure, float tilt_x, float tilt_y) {

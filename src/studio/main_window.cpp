@@ -138,12 +138,12 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   // Pen input -> session clock -> simulation thread.
   connect(view_, &CanvasView::penPress, this, [this](PenInput p, double t) {
     carry_brush(false);
-    push_clock(clock_.press(p, t));
+    push_clock(clock_.press(p, t, wall_now()));
   });
-  connect(view_, &CanvasView::penMove, this, [this](PenInput p, double t) { push_clock(clock_.move(p, t)); });
+  connect(view_, &CanvasView::penMove, this, [this](PenInput p, double t) { push_clock(clock_.move(p, t, wall_now())); });
   connect(view_, &CanvasView::pickColor, this, [this](QPointF c) { pick_color(c); });
   connect(view_, &CanvasView::penRelease, this, [this](PenInput p, double t) {
-    push_clock(clock_.release(p, t));
+    push_clock(clock_.release(p, t, wall_now()));
     for (const StrokeEvent& e : pending_events_) push_clock(clock_.event(e));
     pending_events_.clear();
   });

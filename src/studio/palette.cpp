@@ -71,11 +71,11 @@ PalettePanel::PalettePanel(const SimConfig& config, const RenderParams& render, 
 
   connect(view_, &CanvasView::penPress, this, [this](PenInput p, double t) {
     Q_EMIT aboutToPaint();
-    push(clock_.press(p, t));
+    push(clock_.press(p, t, wall_now()));
   });
-  connect(view_, &CanvasView::penMove, this, [this](PenInput p, double t) { push(clock_.move(p, t)); });
+  connect(view_, &CanvasView::penMove, this, [this](PenInput p, double t) { push(clock_.move(p, t, wall_now())); });
   connect(view_, &CanvasView::penRelease, this, [this](PenInput p, double t) {
-    push(clock_.release(p, t));
+    push(clock_.release(p, t, wall_now()));
     for (const StrokeEvent& e : pending_events_) push(clock_.event(e));
     pending_events_.clear();
   });

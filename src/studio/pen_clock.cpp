@@ -27,11 +27,11 @@ PenSample PenClock::sample(const PenInput& p, double t, bool down) const {
   return s;
 }
 
-double PenClock::stamp(double now) {
-  // Session time of an arrival during a press: time since the press on the session line,
+double PenClock::stamp(double t) {
+  // Session time of an input during a press: time since the press on the session line,
   // quantised, and always after the previous sample.
-  const double t = press_session_t_ + std::floor((now - press_arrival_) / kTimeQuantum) * kTimeQuantum;
-  return std::max(t, last_t_ + kTimeQuantum);
+  const double s = press_session_t_ + std::floor((t - press_t_) / kTimeQuantum) * kTimeQuantum;
+  return std::max(s, last_t_ + kTimeQuantum);
 }
 
 void PenClock::push(ClockOutput& out, const PenSample& s) {
@@ -41,9 +41,9 @@ void PenClock::push(ClockOutput& out, const PenSample& s) {
   any_ = true;
 }
 
-ClockOutput PenClock::press(const PenInput& p, double now) {
+ClockOutput PenClock::press(const PenInput& p, double t, double arrival) {
   ClockOutput out;
-  if (down_) return move(p, now);
+  if (down_) return move(p, t, arrival);
   // The brush hovers above the new spot kLiftGap before touching; a whole kStrokeGap after
   // the previous stroke's last (lifted, step-aligned) sample.
   const double s = any_ ? last_t_ + kStrokeGap : kLeadIn;
@@ -51,16 +51,17 @@ ClockOutput PenClock::press(const PenInput& p, double now) {
   push(out, sample(p, s, true));
   down_ = true;
   press_session_t_ = s;
-  press_arrival_ = now;
-  last_arrival_ = last_input_ = now;
+  press_t_ = last_event_t_ = t;
+  last_arrival_ = last_input_ = arrival;
   return out;
 }
 
-ClockOutput PenClock::move(const PenInput& p, double now) {
+ClockOutput PenClock::move(const PenInput& p, double t, double arrival) {
   ClockOutput out;
   if (!down_) return out;
-  last_arrival_ = last_input_ = now;
-  push(out, sample(p, stamp(now), true));
+  last_event_t_ = t;
+  last_arrival_ = last_input_ = arrival;
+  push(out, sample(p, stamp(t), true));
   return out;
 }
 
@@ -68,17 +69,19 @@ ClockOutput PenClock::hold(double now) {
   ClockOutput out;
   // Still once nothing came for kHoldAfter; then repeated a step apart until the pen moves.
   if (!down_ || now - last_input_ < kHoldAfter || now - last_arrival_ < kStepDt) return out;
-  PenSample s = last_;
-  s.t = stamp(now);
+  // Held since the last sample for as long as nothing has come.
+  last_event_t_ += now - last_arrival_;
   last_arrival_ = now;
+  PenSample s = last_;
+  s.t = stamp(last_event_t_);
   push(out, s);
   return out;
 }
 
-ClockOutput PenClock::release(const PenInput& p, double now) {
+ClockOutput PenClock::release(const PenInput& p, double t, double) {
   ClockOutput out;
   if (!down_) return out;
-  push(out, sample(p, stamp(now), true));
+  push(out, sample(p, stamp(t), true));
   // Lifted kLiftGap later, then held still up to a step boundary: the simulation may run
   // every step up to that sample without knowing what comes next.
   const double up = last_t_ + kLiftGap;

@@ -37,13 +37,14 @@ class PenClock {
  public:
   PenClock(int canvas_width, int canvas_height) : w_(canvas_width), h_(canvas_height) {}
 
-  /// `now` is the arrival time in seconds on any monotonic clock.
-  ClockOutput press(const PenInput& p, double now);
-  ClockOutput move(const PenInput& p, double now);
+  /// `t` is when the input happened and `arrival` when it came, in seconds on the same
+  /// monotonic clock (wall_now): samples are timed by the first, a held pen by the second.
+  ClockOutput press(const PenInput& p, double t, double arrival);
+  ClockOutput move(const PenInput& p, double t, double arrival);
   /// Repeats the last sample, a step apart, once the pen has been still for kHoldAfter (call
   /// from a timer).
   ClockOutput hold(double now);
-  ClockOutput release(const PenInput& p, double now);
+  ClockOutput release(const PenInput& p, double t, double arrival);
   /// A palette event (dip, wipe, clean, dry) while the pen is up: fires in the next step.
   ClockOutput event(StrokeEvent e);
 
@@ -55,16 +56,17 @@ class PenClock {
 
  private:
   PenSample sample(const PenInput& p, double t, bool down) const;
-  double stamp(double now);
+  double stamp(double t);
   void push(ClockOutput& out, const PenSample& s);
 
   int w_, h_;
   bool down_ = false;
   bool any_ = false;
   double last_t_ = 0.0;
-  double press_session_t_ = 0.0, press_arrival_ = 0.0;
-  double last_arrival_ = 0.0;  ///< of the last sample, input or repeat
-  double last_input_ = 0.0;    ///< of the last input
+  double press_session_t_ = 0.0, press_t_ = 0.0;
+  double last_event_t_ = 0.0;  ///< when the last sample's input happened (a repeat: as held)
+  double last_arrival_ = 0.0;  ///< arrival of the last sample, input or repeat
+  double last_input_ = 0.0;    ///< arrival of the last input
   PenSample last_{};
 };
 

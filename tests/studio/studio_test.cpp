@@ -359,13 +359,14 @@ class StudioTest : public QObject {
   /// The session clock repeats a held pen's sample only after a silence longer than a moving
   /// pen's gaps: a pen whose samples reach the UI 12 to 28 ms apart (16 ms and the UI's stalls),
   /// with the hold timer firing every 8 ms, moves on every sample and never holds; held still,
-  /// it is repeated.
-  void penClockRepeatsAHeldPenOnlyAfterSilence() {
+  /// it is repeated. Samples are timed as they happened: a burst the UI takes late keeps its
+  /// spacing.
+  void penClockTimesSamplesAsTheyHappenedAndRepeatsAHeldPen() {
     PenClock clock(400, 300);
     std::vector<PenSample> line;
     auto add = [&](const ClockOutput& o) { line.insert(line.end(), o.samples.begin(), o.samples.end()); };
     double now = 100.0, next_hold = now;
-    add(clock.press(PenInput{50.f, 50.f, 0.5f}, now));
+    add(clock.press(PenInput{50.f, 50.f, 0.5f}, now, now));
     const size_t first_move = line.size();
     uint32_t jitter = 12345u;
     for (int i = 1; i <= 60; ++i) {
@@ -373,7 +374,7 @@ class StudioTest : public QObject {
       const double arrival = now + 0.012 + 0.016 * double(jitter >> 8) / double(1u << 24);
       for (; next_hold < arrival; next_hold += 0.008) add(clock.hold(next_hold));
       now = arrival;
-      add(clock.move(PenInput{50.f + 4.f * float(i), 50.f, 0.5f}, now));
+      add(clock.move(PenInput{50.f + 4.f * float(i), 50.f, 0.5f}, now, now));
     }
     QCOMPARE(line.size(), first_move + 60);  // one sample a move, no repeat between them
     for (size_t k = first_move; k < line.size(); ++k) QVERIFY(line[k].x > line[k - 1].x);
@@ -385,6 +386,20 @@ class StudioTest : public QObject {
     QVERIFY(line[first_move + 60].t - line[first_move + 59].t >= kHoldAfter - 0.01);
     for (size_t k = first_move + 61; k < line.size(); ++k)
       QVERIFY(line[k].t - line[k - 1].t >= kStepDt - kTimeQuantum);
+    add(clock.release(PenInput{290.f, 50.f, 0.5f}, now + 0.5, now + 0.5));
+    // A stroke whose samples, 16 ms apart, the UI takes in bursts of four 50 ms late.
+    const double t0 = now + 1.0;
+    const size_t second = line.size();
+    add(clock.press(PenInput{50.f, 80.f, 0.5f}, t0, t0));
+    const size_t touch = line.size() - 1;
+    for (int i = 1; i <= 16; ++i) {
+      const double t = t0 + 0.016 * i, arrival = t0 + 0.064 * ((i + 3) / 4) + 0.05;
+      add(clock.move(PenInput{50.f + 4.f * float(i), 80.f, 0.5f}, t, arrival));
+    }
+    QCOMPARE(line.size(), second + 2 + 16);
+    for (size_t k = touch + 1; k < line.size(); ++k)
+      QVERIFY2(std::fabs((line[k].t - line[k - 1].t) - 0.016) <= kTimeQuantum + 1e-9,
+               std::to_string(line[k].t - line[k - 1].t).c_str());
   }
 
   /// A new blank canvas, with liquid particles (the hybrid paint) or grid-only paint
