@@ -57,8 +57,8 @@ struct WeaveField {
 };
 WeaveField weave_field(const CanvasGround& g, float cell_size_m, Vec3 priming_ryb);
 
-/// Most paint a woven ground may lay, bytes: what a painting may hold (LoadLimits::max_paint_bytes),
-/// so that a primed canvas always opens again. A ground fills every tile of the canvas.
+/// Most paint a woven ground may lay, bytes, and so what a painting may hold
+/// (LoadLimits::max_paint_bytes): a primed canvas always opens again. A ground fills every tile.
 inline constexpr uint64_t kMaxGroundBytes = uint64_t(4) << 30;
 /// Why a width x height x depth canvas cannot take this ground: thicker than half the paint depth,
 /// or more paint in its tiles than kMaxGroundBytes. Empty when it can (and for a smooth ground).

@@ -164,8 +164,6 @@ std::vector<uint8_t> encode_volume(const TileStore& canvas) {
   return head;
 }
 
-static_assert(LoadLimits{}.max_paint_bytes == kMaxGroundBytes, "a primed canvas must open again");
-
 TileStore decode_volume(const uint8_t* p, size_t size, const Device& device, const std::string& what,
                         const LoadLimits& limits, const char* entry) {
   const std::string w = what + ": " + (entry == kPaletteEntry ? "palette" : "paint volume") + " (" + entry + ")";

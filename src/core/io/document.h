@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/canvas/ground.h"
 #include "core/canvas/tile_store.h"
 #include "core/render/renderer.h"
 
@@ -56,8 +57,9 @@ struct LoadLimits {
   /// Uncompressed size of wetbrush/metadata.json.
   uint64_t max_metadata_bytes = uint64_t(16) << 20;
   /// Decoded paint: tiles x 16 x 16 x depth cells x 14 bytes (also never more than the whole
-  /// canvas the file declares, since a tile may be stored once).
-  uint64_t max_paint_bytes = uint64_t(4) << 30;
+  /// canvas the file declares, since a tile may be stored once). As much as a woven ground may
+  /// lay (kMaxGroundBytes), so that a primed canvas always opens again.
+  uint64_t max_paint_bytes = kMaxGroundBytes;
 };
 
 /// Reads a painting onto `device`. Truncated, corrupted, foreign or newer-version files are

@@ -96,8 +96,11 @@ double BristleLoad::clean() {
 
 double BristleLoad::total_mass(Workspace& ws) const { return reduce_sum(device_, m.data(), count_, ws); }
 
-Vec3 BristleLoad::mean_color(Workspace& ws) {
-  const double w = total_mass(ws);
+Vec3 BristleLoad::mean_color(Workspace& ws) { return mean_color(total_mass(ws), ws); }
+
+float BristleLoad::mean_oil(Workspace& ws) { return mean_oil(total_mass(ws), ws); }
+
+Vec3 BristleLoad::mean_color(double w, Workspace& ws) {
   if (!(w > 0.0)) return Vec3(0.f, 0.f, 0.f);
   double sums[4];
   const float* comp[3] = {pigment_r.data(), pigment_y.data(), pigment_b.data()};
@@ -112,8 +115,7 @@ Vec3 BristleLoad::mean_color(Workspace& ws) {
   return rescale_to_brightness(lin, float(sums[3] / w));
 }
 
-float BristleLoad::mean_oil(Workspace& ws) {
-  const double w = total_mass(ws);
+float BristleLoad::mean_oil(double w, Workspace& ws) {
   if (!(w > 0.0)) return 0.f;
   d_product(device_, m.data(), oil.data(), scratch_.data(), count_);
   return float(reduce_sum(device_, scratch_.data(), count_, ws) / w);
@@ -124,9 +126,9 @@ PaintLoad BristleLoad::mean_paint(Workspace& ws, const PaintLoad& clean) {
   const double mass = total_mass(ws), capacity = reduce_sum(device_, potential.data(), count_, ws);
   out.load = capacity > 0.0 ? float(std::min(1.0, mass / capacity)) : 0.f;
   if (mass > 0.0) {
-    const Vec3 c = mean_color(ws);
+    const Vec3 c = mean_color(mass, ws);
     out.ryb[0] = c.x, out.ryb[1] = c.y, out.ryb[2] = c.z;
-    out.oil = mean_oil(ws);
+    out.oil = mean_oil(mass, ws);
   }
   return out;
 }

@@ -90,6 +90,9 @@ class BristleLoad {
 #undef WB_X
 
  private:
+  /// mean_color and mean_oil of a load of w kg (total_mass).
+  Vec3 mean_color(double w, Workspace& ws);
+  float mean_oil(double w, Workspace& ws);
   /// fill (replace) and dip (top up and mix) in one pass: the kg added.
   double load(const PaintLoad& paint, bool replace, const char* what);
   Device device_;
