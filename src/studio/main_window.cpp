@@ -143,7 +143,7 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   connect(view_, &CanvasView::penMove, this, [this](PenInput p, double t) { push_clock(clock_.move(p, t, wall_now())); });
   connect(view_, &CanvasView::pickColor, this, [this](QPointF c) { pick_color(c); });
   connect(view_, &CanvasView::penRelease, this, [this](PenInput p, double t) {
-    push_clock(clock_.release(p, t, wall_now()));
+    push_clock(clock_.release(p, t));
     for (const StrokeEvent& e : pending_events_) push_clock(clock_.event(e));
     pending_events_.clear();
   });

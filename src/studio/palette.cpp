@@ -75,7 +75,7 @@ PalettePanel::PalettePanel(const SimConfig& config, const RenderParams& render, 
   });
   connect(view_, &CanvasView::penMove, this, [this](PenInput p, double t) { push(clock_.move(p, t, wall_now())); });
   connect(view_, &CanvasView::penRelease, this, [this](PenInput p, double t) {
-    push(clock_.release(p, t, wall_now()));
+    push(clock_.release(p, t));
     for (const StrokeEvent& e : pending_events_) push(clock_.event(e));
     pending_events_.clear();
   });

@@ -78,7 +78,7 @@ ClockOutput PenClock::hold(double now) {
   return out;
 }
 
-ClockOutput PenClock::release(const PenInput& p, double t, double) {
+ClockOutput PenClock::release(const PenInput& p, double t) {
   ClockOutput out;
   if (!down_) return out;
   push(out, sample(p, stamp(t), true));

@@ -44,7 +44,7 @@ class PenClock {
   /// Repeats the last sample, a step apart, once the pen has been still for kHoldAfter (call
   /// from a timer).
   ClockOutput hold(double now);
-  ClockOutput release(const PenInput& p, double t, double arrival);
+  ClockOutput release(const PenInput& p, double t);
   /// A palette event (dip, wipe, clean, dry) while the pen is up: fires in the next step.
   ClockOutput event(StrokeEvent e);
 

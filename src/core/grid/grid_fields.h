@@ -70,12 +70,12 @@ struct GridDims {
   }
 };
 
-/// The layers of the window the grid's stages visit after the joint fields (device memory,
-/// written each step by grid_extent; docs/GRID.md "Work in proportion to the paint"). Cells at
-/// k < layers may hold paint, particles or liquid; above them every cell is air or solid as the
-/// step's first classification found it, and every face there is non-fluid. Stages over this
-/// extent leave the rest as it was, and the layers the last step used (`dirty`) are visited once
-/// more, so that what they held goes back to its value for cells without liquid.
+/// Layers of the window a stage visits (device memory; docs/GRID.md "Work in proportion to the
+/// paint"): those after the joint fields (grid_extent) and the advection's (grid_first_extent,
+/// set_layers). Cells at k < layers may hold paint, particles or liquid; above them no face is
+/// fluid. Stages over this extent leave the rest as it was, and the layers the last step used
+/// (`dirty`) are visited once more, so that what they held goes back to its value for cells
+/// without liquid.
 struct GridExtent {
   int64_t cells;    ///< nx ny layers
   int64_t faces;    ///< the faces of those cells: u and v below `layers`, w up to layer `layers`

@@ -98,7 +98,8 @@ constexpr float kTraceDensity = 1e-6f;
 
 void grid_paint_tops(GridDims d, const float* rho, const float* particle_density, float* top, float* joint_top) {
   parallel_for(d.cells(), [=] WB_HD(int64_t c) {
-    const int k = int(uint32_t(c) / uint32_t(int64_t(d.nx) * d.ny));
+    int i, j, k;
+    d.decompose_cell(c, i, j, k);
     // Traces above the top (a lifting bristle carries them up a fraction of a cell a sub-step)
     // stay where they are for the step.
     const bool paint = rho[c] > kTraceDensity;
