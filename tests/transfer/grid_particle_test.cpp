@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "core/color/ryb.h"
+#include "core/exec/memory.h"
 #include "transfer/transfer_fixture.h"
 
 namespace wb::test {
@@ -31,6 +32,10 @@ class GridParticleTest : public TransferTest {
     v.oy = w.origin().y;
     v.oz = w.origin().z;
     return v;
+  }
+  PaintWindow books_window() {
+    return make_window({48, 48, 12}, {0, 0, 0}, [](int i, int, int k) { return k < 2 && i > 20 ? 0.9f : 0.f; },
+                       Vec3(0.f, 1.f, 0.f), 0.3f);
   }
   static float min_distance(const HostSamples& h, Vec3 p) {
     float d = std::numeric_limits<float>::max();
@@ -324,34 +329,57 @@ TEST_F(GridParticleTest, ParticlesNearTheBristlesStay) {
   EXPECT_EQ(dead[2], 1u);
 }
 
-TEST_F(GridParticleTest, WholeStepsKeepTheBooks) {
-  const Int3 origin{0, 0, 0};
-  PaintWindow w = make_window({48, 48, 12}, origin, [](int i, int, int k) { return k < 2 && i > 20 ? 0.9f : 0.f; },
-                              Vec3(0.f, 1.f, 0.f), 0.3f);
-  HostSamples h = vertical_brush(3, 24, 0.8f, 22.f, 24.f, 1.2f, 2.f, Vec3(40.f, 0.f, 0.f));
-  DeviceSamples s(device_);
-  s.upload(h);
+/// Paint on the canvas beside a loaded brush, with slow particles far from it (they go back)
+/// and near it (absorbed or kept): a transfer step moves paint every way.
+struct BooksScene {
+  Device device;
+  PaintWindow w;
+  DeviceSamples s;
   TransferParams prm;
-  BristleLoad load(device_, s.view().count(), prm);
-  PaintLoad paint;  // default: deep blue, 0.8 of the capacity
-  load.fill(paint);
-  ParticleStore p(device_);
-  // A few slow particles far from the brush (they go back) and near it (absorbed or kept).
-  std::vector<Vec3> xs;
-  for (int i = 0; i < 30; ++i) xs.push_back(Vec3(40.f + 0.2f * i, 40.f, 2.5f));
-  for (int i = 0; i < 30; ++i) xs.push_back(Vec3(22.f + 0.1f * i, 24.3f, 1.5f + 0.3f * i));
-  p.append(particles_at(xs, 2e-10f, Vec3(1.f, 0.f, 0.f)));
-  Transfer t(device_, prm);
+  BristleLoad load;
+  ParticleStore p;
+  Transfer t;
+  BooksScene(const Device& d, PaintWindow&& window, int64_t limit, bool with_particles = true)
+      : device(d), w(std::move(window)), s(brush(d)), load(d, s.view().count(), prm), p(d, limit), t(d, prm) {
+    load.fill(PaintLoad{});  // default: deep blue, 0.8 of the capacity
+    if (!with_particles) return;
+    std::vector<Vec3> xs;
+    for (int i = 0; i < 30; ++i) xs.push_back(Vec3(40.f + 0.2f * i, 40.f, 2.5f));
+    for (int i = 0; i < 30; ++i) xs.push_back(Vec3(22.f + 0.1f * i, 24.3f, 1.5f + 0.3f * i));
+    p.append(particles_at(xs, 2e-10f, Vec3(1.f, 0.f, 0.f)));
+  }
+  static DeviceSamples brush(const Device& d) {
+    DeviceSamples s(d);
+    s.upload(vertical_brush(3, 24, 0.8f, 22.f, 24.f, 1.2f, 2.f, Vec3(40.f, 0.f, 0.f)));
+    return s;
+  }
+  TransferRecord step(Workspace& ws) {
+    SampleHashGrid grid(device);
+    grid.build(s.view(), 2.f, ws);
+    grid.query_nearest(p.view(), 12.f);
+    TransferEnv env;
+    env.paint = w.view();
+    env.D0 = 12.f;
+    const int64_t before = mem::host_reads();
+    TransferRecord rec = t.step(s.view(), load, p, env);
+    step_reads = mem::host_reads() - before;
+    t.collect(rec);
+    return rec;
+  }
+  int64_t step_reads = 0;  ///< host reads of the last Transfer::step
+  PaintCensus census(Workspace& ws) { return PaintBooks::census(load, p, w.total_density(ws), prm, ws); }
+};
+
+TEST_F(GridParticleTest, WholeStepsKeepTheBooks) {
+  BooksScene sc(device_, books_window(), 2000000);
   PaintBooks books;
-  auto census = [&] { return PaintBooks::census(load, p, w.total_density(ws_), prm, ws_); };
+  auto census = [&] { return sc.census(ws_); };
   books.open(census());
   const double start = books.initial_total();
   ASSERT_GT(start, 0.0);
   int64_t moved_any = 0;
   for (int step = 0; step < 6; ++step) {
-    query_nearest(s, p, 12.f);
-    TransferRecord rec = t.step(s.view(), load, p, env_for(w, 12.f));
-    t.collect(rec);
+    TransferRecord rec = sc.step(ws_);
     EXPECT_LT(rec.max_closure_error(), 1e-6) << "step " << step;
     moved_any += rec.absorbed_count + rec.emitted_count + rec.to_grid_count + rec.to_particles_count;
     const double drift = books.record(rec, census());
@@ -363,6 +391,43 @@ TEST_F(GridParticleTest, WholeStepsKeepTheBooks) {
   EXPECT_GT(moved_any, 0);
   EXPECT_LT(books.max_drift(), 1e-5);
   EXPECT_EQ(books.steps().size(), 6u);
+}
+
+// The compaction and both batches of new particles share one scan and one host read: the
+// survivors keep their order at the front, the emission follows, then Eq. 15's candidates; a
+// store at its limit serves the emission first and drops the rest, and the books still close.
+TEST_F(GridParticleTest, AStepRemovesAndAddsParticlesWithOneRead) {
+  BooksScene with(device_, books_window(), 2000000);
+  const TransferRecord first = with.step(ws_);
+  EXPECT_EQ(with.step_reads, 1);
+  const int64_t kept = with.p.size() - first.emitted_count - first.to_particles_count;
+  EXPECT_GT(first.absorbed_count + first.to_grid_count, 0) << "some particles die";
+  EXPECT_EQ(kept, 60 - first.absorbed_count - first.to_grid_count);
+  // The same step from no particles, with room for all, then at limits that cut the candidates
+  // and the emission.
+  BooksScene free(device_, books_window(), 2000000, false);
+  const TransferRecord all = free.step(ws_);
+  ASSERT_GT(all.emitted_count, 4);
+  ASSERT_GT(all.to_particles_count, 4);
+  const ParticleHost ref = free.p.to_host();
+  for (const int64_t limit : {all.emitted_count + all.to_particles_count / 2, all.emitted_count / 2}) {
+    BooksScene cut(device_, books_window(), limit, false);
+    const double before = cut.census(ws_).total();
+    const TransferRecord rec = cut.step(ws_);
+    const int64_t emitted = std::min(all.emitted_count, limit);
+    EXPECT_EQ(cut.p.size(), limit);
+    EXPECT_EQ(rec.emitted_count, emitted);
+    EXPECT_EQ(rec.emission_dropped, all.emitted_count - emitted);
+    EXPECT_EQ(rec.to_particles_count, limit - emitted);
+    EXPECT_EQ(rec.to_particles_dropped, all.to_particles_count - rec.to_particles_count);
+    EXPECT_LT(rec.max_closure_error(), 1e-6);
+    EXPECT_NEAR(cut.census(ws_).total(), before, 1e-6 * before) << "dropped particles leave their paint where it was";
+    const ParticleHost h = cut.p.to_host();
+    for (size_t k = 0; k < size_t(limit); ++k) {
+      EXPECT_EQ(h.x[k].x, ref.x[k].x) << k;
+      EXPECT_EQ(h.x[k].z, ref.x[k].z) << k;
+    }
+  }
 }
 
 }  // namespace

@@ -21,6 +21,24 @@ namespace wb::test {
 /// Window fields on the host, in WB_PAINT_FIELDS order.
 using WindowFields = std::vector<std::vector<float>>;
 
+/// Particles from host arrays: positions, one mass, colour, oil, velocity.
+inline ParticleHost particles_at(const std::vector<Vec3>& x, float m, Vec3 ryb, float oil = 0.3f,
+                                 Vec3 v = Vec3(0.f, 0.f, 0.f)) {
+  ParticleHost h;
+  h.resize(x.size());
+  for (size_t i = 0; i < x.size(); ++i) {
+    h.x[i] = x[i];
+    h.v[i] = v;
+    h.m[i] = m;
+    h.pigment_r[i] = ryb.x;
+    h.pigment_y[i] = ryb.y;
+    h.pigment_b[i] = ryb.z;
+    h.oil[i] = oil;
+    h.dryness[i] = 0.f;
+  }
+  return h;
+}
+
 class TransferTest : public BackendTest {
  protected:
   /// A window of `dims` at `origin` painted by fn(i, j, k) -> density with colour ryb, oil, dryness.
@@ -45,24 +63,6 @@ class TransferTest : public BackendTest {
         }
     w.from_host(f);
     return w;
-  }
-
-  /// Particles from host arrays: positions, one mass, colour, oil, velocity.
-  static ParticleHost particles_at(const std::vector<Vec3>& x, float m, Vec3 ryb, float oil = 0.3f,
-                                   Vec3 v = Vec3(0.f, 0.f, 0.f)) {
-    ParticleHost h;
-    h.resize(x.size());
-    for (size_t i = 0; i < x.size(); ++i) {
-      h.x[i] = x[i];
-      h.v[i] = v;
-      h.m[i] = m;
-      h.pigment_r[i] = ryb.x;
-      h.pigment_y[i] = ryb.y;
-      h.pigment_b[i] = ryb.z;
-      h.oil[i] = oil;
-      h.dryness[i] = 0.f;
-    }
-    return h;
   }
 
   /// Sets every particle's nearest sample (range `range`) with the sample hash grid.

@@ -26,6 +26,11 @@ uint32_t exclusive_scan(const Device& d, const uint32_t* in, uint32_t* out, int6
   mem::count_host_read();
   WB_DISPATCH(d, exclusive_scan(in, out, n, ws));
 }
+void exclusive_scan_into(const Device& d, const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws) {
+  check_ws(d, ws);
+  mem::count_launch();
+  WB_DISPATCH(d, exclusive_scan_into(in, out, n, ws));
+}
 double reduce_sum(const Device& d, const float* in, int64_t n, Workspace& ws) {
   check_ws(d, ws);
   mem::count_launch();

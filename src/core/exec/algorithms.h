@@ -13,6 +13,9 @@ namespace wb {
 void sort_by_key(const Device& device, uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Workspace& ws);
 /// out[i] = sum of in[0..i), out may alias in; returns the total.
 uint32_t exclusive_scan(const Device& device, const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);
+/// The same scan left on the device (not a host read): the kernels that follow read its
+/// prefixes, and the host reads what it needs of them with more in one copy.
+void exclusive_scan_into(const Device& device, const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);
 /// Sum in double precision (mass books need more than float accumulation).
 double reduce_sum(const Device& device, const float* in, int64_t n, Workspace& ws);
 /// The same sum written to *out, a device pointer: the result stays on the device for the
@@ -43,6 +46,7 @@ namespace cpu {
 void count_nonfinite_each_into(const FloatArrays& arrays, int64_t* out, Workspace& ws);
 void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Workspace& ws);
 uint32_t exclusive_scan(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);
+void exclusive_scan_into(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);
 double reduce_sum(const float* in, int64_t n, Workspace& ws);
 void reduce_sum_into(const float* in, int64_t n, double* out, Workspace& ws);
 void reduce_sum_into(const double* in, int64_t n, double* out, Workspace& ws);
@@ -56,6 +60,7 @@ namespace cuda {
 void count_nonfinite_each_into(const FloatArrays& arrays, int64_t* out, Workspace& ws);
 void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Workspace& ws);
 uint32_t exclusive_scan(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);
+void exclusive_scan_into(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);
 double reduce_sum(const float* in, int64_t n, Workspace& ws);
 void reduce_sum_into(const float* in, int64_t n, double* out, Workspace& ws);
 void reduce_sum_into(const double* in, int64_t n, double* out, Workspace& ws);

@@ -50,6 +50,8 @@ uint32_t exclusive_scan(const uint32_t* in, uint32_t* out, int64_t n, Workspace&
   return running;
 }
 
+void exclusive_scan_into(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws) { exclusive_scan(in, out, n, ws); }
+
 double reduce_sum(const float* in, int64_t n, Workspace&) {
   double s = 0.0;
 #pragma omp parallel for reduction(+ : s) schedule(static) if (n > 65536)

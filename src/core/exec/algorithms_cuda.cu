@@ -90,6 +90,14 @@ uint32_t exclusive_scan(const uint32_t* in, uint32_t* out, int64_t n, Workspace&
   return last_out + last_in;
 }
 
+void exclusive_scan_into(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws) {
+  if (n <= 0) return;
+  size_t temp = 0;
+  WB_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, temp, in, out, n, wb::cuda_stream()));
+  void* base = ws.get(temp);
+  WB_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(base, temp, in, out, n, wb::cuda_stream()));
+}
+
 double reduce_sum(const float* in, int64_t n, Workspace& ws) {
   if (n <= 0) return 0.0;
   return reduce(thrust::make_transform_iterator(in, ToDouble{}), n, ::cuda::std::plus<double>{}, 0.0, ws);

@@ -85,20 +85,27 @@ int64_t ParticleStore::compact(Workspace& ws) {
   const int64_t n = count_;
   if (n == 0) return 0;
   if (scan_.size() < size_t(n)) scan_.grow_keep(size_t(n));
-  if (scratch_.size() < size_t(n)) scratch_.grow_keep(size_t(n));
   particles_keep_flags(device_, dead.data(), scan_.data(), n);
   const int64_t kept = int64_t(exclusive_scan(device_, scan_.data(), scan_.data(), n, ws));
-  if (kept == n) return 0;
+  remove_dead(scan_.data(), kept);
+  return n - kept;
+}
+
+void ParticleStore::remove_dead(const uint32_t* pos, int64_t kept) {
+  const int64_t n = count_;
+  WB_REQUIRE(kept >= 0 && kept <= n, "ParticleStore::remove_dead: " + std::to_string(kept) + " kept of " +
+                                         std::to_string(n));
+  if (kept == n) return;
+  if (scratch_.size() < size_t(n)) scratch_.grow_keep(size_t(n));
   // Every field goes through the one scratch buffer (sized for the widest field) and back,
   // which needs a single spare array instead of a second copy of the whole store. The dead
   // flags go last: the scatters read them.
 #define WB_X(type, name, doc) \
-  if (static_cast<const void*>(&name) != static_cast<const void*>(&dead)) compact_one(device_, name, scratch_, dead.data(), scan_.data(), n, kept);
+  if (static_cast<const void*>(&name) != static_cast<const void*>(&dead)) compact_one(device_, name, scratch_, dead.data(), pos, n, kept);
   WB_PARTICLE_FIELDS(WB_X)
 #undef WB_X
   dead.fill_zero();
   count_ = kept;
-  return n - kept;
 }
 
 ParticleView ParticleStore::view() {

@@ -42,6 +42,9 @@ class ParticleStore {
   /// Removes every particle whose `dead` flag is set, keeping the order of the survivors
   /// (exclusive scan of the keep flags, then a scatter of every field). Returns how many went.
   int64_t compact(Workspace& ws);
+  /// The scatter of compact() for a scan made elsewhere: pos = exclusive scan of the keep flags
+  /// (particles_keep_flags) of the size() particles, kept = their total.
+  void remove_dead(const uint32_t* pos, int64_t kept);
   void clear() { count_ = 0; }
 
   ParticleView view();

@@ -10,6 +10,7 @@
 #include "core/exec/dispatch.h"
 #include "core/exec/error.h"
 #include "core/exec/profile.h"
+#include "core/particles/particles.h"
 #include "core/transfer/bristle_particle_kernels.h"
 
 namespace wb {
@@ -65,20 +66,23 @@ void d_emit_count(const Device& d, SampleView s, BristleLoadView l, TransferPara
                   float* mass_each, float* swept_each, uint32_t* swept_n) {
   WB_DISPATCH(d, transfer_emit_count(s, l, prm, dt, count, mass_each, swept_each, swept_n));
 }
-void d_emit_fill(const Device& d, SampleView s, BristleLoadView l, ParticleView p, const uint32_t* offset,
-                 const uint32_t* count, const float* mass_each, const float* swept_each, const uint32_t* swept_n,
-                 int64_t first, int64_t room, int64_t step_index, TransferParams prm, float floor_z, float dt,
-                 PaintWindowView pw, float dry_threshold, float* emitted) {
-  WB_DISPATCH(d, transfer_emit_fill(s, l, p, offset, count, mass_each, swept_each, swept_n, first, room, step_index,
-                                    prm, floor_z, dt, pw, dry_threshold, emitted));
+void d_emit_fill(const Device& d, SampleView s, BristleLoadView l, ParticleView p, NewBatch b, const float* mass_each,
+                 const float* swept_each, const uint32_t* swept_n, int64_t step_index, TransferParams prm,
+                 float floor_z, float dt, PaintWindowView pw, float dry_threshold, float* emitted) {
+  WB_DISPATCH(d, transfer_emit_fill(s, l, p, b, mass_each, swept_each, swept_n, step_index, prm, floor_z, dt, pw,
+                                    dry_threshold, emitted));
 }
 void d_grid_count(const Device& d, PaintWindowView pw, DistanceBlocks db, KeepBox keep, TransferParams prm, float dry,
                   uint32_t* count) {
   WB_DISPATCH(d, transfer_grid_count(pw, db, keep, prm, dry, count));
 }
-void d_grid_emit(const Device& d, PaintWindowView pw, MacView vel, ParticleView p, const uint32_t* count,
-                 const uint32_t* offset, int64_t first, int64_t room, TransferParams prm, float dry, float* demand) {
-  WB_DISPATCH(d, transfer_grid_emit(pw, vel, p, count, offset, first, room, prm, dry, demand));
+void d_grid_emit(const Device& d, PaintWindowView pw, MacView vel, ParticleView p, NewBatch b, TransferParams prm,
+                 float dry, float* demand) {
+  WB_DISPATCH(d, transfer_grid_emit(pw, vel, p, b, prm, dry, demand));
+}
+void d_room_ends(const Device& d, const uint32_t* count, const uint32_t* offset, int64_t n, int64_t a, int64_t b,
+                 uint32_t* ends) {
+  WB_DISPATCH(d, transfer_room_ends(count, offset, n, a, b, ends));
 }
 void d_grid_clamp(const Device& d, PaintWindowView pw, float* demand_ratio, float* removed) {
   WB_DISPATCH(d, transfer_grid_clamp(pw, demand_ratio, removed));
@@ -160,10 +164,12 @@ Transfer::Transfer(const Device& device, const TransferParams& params)
   validate(params_);
   for (auto& b : s_u32_) b.set_device(device);
   for (auto& b : s_f32_) b.set_device(device);
-  for (auto& b : c_u32_) b.set_device(device);
   for (auto& b : c_f32_) b.set_device(device);
   for (auto& b : c_i64_) b.set_device(device);
   p_moved_.set_device(device);
+  room_count_.set_device(device);
+  room_offset_.set_device(device);
+  room_ends_ = DeviceBuffer<uint32_t>(device, 3);
   passes_.set_device(device);
   occ_.set_device(device);
   d2_.set_device(device);
@@ -180,7 +186,6 @@ void Transfer::ensure_samples(int64_t n) {
   for (auto& b : s_f32_) b.resize(size_t(n));
 }
 void Transfer::ensure_cells(int64_t n) {
-  for (auto& b : c_u32_) b.resize(size_t(n));
   for (auto& b : c_f32_) b.resize(size_t(n));
   for (auto& b : c_i64_) b.resize(size_t(n));
 }
@@ -215,18 +220,7 @@ TransferRecord Transfer::step(const SampleView& samples, BristleLoad& load, Part
     WB_PROFILE_SCOPE("transfer.to_grid");
     particles_to_grid(particles, env);
   }
-  {
-    WB_PROFILE_SCOPE("transfer.compact");
-    particles.compact(ws_);
-  }
-  {
-    WB_PROFILE_SCOPE("transfer.emit");
-    emit(samples, load, particles, env, rec);
-  }
-  {
-    WB_PROFILE_SCOPE("transfer.to_particles");
-    grid_to_particles(particles, env, rec);
-  }
+  make_particles(&samples, &load, particles, env, /*compact=*/true, /*candidates=*/true, rec);
   ++step_index_;
   return rec;
 }
@@ -393,64 +387,100 @@ void Transfer::particles_to_grid(ParticleStore& particles, const TransferEnv& en
   reduce_sum_add_into(device_, acc.added, nc, sum_field(&TransferSums::to_grid_into_grid), ws_);
 }
 
-int64_t Transfer::make_room(ParticleStore& particles, const uint32_t* count, uint32_t* offset, int64_t n,
-                            int64_t& first, int64_t& dropped) {
-  const int64_t total = int64_t(exclusive_scan(device_, count, offset, n, ws_));
-  const int64_t n_new = std::min(total, std::max<int64_t>(particles.limit() - particles.size(), 0));
-  dropped = total - n_new;
-  if (n_new > 0) first = particles.append_uninitialised(n_new);
-  return n_new;
-}
-
 void Transfer::emit(const SampleView& samples, BristleLoad& load, ParticleStore& particles, const TransferEnv& env,
                     TransferRecord& rec) {
-  const int64_t ns = samples.count();
-  WB_REQUIRE(ns == load.size(), "Transfer::emit: " + std::to_string(ns) + " samples but a load of " +
-                                    std::to_string(load.size()));
-  if (ns == 0) return;
-  ensure_samples(ns);
-  const BristleLoadView lv = load.view();
-  uint32_t* count = s_u32_[0].data();
-  uint32_t* offset = s_u32_[1].data();
-  float* mass_each = s_f32_[0].data();
-  float* emitted = s_f32_[1].data();
-  float* swept_each = s_f32_[2].data();
-  uint32_t* swept_n = s_u32_[2].data();
-  d_emit_count(device_, samples, lv, params_, env.dt, count, mass_each, swept_each, swept_n);
-  int64_t first = 0;
-  const int64_t n_new = make_room(particles, count, offset, ns, first, rec.emission_dropped);
-  if (n_new == 0) return;
-  const ParticleView pv = particles.view();
-  d_emit_fill(device_, samples, lv, pv, offset, count, mass_each, swept_each, swept_n, first, n_new, step_index_,
-              params_, env.floor_z, env.dt, env.paint, env.dry_threshold, emitted);
-  rec.emitted_count = n_new;
-  reduce_sum_add_into(device_, emitted, ns, sum_field(&TransferSums::emitted_from_bristles), ws_);
-  reduce_sum_add_into(device_, pv.m + first, n_new, sum_field(&TransferSums::emitted_into_particles), ws_);
+  make_particles(&samples, &load, particles, env, /*compact=*/false, /*candidates=*/false, rec);
 }
 
 void Transfer::grid_to_particles(ParticleStore& particles, const TransferEnv& env, TransferRecord& rec) {
-  validate(env);
-  const DistanceBlocks db = distance_view();
-  WB_REQUIRE(db.D0 == env.D0, "Transfer: the distance field was built for another D0");
+  make_particles(nullptr, nullptr, particles, env, /*compact=*/false, /*candidates=*/true, rec);
+}
+
+void Transfer::make_particles(const SampleView* samples, BristleLoad* load, ParticleStore& particles,
+                              const TransferEnv& env, bool compact, bool candidates, TransferRecord& rec) {
+  const int64_t nk = compact ? particles.size() : 0;
+  const int64_t ns = samples ? samples->count() : 0;
+  if (samples)
+    WB_REQUIRE(ns == load->size(), "Transfer::emit: " + std::to_string(ns) + " samples but a load of " +
+                                       std::to_string(load->size()));
+  DistanceBlocks db{};
+  if (candidates) {
+    validate(env);
+    db = distance_view();
+    WB_REQUIRE(db.D0 == env.D0, "Transfer: the distance field was built for another D0");
+  }
+  const int64_t nc = candidates ? env.paint.size() : 0;
+  const int64_t n = nk + ns + nc;
+  if (n == 0) return;
+  NewBatch emission{}, cells{};
+  {
+    WB_PROFILE_SCOPE("transfer.room");
+    room_count_.resize(size_t(n));
+    room_offset_.resize(size_t(n));
+    uint32_t* count = room_count_.data();
+    uint32_t* offset = room_offset_.data();
+    if (nk > 0) particles_keep_flags(device_, particles.dead.data(), count, nk);
+    if (ns > 0) {
+      ensure_samples(ns);
+      d_emit_count(device_, *samples, load->view(), params_, env.dt, count + nk, s_f32_[0].data(), s_f32_[2].data(),
+                   s_u32_[1].data());
+    }
+    if (nc > 0) {
+      ensure_cells(nc);
+      d_grid_count(device_, env.paint, db, env.keep, params_, env.dry_threshold, count + nk + ns);
+    }
+    exclusive_scan_into(device_, count, offset, n, ws_);
+    d_room_ends(device_, count, offset, n, nk, nk + ns, room_ends_.data());
+    uint32_t ends[3];
+    room_ends_.copy_to_host(ends, 3);  // the step's one wait of the transfer
+    const int64_t kept = compact ? int64_t(ends[0]) : particles.size();
+    if (kept < nk) particles.remove_dead(offset, kept);
+    const int64_t want_emitted = int64_t(ends[1]) - int64_t(ends[0]), want_cells = int64_t(ends[2]) - int64_t(ends[1]);
+    int64_t room = std::max<int64_t>(particles.limit() - kept, 0);
+    const int64_t n_emitted = std::min(want_emitted, room);
+    room -= n_emitted;
+    const int64_t n_cells = std::min(want_cells, room);
+    if (samples) rec.emission_dropped = want_emitted - n_emitted;
+    if (candidates) rec.to_particles_dropped = want_cells - n_cells;
+    const int64_t first = n_emitted + n_cells > 0 ? particles.append_uninitialised(n_emitted + n_cells) : kept;
+    emission = NewBatch{count + nk, offset + nk, int64_t(ends[0]), first, n_emitted};
+    cells = NewBatch{count + nk + ns, offset + nk + ns, int64_t(ends[1]), first + n_emitted, n_cells};
+  }
+  if (emission.n > 0) {
+    WB_PROFILE_SCOPE("transfer.emit");
+    fill_emission(*samples, *load, particles, env, emission);
+    rec.emitted_count = emission.n;
+  }
+  if (cells.n > 0) {
+    WB_PROFILE_SCOPE("transfer.to_particles");
+    fill_candidates(particles, env, cells);
+    rec.to_particles_count = cells.n;
+  }
+}
+
+void Transfer::fill_emission(const SampleView& samples, BristleLoad& load, ParticleStore& particles,
+                             const TransferEnv& env, const NewBatch& batch) {
+  const int64_t ns = samples.count();
+  const ParticleView pv = particles.view();
+  float* emitted = s_f32_[1].data();
+  d_emit_fill(device_, samples, load.view(), pv, batch, s_f32_[0].data(), s_f32_[2].data(), s_u32_[1].data(),
+              step_index_, params_, env.floor_z, env.dt, env.paint, env.dry_threshold, emitted);
+  reduce_sum_add_into(device_, emitted, ns, sum_field(&TransferSums::emitted_from_bristles), ws_);
+  reduce_sum_add_into(device_, pv.m + batch.first, batch.n, sum_field(&TransferSums::emitted_into_particles), ws_);
+}
+
+void Transfer::fill_candidates(ParticleStore& particles, const TransferEnv& env, const NewBatch& batch) {
   const int64_t nc = env.paint.size();
-  ensure_cells(nc);
-  uint32_t* count = c_u32_[0].data();
-  uint32_t* offset = c_u32_[1].data();
-  d_grid_count(device_, env.paint, db, env.keep, params_, env.dry_threshold, count);
-  int64_t first = 0;
-  const int64_t n_new = make_room(particles, count, offset, nc, first, rec.to_particles_dropped);
-  if (n_new == 0) return;
   const ParticleView pv = particles.view();
   float* demand = c_f32_[0].data();
   float* removed = c_f32_[1].data();
   c_f32_[0].fill_zero();
-  d_grid_emit(device_, env.paint, env.velocity, pv, count, offset, first, n_new, params_, env.dry_threshold, demand);
+  d_grid_emit(device_, env.paint, env.velocity, pv, batch, params_, env.dry_threshold, demand);
   d_grid_clamp(device_, env.paint, demand, removed);
-  d_grid_finish(device_, pv, first, n_new, env.paint, demand, params_, env.dry_threshold);
-  rec.to_particles_count = n_new;
+  d_grid_finish(device_, pv, batch.first, batch.n, env.paint, demand, params_, env.dry_threshold);
   // Density units here; collect() turns them into kg.
   reduce_sum_add_into(device_, removed, nc, sum_field(&TransferSums::to_particles_from_grid), ws_);
-  reduce_sum_add_into(device_, pv.m + first, n_new, sum_field(&TransferSums::to_particles_into_particles), ws_);
+  reduce_sum_add_into(device_, pv.m + batch.first, batch.n, sum_field(&TransferSums::to_particles_into_particles), ws_);
 }
 
 }  // namespace wb

@@ -1,6 +1,7 @@
 // Liquid transfer stage (paper §5, Eq. 12-16; DESIGN step 8). Transfer::step runs, in order:
 //   update_capacity (Eq. 12-13) -> absorb (Eq. 14, colour bleeding) -> update_distance ->
 //   particles_to_grid (Eq. 16) -> compact -> emit (§5.1) -> grid_to_particles (Eq. 15)
+// (the last three sized by one scan and one host read, make_particles)
 // and returns what each transfer moved (TransferRecord; PaintBooks keeps the budget).
 // The stage functions validate their input and dispatch to wb::cpu or wb::cuda (transfer_impl.h).
 #pragma once
@@ -11,6 +12,7 @@
 #include "core/canvas/window.h"
 #include "core/exec/buffer.h"
 #include "core/exec/device.h"
+#include "core/exec/hd.h"
 #include "core/exec/workspace.h"
 #include "core/particles/mac_sample.h"
 #include "core/particles/particle_fields.h"
@@ -125,6 +127,19 @@ struct DepositScratch {
   const float* surface;     ///< TransferEnv::surface
 };
 
+/// A batch of new particles (§5.1's emission or Eq. 15's candidates): count[j] from source j,
+/// laid at store index first + offset[j] - base, where offset is the exclusive scan the batch
+/// shares with what precedes it (Transfer::make_particles); the first n exist, the rest were
+/// dropped at the store's limit.
+struct NewBatch {
+  const uint32_t* count;
+  const uint32_t* offset;
+  int64_t base;   ///< offset of the batch's first slot in the shared scan
+  int64_t first;  ///< store index of the batch's first particle
+  int64_t n;      ///< particles appended for the batch
+  WB_HD int64_t slot(int64_t j) const { return int64_t(offset[j]) - base; }
+};
+
 class Transfer {
  public:
   explicit Transfer(const Device& device, const TransferParams& params = {});
@@ -134,8 +149,8 @@ class Transfer {
   const TransferParams& params() const { return params_; }
   int64_t steps() const { return step_index_; }
 
-  /// One transfer step (§5): every stage below in order, with one compaction of the particle
-  /// store. The particles' `nearest` must come from SampleHashGrid::query_nearest on these
+  /// One transfer step (§5): every stage below in order; the compaction of the particle store
+  /// and the room of the emission and of Eq. 15 come from one scan and one host read. The particles' `nearest` must come from SampleHashGrid::query_nearest on these
   /// samples this step (the absorption candidate; the distance is re-measured here). The
   /// record holds what the host knows (new particles, drops); the device's sums and counts
   /// join it in collect().
@@ -181,11 +196,17 @@ class Transfer {
   std::vector<float> distance_to_host();
 
  private:
-  /// Slots for new particles: offsets = exclusive scan of the per-source counts; as many as the
-  /// store's limit allows are appended at `first` (sources served in index order), the rest
-  /// counted in `dropped`. Returns the number appended.
-  int64_t make_room(ParticleStore& particles, const uint32_t* count, uint32_t* offset, int64_t n, int64_t& first,
-                    int64_t& dropped);
+  /// New particles from the samples (§5.1, when `samples` is given) and from the cells near the
+  /// bristles (Eq. 15, when `candidates`), after removing the dead ones (when `compact`). One
+  /// exclusive scan over [keep flags | emission counts | candidate counts] gives the survivors'
+  /// slots and both batches' offsets, and one host read its three prefix ends: the counts the
+  /// store is sized by. As many as the store's limit allows are appended (emission first, sources
+  /// in index order); the rest are counted as dropped in rec.
+  void make_particles(const SampleView* samples, BristleLoad* load, ParticleStore& particles, const TransferEnv& env,
+                      bool compact, bool candidates, TransferRecord& rec);
+  void fill_emission(const SampleView& samples, BristleLoad& load, ParticleStore& particles, const TransferEnv& env,
+                     const NewBatch& batch);
+  void fill_candidates(ParticleStore& particles, const TransferEnv& env, const NewBatch& batch);
   void ensure_samples(int64_t n);
   void ensure_cells(int64_t n);
   void ensure_particles(int64_t n);
@@ -195,12 +216,13 @@ class Transfer {
   Workspace ws_;
   int64_t step_index_ = 0;
   // Per sample.
-  DeviceBuffer<uint32_t> s_u32_[3];
+  DeviceBuffer<uint32_t> s_u32_[2];
   DeviceBuffer<float> s_f32_[12];
   // Per particle.
   DeviceBuffer<float> p_moved_;
+  // make_particles: the counts, their scan, and its three prefix ends.
+  DeviceBuffer<uint32_t> room_count_, room_offset_, room_ends_;
   // Per cell.
-  DeviceBuffer<uint32_t> c_u32_[2];
   DeviceBuffer<float> c_f32_[7];
   DeviceBuffer<int64_t> c_i64_[7];
   // Distance blocks.
@@ -243,16 +265,16 @@ void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadVi
   void transfer_to_grid_apply(PaintWindowView pw, DepositScratch acc);                                             \
   void transfer_emit_count(SampleView s, BristleLoadView load, TransferParams prm, float dt, uint32_t* count,       \
                            float* mass_each, float* swept_each, uint32_t* swept_n);                                \
-  void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, const uint32_t* offset,               \
-                          const uint32_t* count, const float* mass_each, const float* swept_each,                  \
-                          const uint32_t* swept_n, int64_t first, int64_t room, int64_t step_index,                \
-                          TransferParams prm, float floor_z, float dt, PaintWindowView pw, float dry_threshold,    \
-                          float* emitted);                                                                         \
+  void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, NewBatch batch,                     \
+                          const float* mass_each, const float* swept_each, const uint32_t* swept_n,                \
+                          int64_t step_index, TransferParams prm, float floor_z, float dt, PaintWindowView pw,     \
+                          float dry_threshold, float* emitted);                                                    \
   void transfer_grid_count(PaintWindowView pw, DistanceBlocks db, KeepBox keep, TransferParams prm,                \
                            float dry_threshold, uint32_t* count);                                                                        \
-  void transfer_grid_emit(PaintWindowView pw, MacView vel, ParticleView p, const uint32_t* count,                   \
-                          const uint32_t* offset, int64_t first, int64_t room, TransferParams prm,                 \
+  void transfer_grid_emit(PaintWindowView pw, MacView vel, ParticleView p, NewBatch batch, TransferParams prm,     \
                           float dry_threshold, float* demand);                                                      \
+  void transfer_room_ends(const uint32_t* count, const uint32_t* offset, int64_t n, int64_t a, int64_t b,          \
+                          uint32_t* ends);                                                                         \
   void transfer_grid_clamp(PaintWindowView pw, float* demand_ratio, float* removed);                               \
   void transfer_grid_finish(ParticleView p, int64_t first, int64_t n, PaintWindowView pw, const float* ratio,       \
                             TransferParams prm, float dry_threshold);                                               \

@@ -359,9 +359,8 @@ void transfer_emit_count(SampleView s, BristleLoadView load, TransferParams prm,
   });
 }
 
-void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, const uint32_t* offset,
-                        const uint32_t* count, const float* mass_each, const float* swept_each,
-                        const uint32_t* swept_n, int64_t first, int64_t room, int64_t step_index, TransferParams prm,
+void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, NewBatch batch, const float* mass_each,
+                        const float* swept_each, const uint32_t* swept_n, int64_t step_index, TransferParams prm,
                         float floor_z, float dt, PaintWindowView pw, float dry_threshold, float* emitted) {
   const int P = prm.emit_pattern;
   const CellField density{pw.density, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
@@ -371,10 +370,10 @@ void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, cons
   const float cm = prm.cell_mass();
   parallel_for(load.count, [=] WB_HD(int64_t j) {
     emitted[j] = 0.f;
-    const int n = int(count[j]);
+    const int n = int(batch.count[j]);
     if (n == 0) return;
-    const int64_t off = int64_t(offset[j]);
-    const int64_t left = room - off;
+    const int64_t off = batch.slot(j);
+    const int64_t left = batch.n - off;
     const int n_eff = left <= 0 ? 0 : (left < n ? int(left) : n);
     if (n_eff == 0) return;
     const int n_swept = int(swept_n[j]), n_static = n - n_swept;
@@ -386,7 +385,7 @@ void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, cons
     const float a = sqrtf(maxf(Rm * Rm - r * r, 0.f));
     float out = 0.f;
     for (int i = 0; i < n_eff; ++i) {
-      const int64_t k = first + off + i;
+      const int64_t k = batch.first + off + i;
       if (i < n_static) {
         p.x[k] = emission_position(xj, R, j, step_index, n_static, i, P, floor_z);
         p.v[k] = vj;  // "the new particles share the same attributes as the sample, including the velocity"
@@ -451,24 +450,24 @@ void transfer_grid_count(PaintWindowView pw, DistanceBlocks db, KeepBox keep, Tr
   });
 }
 
-void transfer_grid_emit(PaintWindowView pw, MacView vel, ParticleView p, const uint32_t* count, const uint32_t* offset,
-                        int64_t first, int64_t room, TransferParams prm, float dry_threshold, float* demand) {
+void transfer_grid_emit(PaintWindowView pw, MacView vel, ParticleView p, NewBatch batch, TransferParams prm,
+                        float dry_threshold, float* demand) {
   const float h = prm.kernel_h, cm = prm.cell_mass();
   const int split = prm.candidate_split, candidates = split * split * split;
   const float share = 1.f / float(candidates);
   parallel_for(pw.size(), [=] WB_HD(int64_t c) {
-    if (count[c] == 0u) return;
-    const int64_t off = int64_t(offset[c]);
-    if (off >= room) return;
+    if (batch.count[c] == 0u) return;
+    const int64_t off = batch.slot(c);
+    if (off >= batch.n) return;
     const int i = int(c % pw.nx), j = int((c / pw.nx) % pw.ny), k = int(c / (int64_t(pw.nx) * pw.ny));
     const Vec3 cell_c(pw.pigment_r[c], pw.pigment_y[c], pw.pigment_b[c]);
     const float oil = pw.oil[c], dry = pw.dryness[c];
     int64_t t = 0;
-    for (int s = 0; s < candidates && off + t < room; ++s) {
+    for (int s = 0; s < candidates && off + t < batch.n; ++s) {
       const Vec3 q = Vec3(float(i), float(j), float(k)) + candidate_offset(i + pw.ox, j + pw.oy, k + pw.oz, s, split);
       const float rho_q = liquid_density_at(pw, q, dry_threshold);
       if (!(rho_q > 0.f)) continue;
-      const int64_t pk = first + off + t;
+      const int64_t pk = batch.first + off + t;
       ++t;
       const Vec3 x(q.x + float(pw.ox), q.y + float(pw.oy), q.z + float(pw.oz));
       const float a = rho_q * share;  // the candidate's share of the cell, density units
@@ -482,6 +481,17 @@ void transfer_grid_emit(PaintWindowView pw, MacView vel, ParticleView p, const u
       p.dryness[pk] = dry;
       for_each_kernel_cell(pw, q, h, dry_threshold, [&](int64_t id, float w) { atomic_add(&demand[id], a * w); });
     }
+  });
+}
+
+void transfer_room_ends(const uint32_t* count, const uint32_t* offset, int64_t n, int64_t a, int64_t b,
+                        uint32_t* ends) {
+  // The scan's prefixes at a and b and its total (n > 0): one small copy for the host.
+  parallel_for(1, [=] WB_HD(int64_t) {
+    const uint32_t total = offset[n - 1] + count[n - 1];
+    ends[0] = a < n ? offset[a] : total;
+    ends[1] = b < n ? offset[b] : total;
+    ends[2] = total;
   });
 }
 
