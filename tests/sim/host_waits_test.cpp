@@ -41,7 +41,7 @@ TEST_F(SimulatorTest, HostWaitsPerStepStayWithinEachStagesBudget) {
       {"brush.step", 0.0},       // sub-steps roll back on the device; the record reports it
       {"books", 1.0},            // the step's record: sums, census, non-finite counts, rollbacks
       {"grid.advect", 1.0},      // the velocity maxima that set the sub-step count
-      {"grid.viscosity", 3.0},   // the fluid faces' count; CG's one test when the plan holds
+      {"grid.viscosity", 2.0},   // CG's one test when the plan holds, the fluid faces' count with it
       {"transfer.step", 1.0},    // one scan's ends: the survivors, the emission, Eq. 15's candidates
       {"window", 2.0},           // the samples' box and ground; a move's tile flags, compaction
   };
@@ -53,7 +53,7 @@ TEST_F(SimulatorTest, HostWaitsPerStepStayWithinEachStagesBudget) {
   const double total = mean_of(prof.host_reads("sim.step"));
   std::printf("[ waits ] %-16s %.2f a step; %.0f launches a step\n", "sim.step", total,
               mean_of(prof.launches("sim.step")));
-  EXPECT_LE(total, 7.5) << "a step's host waits";
+  EXPECT_LE(total, 6.5) << "a step's host waits";
   // The worst step: at the lift, where Eq. 9 lifts the paint the tips hold, the viscous solve can
   // take up to its 300 iterations, far past its plan: it reads after 8, 16, 32, ... more.
   const auto& steps = prof.host_reads("sim.step");

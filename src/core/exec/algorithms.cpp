@@ -47,6 +47,12 @@ void reduce_sum_into(const Device& d, const double* in, int64_t n, double* out, 
   mem::count_launch();
   WB_DISPATCH(d, reduce_sum_into(in, n, out, ws));
 }
+void reduce_sum_count_into(const Device& d, const double* in, const int64_t* count, int64_t capacity, double* out,
+                           Workspace& ws) {
+  check_ws(d, ws);
+  mem::count_launch();
+  WB_DISPATCH(d, reduce_sum_count_into(in, count, capacity, out, ws));
+}
 void reduce_sum_add_into(const Device& d, const float* in, int64_t n, double* out, Workspace& ws) {
   check_ws(d, ws);
   mem::count_launch();

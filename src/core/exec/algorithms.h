@@ -22,6 +22,10 @@ double reduce_sum(const Device& device, const float* in, int64_t n, Workspace& w
 /// kernels that use it, and the host does not wait for it (not a host read).
 void reduce_sum_into(const Device& device, const float* in, int64_t n, double* out, Workspace& ws);
 void reduce_sum_into(const Device& device, const double* in, int64_t n, double* out, Workspace& ws);
+/// The sum of the first *count of `capacity` values, *count device memory a kernel wrote (as
+/// parallel_for_count): neither the count nor the sum is read by the host.
+void reduce_sum_count_into(const Device& device, const double* in, const int64_t* count, int64_t capacity,
+                           double* out, Workspace& ws);
 /// *out += the sum, on the device (not a host read): a record the device keeps over a step.
 void reduce_sum_add_into(const Device& device, const float* in, int64_t n, double* out, Workspace& ws);
 float reduce_max(const Device& device, const float* in, int64_t n, Workspace& ws);
@@ -44,6 +48,7 @@ void count_nonfinite_each_into(const Device& device, const FloatArrays& arrays, 
 
 namespace cpu {
 void count_nonfinite_each_into(const FloatArrays& arrays, int64_t* out, Workspace& ws);
+void reduce_sum_count_into(const double* in, const int64_t* count, int64_t capacity, double* out, Workspace& ws);
 void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Workspace& ws);
 uint32_t exclusive_scan(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);
 void exclusive_scan_into(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);
@@ -58,6 +63,7 @@ int64_t count_nonfinite(const float* in, int64_t n, Workspace& ws);
 }  // namespace cpu
 namespace cuda {
 void count_nonfinite_each_into(const FloatArrays& arrays, int64_t* out, Workspace& ws);
+void reduce_sum_count_into(const double* in, const int64_t* count, int64_t capacity, double* out, Workspace& ws);
 void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Workspace& ws);
 uint32_t exclusive_scan(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);
 void exclusive_scan_into(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws);

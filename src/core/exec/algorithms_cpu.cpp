@@ -68,6 +68,10 @@ void reduce_sum_into(const double* in, int64_t n, double* out, Workspace&) {
   *out = s;
 }
 
+void reduce_sum_count_into(const double* in, const int64_t* count, int64_t capacity, double* out, Workspace& ws) {
+  reduce_sum_into(in, *count < capacity ? *count : capacity, out, ws);  // device memory is the host's
+}
+
 void reduce_sum_add_into(const float* in, int64_t n, double* out, Workspace& ws) { *out += reduce_sum(in, n, ws); }
 
 float reduce_max(const float* in, int64_t n, Workspace&) {

@@ -3,6 +3,7 @@
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_reduce.cuh>
 #include <cub/device/device_scan.cuh>
+#include <thrust/iterator/counting_iterator.h>
 #include <thrust/iterator/transform_iterator.h>
 
 #include <cuda/std/limits>
@@ -16,6 +17,12 @@ namespace {
 
 struct ToDouble {
   __host__ __device__ double operator()(float v) const { return double(v); }
+};
+// in[i] below the device's count, else 0: a reduction over the capacity sums the first *count.
+struct CountedDouble {
+  const double* in;
+  const int64_t* count;
+  __host__ __device__ double operator()(int64_t i) const { return i < *count ? in[i] : 0.0; }
 };
 struct NonFinite {
   __host__ __device__ long long operator()(float v) const { return isfinite(v) ? 0 : 1; }
@@ -109,6 +116,11 @@ void reduce_sum_into(const float* in, int64_t n, double* out, Workspace& ws) {
 
 void reduce_sum_into(const double* in, int64_t n, double* out, Workspace& ws) {
   reduce_to(in, n, ::cuda::std::plus<double>{}, 0.0, out, ws);
+}
+
+void reduce_sum_count_into(const double* in, const int64_t* count, int64_t capacity, double* out, Workspace& ws) {
+  reduce_to(thrust::make_transform_iterator(thrust::counting_iterator<int64_t>(0), CountedDouble{in, count}), capacity,
+            ::cuda::std::plus<double>{}, 0.0, out, ws);
 }
 
 namespace {

@@ -51,26 +51,29 @@ void visc_flags_d(const Device& d, GridView g, uint32_t* flag) { WB_DISPATCH(d, 
 void visc_list_d(const Device& d, GridView g, const uint32_t* idx, uint32_t* list) {
   WB_DISPATCH(d, grid_viscous_list(g, idx, list));
 }
-void visc_setup_d(const Device& d, GridView g, const uint32_t* list, int64_t n, const uint32_t* idx, const float* mu,
+void visc_count_d(const Device& d, GridView g, const uint32_t* idx, int64_t capacity, int64_t* run, double* total) {
+  WB_DISPATCH(d, grid_viscous_count(g, idx, capacity, run, total));
+}
+void visc_setup_d(const Device& d, GridView g, const uint32_t* list, ListCount n, const uint32_t* idx, const float* mu,
                   float scale, float* nu, int32_t* nb, double* diag, double* b, double* x) {
   WB_DISPATCH(d, grid_viscous_setup(g, list, n, idx, mu, scale, nu, nb, diag, b, x));
 }
-void visc_apply_d(const Device& d, int64_t n, const float* nu, const int32_t* nb, const double* diag, const double* p,
+void visc_apply_d(const Device& d, ListCount n, const float* nu, const int32_t* nb, const double* diag, const double* p,
                   double* q, double* pq, CgGuard guard = {}) {
   WB_DISPATCH(d, grid_viscous_apply(n, nu, nb, diag, p, q, pq, guard));
 }
-void pcg_start_d(const Device& d, int64_t n, const double* b, const double* ax, const double* diag, double* r,
+void pcg_start_d(const Device& d, ListCount n, const double* b, const double* ax, const double* diag, double* r,
                  double* z, double* p, double* rz, double* bz) {
   WB_DISPATCH(d, grid_pcg_start(n, b, ax, diag, r, z, p, rz, bz));
 }
-void pcg_update_d(const Device& d, int64_t n, CgGuard guard, const double* pq, const double* p, const double* q,
+void pcg_update_d(const Device& d, ListCount n, CgGuard guard, const double* pq, const double* p, const double* q,
                   const double* diag, double* x, double* r, double* z, double* rz, double* iterations) {
   WB_DISPATCH(d, grid_pcg_update(n, guard, pq, p, q, diag, x, r, z, rz, iterations));
 }
-void pcg_direction_d(const Device& d, int64_t n, CgGuard guard, const double* rz_new, const double* z, double* p) {
+void pcg_direction_d(const Device& d, ListCount n, CgGuard guard, const double* rz_new, const double* z, double* p) {
   WB_DISPATCH(d, grid_pcg_direction(n, guard, rz_new, z, p));
 }
-void visc_write_d(const Device& d, GridView g, const uint32_t* list, int64_t n, const double* x) {
+void visc_write_d(const Device& d, GridView g, const uint32_t* list, ListCount n, const double* x) {
   WB_DISPATCH(d, grid_viscous_write(g, list, n, x));
 }
 void rhs_d(const Device& d, GridView g, const float* rho, float inv_dt, float* b) {
@@ -274,7 +277,9 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   for (auto* b : {&cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_, &cg_dot_a_, &cg_dot_b_})
     b->set_device(d);
   cg_sums_.set_device(d);
-  cg_sums_.resize(5);
+  cg_sums_.resize(6);
+  cg_count_.set_device(d);
+  cg_count_.resize(1);
   advect_max_.set_device(d);
   advect_max_.resize(kAdvectMaxSlots);
   const size_t tiles = size_t((g.nx + kPaintTile - 1) / kPaintTile) * size_t((g.ny + kPaintTile - 1) / kPaintTile);
@@ -488,26 +493,17 @@ void Grid::apply_viscosity(float dt) {
   stats_.viscosity_residual = 0;
   if (params_.viscosity_max_iterations <= 0) return;
   // The fluid faces, compacted: the solve costs in proportion to the paint, not to the window.
+  // Their count stays on the device (ListCount) and comes back with the CG's one read; a list
+  // longer than the vectors' capacity runs nothing and is solved again once they are sized.
   const int64_t all = int64_t(visc_idx_.size());
   visc_flags_d(d, v, visc_idx_.data());
-  const int64_t n = exclusive_scan(d, visc_idx_.data(), visc_idx_.data(), all, ws_);
-  stats_.viscosity_faces = int(n);
-  if (n == 0) return;
+  exclusive_scan_into(d, visc_idx_.data(), visc_idx_.data(), all, ws_);
   visc_list_d(d, v, visc_idx_.data(), visc_list_.data());
-  if (cg_x_.size() < size_t(n)) {
-    const size_t cap = std::min(size_t(all), size_t(n) + size_t(n) / 2);
-    cg_nb_.resize(6 * cap);
-    cg_nu_.resize(cap);
-    for (auto* b : {&cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_, &cg_dot_a_, &cg_dot_b_})
-      b->resize(cap);
-  }
   // (1 - dt div(nu grad)) u = u_old, nu = mu / rho0 in cells^2/s.
   const double h = params_.cell_size;
   const float nu_scale = float(double(dt) / (double(params_.rho0) * h * h));
   const uint32_t* list = visc_list_.data();
   const uint32_t* idx = visc_idx_.data();
-  visc_setup_d(d, v, list, n, idx, mu_.data(), nu_scale, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_b_.data(),
-               cg_x_.data());
   // Jacobi-preconditioned conjugate gradients (Saad 2003, Alg. 9.1) from the current velocity.
   // alpha, beta and the test of convergence are formed on the device from sums kept there
   // (cg_sums_: r.z of the current and the next iteration, p.Ap, b.D^-1 b, the iterations made),
@@ -516,40 +512,60 @@ void Grid::apply_viscosity(float dt) {
   // once; only a solve that needs more reads again, after kCgCheckEvery more iterations, then
   // twice as many each time (a solve far past its plan reads a few times, not every 8).
   constexpr int kCgCheckEvery = 8, kCgMargin = 2;
-  double* sums = cg_sums_.data();
-  cg_sums_.fill_zero();
-  visc_apply_d(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_x_.data(), cg_q_.data(), cg_dot_a_.data());
-  pcg_start_d(d, n, cg_b_.data(), cg_q_.data(), cg_diag_.data(), cg_r_.data(), cg_z_.data(), cg_p_.data(),
-              cg_dot_a_.data(), cg_dot_b_.data());
-  reduce_sum_into(d, cg_dot_a_.data(), n, sums + 0, ws_);
-  reduce_sum_into(d, cg_dot_b_.data(), n, sums + 3, ws_);
+  constexpr int64_t kCgFirstCapacity = 4096;  // entries of the first solve's vectors
   const double tol2 = double(params_.viscosity_tolerance) * double(params_.viscosity_tolerance);
   const int max_it = params_.viscosity_max_iterations;
-  int launched = 0, cur = 0;
-  double host[5] = {};
-  for (int planned = std::min(max_it, cg_last_iterations_ + kCgMargin), more = kCgCheckEvery;; more *= 2) {
-    for (; launched < planned; ++launched) {
-      const int next = 1 - cur;
-      const CgGuard guard{sums + cur, sums + 3, tol2};
-      visc_apply_d(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_p_.data(), cg_q_.data(), cg_dot_a_.data(),
-                   guard);
-      reduce_sum_into(d, cg_dot_a_.data(), n, sums + 2, ws_);
-      pcg_update_d(d, n, guard, sums + 2, cg_p_.data(), cg_q_.data(), cg_diag_.data(), cg_x_.data(), cg_r_.data(),
-                   cg_z_.data(), cg_dot_a_.data(), sums + 4);
-      reduce_sum_into(d, cg_dot_a_.data(), n, sums + next, ws_);
-      pcg_direction_d(d, n, guard, sums + next, cg_z_.data(), cg_p_.data());
-      cur = next;
+  double* sums = cg_sums_.data();
+  double host[6] = {};
+  int cur = 0;
+  for (int64_t need = 0;;) {
+    if (need > int64_t(cg_x_.size()) || cg_x_.size() == 0) {
+      const size_t cap = size_t(std::min(all, std::max<int64_t>(need + need / 2, kCgFirstCapacity)));
+      cg_nb_.resize(6 * cap);
+      cg_nu_.resize(cap);
+      for (auto* b : {&cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_, &cg_dot_a_, &cg_dot_b_})
+        b->resize(cap);
     }
-    cg_sums_.copy_to_host(host, 5);
-    const double rz = host[cur];
-    if (!(rz > tol2 * host[3] && rz > 0.0) || launched >= max_it) break;
-    planned = std::min(max_it, launched + more);
+    const ListCount n{cg_count_.data(), int64_t(cg_x_.size())};
+    cg_sums_.fill_zero();
+    visc_count_d(d, v, idx, n.capacity, cg_count_.data(), sums + 5);
+    visc_setup_d(d, v, list, n, idx, mu_.data(), nu_scale, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(),
+                 cg_b_.data(), cg_x_.data());
+    visc_apply_d(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_x_.data(), cg_q_.data(), cg_dot_a_.data());
+    pcg_start_d(d, n, cg_b_.data(), cg_q_.data(), cg_diag_.data(), cg_r_.data(), cg_z_.data(), cg_p_.data(),
+                cg_dot_a_.data(), cg_dot_b_.data());
+    reduce_sum_count_into(d, cg_dot_a_.data(), n.n, n.capacity, sums + 0, ws_);
+    reduce_sum_count_into(d, cg_dot_b_.data(), n.n, n.capacity, sums + 3, ws_);
+    int launched = 0;
+    cur = 0;
+    for (int planned = std::min(max_it, cg_last_iterations_ + kCgMargin), more = kCgCheckEvery;; more *= 2) {
+      for (; launched < planned; ++launched) {
+        const int next = 1 - cur;
+        const CgGuard guard{sums + cur, sums + 3, tol2};
+        visc_apply_d(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_p_.data(), cg_q_.data(),
+                     cg_dot_a_.data(), guard);
+        reduce_sum_count_into(d, cg_dot_a_.data(), n.n, n.capacity, sums + 2, ws_);
+        pcg_update_d(d, n, guard, sums + 2, cg_p_.data(), cg_q_.data(), cg_diag_.data(), cg_x_.data(), cg_r_.data(),
+                     cg_z_.data(), cg_dot_a_.data(), sums + 4);
+        reduce_sum_count_into(d, cg_dot_a_.data(), n.n, n.capacity, sums + next, ws_);
+        pcg_direction_d(d, n, guard, sums + next, cg_z_.data(), cg_p_.data());
+        cur = next;
+      }
+      cg_sums_.copy_to_host(host, 6);
+      need = int64_t(host[5]);
+      if (need > n.capacity) break;  // nothing ran: size the vectors and solve again
+      const double rz = host[cur];
+      if (!(rz > tol2 * host[3] && rz > 0.0) || launched >= max_it) break;
+      planned = std::min(max_it, launched + more);
+    }
+    if (need <= int64_t(cg_x_.size())) break;
   }
+  stats_.viscosity_faces = int(host[5]);
   const int it = int(host[4]);
-  cg_last_iterations_ = it;
+  if (host[5] > 0.0) cg_last_iterations_ = it;  // a solve of nothing plans nothing
   stats_.viscosity_iterations = it;
   stats_.viscosity_residual = host[3] > 0.0 ? std::sqrt(std::max(host[cur], 0.0) / host[3]) : 0.0;
-  visc_write_d(d, v, list, n, cg_x_.data());
+  visc_write_d(d, v, list, ListCount{cg_count_.data(), int64_t(cg_x_.size())}, cg_x_.data());
 }
 
 void Grid::compute_rhs(float dt) {

@@ -155,8 +155,11 @@ class Grid {
   DeviceBuffer<float> cg_nu_;
   /// The viscous CG's vectors and matrix diagonal, in double (viscous_apply says why).
   DeviceBuffer<double> cg_x_, cg_b_, cg_r_, cg_z_, cg_p_, cg_q_, cg_diag_, cg_dot_a_, cg_dot_b_;
-  /// The CG's scalars on the device: r.z of the two latest iterations, p.Ap, b.D^-1 b.
+  /// The CG's scalars on the device: r.z of the two latest iterations, p.Ap, b.D^-1 b, the
+  /// iterations made, the fluid faces counted (read together, once a solve).
   DeviceBuffer<double> cg_sums_;
+  /// The fluid faces the solve's kernels run over (ListCount::n).
+  DeviceBuffer<int64_t> cg_count_;
   int cg_last_iterations_ = 0;  ///< the last viscous solve's CG iterations: the next one plans on them
   /// The advection's maxima, read in one copy: the outflow rate along each axis (slots 0-2), the
   /// top layers holding paint and paint or particles; then the joint top after the particles
@@ -215,16 +218,17 @@ class Grid {
                                 float* mu);                                                                          \
   void grid_viscous_flags(GridView g, uint32_t* flag);                                                               \
   void grid_viscous_list(GridView g, const uint32_t* idx, uint32_t* list);                                           \
-  void grid_viscous_setup(GridView g, const uint32_t* list, int64_t n, const uint32_t* idx, const float* mu,       \
+  void grid_viscous_count(GridView g, const uint32_t* idx, int64_t capacity, int64_t* run, double* total);       \
+  void grid_viscous_setup(GridView g, const uint32_t* list, ListCount n, const uint32_t* idx, const float* mu,     \
                           float nu_scale, float* nu, int32_t* nb, double* diag, double* b, double* x);               \
-  void grid_viscous_apply(int64_t n, const float* nu, const int32_t* nb, const double* diag, const double* p,       \
+  void grid_viscous_apply(ListCount n, const float* nu, const int32_t* nb, const double* diag, const double* p,       \
                           double* q, double* pq, CgGuard guard);                                                     \
-  void grid_pcg_start(int64_t n, const double* b, const double* ax, const double* diag, double* r, double* z,      \
+  void grid_pcg_start(ListCount n, const double* b, const double* ax, const double* diag, double* r, double* z,      \
                       double* p, double* rz, double* bz);                                                            \
-  void grid_pcg_update(int64_t n, CgGuard guard, const double* pq, const double* p, const double* q,               \
+  void grid_pcg_update(ListCount n, CgGuard guard, const double* pq, const double* p, const double* q,               \
                        const double* diag, double* x, double* r, double* z, double* rz, double* iterations);        \
-  void grid_pcg_direction(int64_t n, CgGuard guard, const double* rz_new, const double* z, double* p);            \
-  void grid_viscous_write(GridView g, const uint32_t* list, int64_t n, const double* x);                           \
+  void grid_pcg_direction(ListCount n, CgGuard guard, const double* rz_new, const double* z, double* p);          \
+  void grid_viscous_write(GridView g, const uint32_t* list, ListCount n, const double* x);                         \
   void grid_rhs(GridView g, const float* rho, float inv_dt, float* b);                                                                               \
   void poisson_jacobi(PoissonView s, const float* b, const float* x, float* out, float omega);                      \
   void poisson_residual(PoissonView s, const float* b, const float* x, float* r);                                   \

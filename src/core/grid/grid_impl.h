@@ -378,15 +378,30 @@ WB_HD WB_INLINE int64_t list_face(const GridDims& d, const uint32_t* list, int64
 }
 }  // namespace detail
 
-void grid_viscous_setup(GridView g, const uint32_t* list, int64_t n, const uint32_t* idx, const float* mu,
+void grid_viscous_count(GridView g, const uint32_t* idx, int64_t capacity, int64_t* run, double* total) {
+  // idx is the exclusive scan of the fluid flags of every face: the last entry plus the last
+  // face's own flag is the count.
+  const GridDims d = g.d;
+  parallel_for(1, [=] WB_HD(int64_t) {
+    const int64_t last = detail::all_faces(d) - 1;
+    int c;
+    int64_t f;
+    detail::split_face_below(d, d.nz, last, c, f);
+    const int64_t n = int64_t(idx[last]) + (g.fluid[c][f] ? 1 : 0);
+    *run = n <= capacity ? n : 0;
+    *total = double(n);
+  });
+}
+
+void grid_viscous_setup(GridView g, const uint32_t* list, ListCount n, const uint32_t* idx, const float* mu,
                         float nu_scale, float* nu, int32_t* nb, double* diag, double* b, double* x) {
   const GridDims d = g.d;
-  parallel_for(n, [=] WB_HD(int64_t e) {
+  parallel_for_count(n.n, n.capacity, [=] WB_HD(int64_t e) {
     int c, i, j, k;
     detail::list_face(d, list, e, c, i, j, k);
     nu[e] = face_nu_dt(g, mu, c, i, j, k, nu_scale);
   });
-  parallel_for(n, [=] WB_HD(int64_t e) {
+  parallel_for_count(n.n, n.capacity, [=] WB_HD(int64_t e) {
     int c, i, j, k;
     const int64_t f = detail::list_face(d, list, e, c, i, j, k);
     viscous_row(g, nu, idx, e, c, i, j, k, g.vel[c][f], nb + 6 * e, diag[e], b[e]);
@@ -394,18 +409,18 @@ void grid_viscous_setup(GridView g, const uint32_t* list, int64_t n, const uint3
   });
 }
 
-void grid_viscous_apply(int64_t n, const float* nu, const int32_t* nb, const double* diag, const double* p, double* q,
-                        double* pq, CgGuard guard) {
-  parallel_for(n, [=] WB_HD(int64_t e) {
+void grid_viscous_apply(ListCount n, const float* nu, const int32_t* nb, const double* diag, const double* p,
+                        double* q, double* pq, CgGuard guard) {
+  parallel_for_count(n.n, n.capacity, [=] WB_HD(int64_t e) {
     if (!guard.active()) return;
     q[e] = viscous_apply(nu, nb, p, diag[e], e);
     pq[e] = p[e] * q[e];
   });
 }
 
-void grid_pcg_start(int64_t n, const double* b, const double* ax, const double* diag, double* r, double* z, double* p,
-                    double* rz, double* bz) {
-  parallel_for(n, [=] WB_HD(int64_t e) {
+void grid_pcg_start(ListCount n, const double* b, const double* ax, const double* diag, double* r, double* z,
+                    double* p, double* rz, double* bz) {
+  parallel_for_count(n.n, n.capacity, [=] WB_HD(int64_t e) {
     r[e] = b[e] - ax[e];
     z[e] = r[e] / diag[e];
     p[e] = z[e];
@@ -414,9 +429,9 @@ void grid_pcg_start(int64_t n, const double* b, const double* ax, const double* 
   });
 }
 
-void grid_pcg_update(int64_t n, CgGuard guard, const double* pq, const double* p, const double* q,
+void grid_pcg_update(ListCount n, CgGuard guard, const double* pq, const double* p, const double* q,
                      const double* diag, double* x, double* r, double* z, double* rz, double* iterations) {
-  parallel_for(n, [=] WB_HD(int64_t e) {
+  parallel_for_count(n.n, n.capacity, [=] WB_HD(int64_t e) {
     if (!guard.active()) return;
     if (e == 0) *iterations += 1.0;
     // alpha = (r.z) / (p.Ap) from the device sums; 0 (no step) where p.Ap is not positive,
@@ -429,17 +444,17 @@ void grid_pcg_update(int64_t n, CgGuard guard, const double* pq, const double* p
   });
 }
 
-void grid_pcg_direction(int64_t n, CgGuard guard, const double* rz_new, const double* z, double* p) {
-  parallel_for(n, [=] WB_HD(int64_t e) {
+void grid_pcg_direction(ListCount n, CgGuard guard, const double* rz_new, const double* z, double* p) {
+  parallel_for_count(n.n, n.capacity, [=] WB_HD(int64_t e) {
     if (!guard.active()) return;
     const double beta = *rz_new / *guard.rz;
     p[e] = z[e] + beta * p[e];
   });
 }
 
-void grid_viscous_write(GridView g, const uint32_t* list, int64_t n, const double* x) {
+void grid_viscous_write(GridView g, const uint32_t* list, ListCount n, const double* x) {
   const GridDims d = g.d;
-  parallel_for(n, [=] WB_HD(int64_t e) {
+  parallel_for_count(n.n, n.capacity, [=] WB_HD(int64_t e) {
     int c;
     int64_t f;
     detail::split_face_below(d, d.nz, int64_t(list[e]), c, f);
