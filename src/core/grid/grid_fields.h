@@ -100,9 +100,6 @@ struct JointOil {
   }
 };
 
-/// The viscous CG's test of convergence, made on the device by every kernel of an iteration:
-/// the iteration runs while r.z > tol2 b.D^-1 b (and r.z > 0), so that iterations launched past
-/// convergence do nothing and the host need not read r.z to stop them. rz null: always run.
 /// The viscous solve's list length as the device counted it (the host does not wait for it):
 /// its kernels run over the first *n of `capacity` entries (parallel_for_count); *n is 0 when
 /// the list outgrew the capacity, and the solve's one read tells the host to size it again.
@@ -111,6 +108,9 @@ struct ListCount {
   int64_t capacity = 0;
 };
 
+/// The viscous CG's test of convergence, made on the device by every kernel of an iteration:
+/// the iteration runs while r.z > tol2 b.D^-1 b (and r.z > 0), so that iterations launched past
+/// convergence do nothing and the host need not read r.z to stop them. rz null: always run.
 struct CgGuard {
   const double* rz = nullptr;
   const double* bnorm = nullptr;
