@@ -1,5 +1,7 @@
 // The whole step of Figure 4 on a small scene: paint books, no paint from a clean brush,
 // paint only under a pressed brush, stability under jitter and a very fast stroke.
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -70,6 +72,13 @@ TEST_F(SimulatorTest, BrushPictureIsTheBrushsPaintAndPose) {
 // the simulation exactly as it was. A canvas written from outside drops the paint in flight and
 // the books record it.
 TEST_F(SimulatorTest, SettledCanvasLeavesTheSimulationAsItWasAndReplacedCanvasIsBooked) {
+  // On one CPU thread the float atomics add in one order: a simulation that took the copy and one
+  // that did not must then go on alike. (On a GPU their order varies: within the spread of such sums.)
+  struct OneThread {
+    int threads = omp_get_max_threads();
+    OneThread() { omp_set_num_threads(1); }
+    ~OneThread() { omp_set_num_threads(threads); }
+  } one_thread;
   const SimConfig c = small_config();
   Simulator a(c, pose_at(c.brush, 120, 128, 0.f, false)), b(c, pose_at(c.brush, 120, 128, 0.f, false));
   for (Simulator* s : {&a, &b}) s->load_paint(red());
@@ -101,12 +110,13 @@ TEST_F(SimulatorTest, SettledCanvasLeavesTheSimulationAsItWasAndReplacedCanvasIs
   EXPECT_NEAR(copy.total_density() * cell_mass, census.grid + census.particles, 1e-6 * census.total())
       << "the settled canvas holds the paint on the canvas and in flight";
   EXPECT_EQ(a.particle_count(), in_flight) << "taking it leaves the particles";
-  // And it goes on as one that took no copy (within the run-to-run spread of parallel sums).
+  // And it goes on as one that took no copy.
   stroke(a, 8, 12);
   stroke(b, 8, 12);
-  EXPECT_NEAR(double(a.particle_count()), double(b.particle_count()), 0.01 * double(b.particle_count()));
-  EXPECT_NEAR(a.census().grid, b.census().grid, 1e-3 * b.census().total());
-  EXPECT_NEAR(a.census().bristles, b.census().bristles, 1e-3 * b.census().total());
+  const double spread = device_.is_cpu() ? 0.0 : 1e-3;
+  EXPECT_NEAR(double(a.particle_count()), double(b.particle_count()), 10.0 * spread * double(b.particle_count()));
+  EXPECT_NEAR(a.census().grid, b.census().grid, (spread + 1e-9) * b.census().total());
+  EXPECT_NEAR(a.census().bristles, b.census().bristles, (spread + 1e-9) * b.census().total());
   // Undo writes a tile back under the window: the paint in flight goes, and the books say so.
   const PaintCensus before = a.census();
   a.replace_canvas([&](TileStore& canvas) {

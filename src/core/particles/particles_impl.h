@@ -76,24 +76,6 @@ void particles_init_scratch(ParticleView p, int64_t first, int64_t n) {
   });
 }
 
-/// Top of the dried paint in window column c (absolute canvas z), or floor_z where none: the
-/// highest cell the grid counts as solid (cell_is_solid), a partly filled one holding its paint at
-/// the bottom (the surface is rho up). `above` receives the first layer over it (0 where none).
-WB_HD WB_INLINE float column_solid_top(const PaintWindowView& pw, int64_t c, float dry_threshold, float floor_z,
-                                       int& above) {
-  const int64_t layer = int64_t(pw.nx) * pw.ny;
-  above = 0;
-  for (int k = pw.nz - 1; k >= 0; --k) {
-    const int64_t id = int64_t(k) * layer + c;
-    const float rho = pw.density[id];
-    if (dried_solid(rho, pw.dryness[id], dry_threshold)) {
-      above = k + 1;
-      return maxf(floor_z, float(pw.oz + k) + minf(rho, 1.f));
-    }
-  }
-  return floor_z;
-}
-
 void particles_solid_height(PaintWindowView pw, const float* particle_density, float dry_threshold,
                             float liquid_threshold, float floor_z, bool grid_cells, float* height, float* wet_top) {
   parallel_for(int64_t(pw.nx) * pw.ny, [=] WB_HD(int64_t c) {

@@ -21,9 +21,9 @@ void joint_clamp_to_canvas(const Device& d, ParticleView p, Vec3 lo, Vec3 hi) {
   WB_DISPATCH(d, joint_clamp_to_canvas(p, lo, hi));
 }
 void joint_kill_nonfinite(const Device& d, ParticleView p) { WB_DISPATCH(d, joint_kill_nonfinite(p)); }
-void joint_ground_under(const Device& d, const float* height, int nx, int ny, int ox, int oy, float cx, float cy,
-                        float r, float floor_z, float* out) {
-  WB_DISPATCH(d, joint_ground_under(height, nx, ny, ox, oy, cx, cy, r, floor_z, out));
+void joint_ground_under(const Device& d, PaintWindowView pw, float dry_threshold, float cx, float cy, float r,
+                        float floor_z, float* out) {
+  WB_DISPATCH(d, joint_ground_under(pw, dry_threshold, cx, cy, r, floor_z, out));
 }
 void joint_sample_extent(const Device& d, const Vec3* x, int64_t n, float z_top, float* out) {
   WB_DISPATCH(d, joint_sample_extent(x, n, z_top, out));

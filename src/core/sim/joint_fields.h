@@ -30,11 +30,11 @@ void joint_kill_nonfinite(const Device& d, ParticleView p);
 /// Per sample below height z_top: x, -x, y and -y into out[0..n), [n..2n), [2n..3n), [3n..4n)
 /// (-inf above z_top); their maxima are the horizontal box of the samples that reach the window.
 void joint_sample_extent(const Device& d, const Vec3* x, int64_t n, float z_top, float* out);
-/// Per window column (nx x ny at ox, oy): the dried paint's top `height` where the column's
-/// centre lies within r of (cx, cy) and the top is above floor_z, else 0 (their maximum is the
-/// ground under a brush footprint).
-void joint_ground_under(const Device& d, const float* height, int nx, int ny, int ox, int oy, float cx, float cy,
-                        float r, float floor_z, float* out);
+/// Per window column: the dried paint's top (column_solid_top) where the column's centre lies
+/// within r of (cx, cy) and the top is above floor_z, else 0 (their maximum is the ground under a
+/// brush footprint). Only the columns under the footprint are scanned.
+void joint_ground_under(const Device& d, PaintWindowView pw, float dry_threshold, float cx, float cy, float r,
+                        float floor_z, float* out);
 
 #define WB_JOINT_BACKEND_DECLS                                                                          \
   void joint_scale(const float* in, float* out, int64_t n, float scale);                               \
@@ -44,8 +44,8 @@ void joint_ground_under(const Device& d, const float* height, int nx, int ny, in
   void joint_kill_nonfinite(ParticleView p);                                                            \
   void joint_clamp_to_canvas(ParticleView p, Vec3 lo, Vec3 hi);                                      \
   void joint_sample_extent(const Vec3* x, int64_t n, float z_top, float* out);                         \
-  void joint_ground_under(const float* height, int nx, int ny, int ox, int oy, float cx, float cy, float r,  \
-                          float floor_z, float* out);
+  void joint_ground_under(PaintWindowView pw, float dry_threshold, float cx, float cy, float r, float floor_z, \
+                          float* out);
 namespace cpu {
 WB_JOINT_BACKEND_DECLS
 }

@@ -9,12 +9,15 @@ void joint_scale(const float* in, float* out, int64_t n, float scale) {
   parallel_for(n, [=] WB_HD(int64_t i) { out[i] = in[i] * scale; });
 }
 
-void joint_ground_under(const float* height, int nx, int ny, int ox, int oy, float cx, float cy, float r,
-                        float floor_z, float* out) {
-  parallel_for(int64_t(nx) * ny, [=] WB_HD(int64_t c) {
-    const float dx = float(ox + int(c % nx)) + 0.5f - cx, dy = float(oy + int(c / nx)) + 0.5f - cy;
-    const float h = height[c];
-    out[c] = dx * dx + dy * dy <= r * r && h > floor_z ? h : 0.f;
+void joint_ground_under(PaintWindowView pw, float dry_threshold, float cx, float cy, float r, float floor_z,
+                        float* out) {
+  parallel_for(int64_t(pw.nx) * pw.ny, [=] WB_HD(int64_t c) {
+    out[c] = 0.f;
+    const float dx = float(pw.ox + int(c % pw.nx)) + 0.5f - cx, dy = float(pw.oy + int(c / pw.nx)) + 0.5f - cy;
+    if (!(dx * dx + dy * dy <= r * r)) return;
+    int above = 0;
+    const float h = column_solid_top(pw, c, dry_threshold, floor_z, above);
+    if (h > floor_z) out[c] = h;
   });
 }
 

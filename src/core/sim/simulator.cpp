@@ -304,10 +304,8 @@ std::array<float, 4> Simulator::samples_box() {
   // The ground for the next step: the dried paint's top under the footprint (the disc of the
   // brush's half width around where its tips meet the canvas), in the same copy.
   const ParticleParams& pp = config_.params.particles;
-  particles_solid_height(device(), win.paint().view(), nullptr, config_.params.grid.dry_threshold,
-                         config_.params.grid.liquid_threshold, pp.floor_z, false, solid_height_.data());
   const Vec3 tip = footprint_centre(brush_->pose(), config_.brush.length);
-  joint_ground_under(device(), solid_height_.data(), wn.x, wn.y, o.x, o.y, tip.x, tip.y,
+  joint_ground_under(device(), win.paint().view(), config_.params.grid.dry_threshold, tip.x, tip.y,
                      0.5f * std::max(config_.brush.width, config_.brush.thickness), pp.floor_z, extent_scratch_.data());
   reduce_max_into(device(), extent_scratch_.data(), columns, extent_.data() + 4, ws_);
   float m[5];
