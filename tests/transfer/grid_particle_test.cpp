@@ -398,11 +398,21 @@ TEST_F(GridParticleTest, WholeStepsKeepTheBooks) {
 // store at its limit serves the emission first and drops the rest, and the books still close.
 TEST_F(GridParticleTest, AStepRemovesAndAddsParticlesWithOneRead) {
   BooksScene with(device_, books_window(), 2000000);
+  const std::vector<Vec3> at_start = with.p.to_host().x;
   const TransferRecord first = with.step(ws_);
   EXPECT_EQ(with.step_reads, 1);
   const int64_t kept = with.p.size() - first.emitted_count - first.to_particles_count;
   EXPECT_GT(first.absorbed_count + first.to_grid_count, 0) << "some particles die";
   EXPECT_EQ(kept, 60 - first.absorbed_count - first.to_grid_count);
+  // The survivors lead the store, in their order (the transfer moves no particle).
+  const std::vector<Vec3> after = with.p.to_host().x;
+  size_t next = 0;
+  for (int64_t k = 0; k < kept; ++k) {
+    while (next < at_start.size() && !(at_start[next].x == after[size_t(k)].x && at_start[next].z == after[size_t(k)].z))
+      ++next;
+    ASSERT_LT(next, at_start.size()) << "survivor " << k << " out of order";
+    ++next;
+  }
   // The same step from no particles, with room for all, then at limits that cut the candidates
   // and the emission.
   BooksScene free(device_, books_window(), 2000000, false);
