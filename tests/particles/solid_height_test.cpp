@@ -23,32 +23,34 @@ TEST_F(SolidHeightTest, DriedPaintRaisesTheFloorWetPaintDoesNot) {
     f[0][at(4, j, 4)] = 1.f, f[5][at(4, j, 4)] = 1.f;
   }
   w.from_host(f);
-  DeviceBuffer<float> h(device_, size_t(n.x) * n.y), wet(device_, size_t(n.x) * n.y);
-  particles_solid_height(device_, w.view(), nullptr, 0.95f, 0.5f, 0.25f, false, h.data(), wet.data());
-  const std::vector<float> hh = h.to_host(), ww = wet.to_host();
+  // The dried paint's own top per column (column_solid_top: the ground under the brush).
+  PaintWindowView hv = w.view();
+  hv.density = f[0].data();
+  hv.dryness = f[5].data();
+  std::vector<float> hh(size_t(n.x) * n.y);
+  for (int64_t c = 0; c < int64_t(hh.size()); ++c) {
+    int above = 0;
+    hh[size_t(c)] = column_solid_top(hv, c, 0.95f, 0.25f, above);
+  }
   for (int j = 0; j < n.y; ++j) {
     EXPECT_FLOAT_EQ(hh[size_t(j) * n.x + 0], 0.25f) << "no paint: the canvas floor";
     EXPECT_FLOAT_EQ(hh[size_t(j) * n.x + 1], 2.5f) << "top of the dried layer, half-full top cell";
     EXPECT_FLOAT_EQ(hh[size_t(j) * n.x + 2], 2.f) << "wet paint on dried paint: the dried top";
     EXPECT_FLOAT_EQ(hh[size_t(j) * n.x + 3], 0.25f) << "wet paint is not solid";
     EXPECT_FLOAT_EQ(hh[size_t(j) * n.x + 4], 5.f) << "the highest dried cell counts";
-    // The wet paint's surface: the solid's where there is no wet paint on it.
-    EXPECT_FLOAT_EQ(ww[size_t(j) * n.x + 0], 0.25f);
-    EXPECT_FLOAT_EQ(ww[size_t(j) * n.x + 1], 2.5f);
-    EXPECT_FLOAT_EQ(ww[size_t(j) * n.x + 2], 4.f) << "two wet cells on the dried ones";
-    EXPECT_FLOAT_EQ(ww[size_t(j) * n.x + 3], 3.f) << "three wet cells on the canvas";
-    EXPECT_FLOAT_EQ(ww[size_t(j) * n.x + 4], 5.f);
   }
-  // What the particles rest on: the grid's cells, one state each, so wet paint over the half-full
-  // dried top cell starts at that cell's top.
+  // What the particles rest on: the grid's cells, one state each, so over the half-full dried
+  // top cell of column 1 the floor and the wet paint start at that cell's top; elsewhere the
+  // dried top. The wet paint's surface: the solid's where there is no wet paint on it.
   DeviceBuffer<float> hg(device_, size_t(n.x) * n.y), wg(device_, size_t(n.x) * n.y);
-  particles_solid_height(device_, w.view(), nullptr, 0.95f, 0.5f, 0.25f, true, hg.data(), wg.data());
+  particles_solid_height(device_, w.view(), nullptr, 0.95f, 0.5f, 0.25f, hg.data(), wg.data());
   const std::vector<float> hgh = hg.to_host(), wgh = wg.to_host();
+  const float wet[5] = {0.25f, 3.f, 4.f, 3.f, 5.f};  // two wet cells on the dried ones; three on the canvas
   for (int j = 0; j < n.y; ++j)
     for (int i = 0; i < n.x; ++i) {
       const size_t c = size_t(j) * n.x + i;
       EXPECT_FLOAT_EQ(hgh[c], i == 1 ? 3.f : hh[c]) << "column " << i;
-      EXPECT_FLOAT_EQ(wgh[c], i == 1 ? 3.f : ww[c]) << "column " << i;
+      EXPECT_FLOAT_EQ(wgh[c], i < 5 ? wet[i] : 0.25f) << "column " << i;
     }
   // A particle resting above column 1 is 0.5 cells from the solid; above column 3, 2.25.
   SolidView s;

@@ -77,13 +77,13 @@ void particles_compact_field(const Device& d, const uint32_t* src, uint32_t* dst
   WB_DISPATCH(d, particles_compact_field(src, dst, dead, pos, n));
 }
 void particles_solid_height(const Device& d, const PaintWindowView& pw, const float* particle_density,
-                            float dry_threshold, float liquid_threshold, float floor_z, bool grid_cells, float* height,
+                            float dry_threshold, float liquid_threshold, float floor_z, float* height,
                             float* wet_top) {
   WB_REQUIRE(pw.density && pw.dryness && height, "particles_solid_height: missing fields");
   WB_REQUIRE(std::isfinite(dry_threshold) && dry_threshold > 0.f && std::isfinite(liquid_threshold) &&
                  liquid_threshold > 0.f && std::isfinite(floor_z),
              "particles_solid_height: bad threshold or floor");
-  WB_DISPATCH(d, particles_solid_height(pw, particle_density, dry_threshold, liquid_threshold, floor_z, grid_cells, height, wet_top));
+  WB_DISPATCH(d, particles_solid_height(pw, particle_density, dry_threshold, liquid_threshold, floor_z, height, wet_top));
 }
 
 void particles_init_scratch(const Device& d, const ParticleView& p, int64_t first, int64_t n) {

@@ -45,12 +45,14 @@ void particles_compact_field(const Device& d, const uint32_t* src, uint32_t* dst
                              const uint32_t* pos, int64_t n);
 /// Height fields of what the particles rest on over the window's columns (SolidView), absolute
 /// canvas z, nx * ny floats each: `height`, the top of the highest dried cell (dryness at or above
-/// dry_threshold, the grid's solid test) or floor_z where none; `wet_top` (nullable), the top
+/// dry_threshold, the grid's solid test) as a whole cell (the grid holds one state a cell, so
+/// wet paint over a partly filled dried cell starts at its top; column_solid_top gives the paint's
+/// own top), or floor_z where none; `wet_top` (nullable), the top
 /// of the highest liquid cell above it, or `height` where none. Liquid is the grid's joint test:
 /// density plus `particle_density` (the particles' raster, nullable) at or above liquid_threshold;
 /// where the layer near the bristles is mostly particles (§5.2), its grid density alone is air.
 void particles_solid_height(const Device& d, const PaintWindowView& pw, const float* particle_density,
-                            float dry_threshold, float liquid_threshold, float floor_z, bool grid_cells, float* height,
+                            float dry_threshold, float liquid_threshold, float floor_z, float* height,
                             float* wet_top = nullptr);
 /// The ground a particle in flight lands on, per window column (absolute canvas z): the solid's
 /// top (as `height` above), raised through the liquid cells (joint test) stacked on it up to the
@@ -76,7 +78,7 @@ void particles_init_scratch(const Device& d, const ParticleView& p, int64_t firs
   void particles_ground_surface(PaintWindowView pw, const float* particle_density, float dry_threshold,          \
                                 float liquid_threshold, float floor_z, float* surface);                          \
   void particles_solid_height(PaintWindowView pw, const float* particle_density, float dry_threshold,            \
-                              float liquid_threshold, float floor_z, bool grid_cells, float* height, float* wet_top);
+                              float liquid_threshold, float floor_z, float* height, float* wet_top);
 
 namespace cpu {
 WB_PARTICLES_BACKEND_DECLS

@@ -77,14 +77,14 @@ void particles_init_scratch(ParticleView p, int64_t first, int64_t n) {
 }
 
 void particles_solid_height(PaintWindowView pw, const float* particle_density, float dry_threshold,
-                            float liquid_threshold, float floor_z, bool grid_cells, float* height, float* wet_top) {
+                            float liquid_threshold, float floor_z, float* height, float* wet_top) {
   parallel_for(int64_t(pw.nx) * pw.ny, [=] WB_HD(int64_t c) {
     const int64_t layer = int64_t(pw.nx) * pw.ny;
     int above = 0;
     const float surface = column_solid_top(pw, c, dry_threshold, floor_z, above);
     // The grid holds one state per cell: wet paint cannot share a cell with dried paint, so over
     // a partly filled dried top the particles' floor is that cell's top.
-    const float top = grid_cells && above > 0 ? maxf(floor_z, float(pw.oz + above)) : surface;
+    const float top = above > 0 ? maxf(floor_z, float(pw.oz + above)) : surface;
     height[c] = top;
     if (!wet_top) return;
     // The highest liquid cell over it (the grid's joint liquid test) is the wet paint's free surface.

@@ -576,7 +576,7 @@ void Simulator::particle_stage(float dt) {
   joint_scale(device(), raster_mass_.data(), raster_density_.data(), int64_t(raster_mass_.size()),
               1.f / transfer_->params().cell_mass());
   particles_solid_height(device(), win.paint().view(), raster_density_.data(), config_.params.grid.dry_threshold,
-                         config_.params.grid.liquid_threshold, prm.floor_z, true, solid_height_.data(), wet_top_.data());
+                         config_.params.grid.liquid_threshold, prm.floor_z, solid_height_.data(), wet_top_.data());
   SolidView solid;
   solid.floor_z = prm.floor_z;
   solid.height = solid_height_.data();
