@@ -422,8 +422,8 @@ void Transfer::make_particles(const SampleView* samples, BristleLoad* load, Part
     if (nk > 0) particles_keep_flags(device_, particles.dead.data(), count, nk);
     if (ns > 0) {
       ensure_samples(ns);
-      d_emit_count(device_, *samples, load->view(), params_, env.dt, count + nk, s_f32_[0].data(), s_f32_[2].data(),
-                   s_u32_[1].data());
+      const EmitScratch e = emit_scratch();
+      d_emit_count(device_, *samples, load->view(), params_, env.dt, count + nk, e.mass_each, e.swept_each, e.swept_n);
     }
     if (nc > 0) {
       ensure_cells(nc);
@@ -462,9 +462,10 @@ void Transfer::fill_emission(const SampleView& samples, BristleLoad& load, Parti
                              const TransferEnv& env, const NewBatch& batch) {
   const int64_t ns = samples.count();
   const ParticleView pv = particles.view();
-  float* emitted = s_f32_[1].data();
-  d_emit_fill(device_, samples, load.view(), pv, batch, s_f32_[0].data(), s_f32_[2].data(), s_u32_[1].data(),
-              step_index_, params_, env.floor_z, env.dt, env.paint, env.dry_threshold, emitted);
+  const EmitScratch e = emit_scratch();
+  float* emitted = e.emitted;
+  d_emit_fill(device_, samples, load.view(), pv, batch, e.mass_each, e.swept_each, e.swept_n, step_index_, params_,
+              env.floor_z, env.dt, env.paint, env.dry_threshold, emitted);
   reduce_sum_add_into(device_, emitted, ns, sum_field(&TransferSums::emitted_from_bristles), ws_);
   reduce_sum_add_into(device_, pv.m + batch.first, batch.n, sum_field(&TransferSums::emitted_into_particles), ws_);
 }

@@ -206,6 +206,16 @@ class Transfer {
                       bool compact, bool candidates, TransferRecord& rec);
   void fill_emission(const SampleView& samples, BristleLoad& load, ParticleStore& particles, const TransferEnv& env,
                      const NewBatch& batch);
+  /// The emission's per-sample scratch, written by its count and read by its fill.
+  struct EmitScratch {
+    float* mass_each;
+    float* emitted;
+    float* swept_each;
+    uint32_t* swept_n;
+  };
+  EmitScratch emit_scratch() {
+    return {s_f32_[0].data(), s_f32_[1].data(), s_f32_[2].data(), s_u32_[1].data()};
+  }
   void fill_candidates(ParticleStore& particles, const TransferEnv& env, const NewBatch& batch);
   void ensure_samples(int64_t n);
   void ensure_cells(int64_t n);
