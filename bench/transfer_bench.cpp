@@ -126,7 +126,7 @@ BENCHMARK(BM_TransferCapacity)->Unit(benchmark::kMicrosecond)->Iterations(20);
 void BM_TransferAbsorb(benchmark::State& state) {
   TransferScene& s = scene();
   s.transfer.update_capacity(s.ds.view(), s.load, s.env);
-  run_stage(state, [](TransferScene& sc) { sc.transfer.absorb(sc.ds.view(), sc.load, sc.store); });
+  run_stage(state, [](TransferScene& sc) { sc.transfer.absorb(sc.ds.view(), sc.load, sc.store, 1.f / 60.f); });
   state.SetItemsProcessed(state.iterations() * s.store.size());
 }
 BENCHMARK(BM_TransferAbsorb)->Unit(benchmark::kMillisecond)->Iterations(20);

@@ -375,6 +375,46 @@ TEST_F(StrokePropertiesTest, OneLoadRunsOutAlongALongStroke) {
   EXPECT_GT(last, 0.0) << "but still paints";
 }
 
+TEST_F(StrokePropertiesTest, APressedBrushRollingSlowlyKeepsTheFilmInWholeParticles) {
+  // The default flat, full, pressed (0.8) into the canvas and held for 20 steps, then rolled and
+  // dragged slowly (30 mm/s) for 40: its bristles rest on and slide over the film they laid. The
+  // particles stay about the size they were made (emitted: emit_mass, an eighth of a cell;
+  // Eq. 15's candidates: a 1/27 share of a full cell): a touching sample takes a film particle
+  // whole or not at all, and a thin cell near the bristles becomes one candidate, not 27
+  // (docs/TRANSFER.md "Swept contact", "Candidates"). Measured at the most particles: 432 000, 38 %
+  // of them lighter than 1/64 of a cell, when a touching sample took half of every particle it
+  // rested on each step and every cell became 27; 206 000 and 4.9 % now.
+  SimConfig c = small_config(CanvasDims{kW, 160, 32});
+  c.brush = default_brush(BrushShape::Flat);
+  c.window = Int3{128, 128, 32};
+  c.params.particles = ParticleParams{};  // the scene's small-brush D0 and D1 are not this brush's
+  auto pose = [&](float x, float p, float twist, bool down = true) {
+    PenSample s;
+    s.x = x, s.y = 80.f, s.pressure = p, s.twist = twist, s.down = down;
+    return pose_from_pen(s, c.brush);
+  };
+  Simulator sim(c, pose(kX0, 0.f, 0.f, false));
+  sim.load_paint(red());
+  const float speck = c.params.transfer.cell_mass() / 64.f;
+  int64_t most = 0, specks_then = 0;
+  const auto count = [&] {
+    const std::vector<float> m = sim.particles().m.to_host();
+    const int64_t n = sim.particle_count();  // the live ones lead the store: compacted each step
+    int64_t light = 0;
+    for (int64_t k = 0; k < n; ++k) light += m[size_t(k)] < speck;
+    if (n > most) most = n, specks_then = light;
+  };
+  for (int i = 1; i <= 4; ++i) sim.step(pose(kX0, 0.2f * float(i), 0.f), kDt);
+  for (int i = 0; i < 20; ++i) sim.step(pose(kX0, 0.8f, 0.f), kDt), count();
+  for (int i = 1; i <= 40; ++i) sim.step(pose(kX0 + 2.5f * float(i), 0.8f, 3.f * float(i)), kDt), count();
+  std::printf("at the most %lld particles, %lld (%.1f %%) lighter than 1/64 of a cell\n", (long long)most,
+              (long long)specks_then, 100.0 * double(specks_then) / double(std::max<int64_t>(most, 1)));
+  ASSERT_GT(most, 1000) << "the brush lays its film as particles";
+  EXPECT_LT(double(specks_then), 0.1 * double(most));
+  EXPECT_LT(std::abs(sim.books().max_drift()), 1e-4);
+  EXPECT_EQ(sim.counters().nonfinite_events, 0);
+}
+
 TEST_F(StrokePropertiesTest, FlatPulledBroadsideLeavesBristleStreaks) {
   // 100 mm (500 cells). In the stroke's body the paint's thickness varies across the stroke (the
   // bristles' tracks) far more than along it, in distinct ridges (docs/TRANSFER.md "Bristle

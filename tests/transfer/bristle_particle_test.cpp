@@ -97,7 +97,7 @@ TEST(TransferSweep, OneParticleAStepLandsAnywhereAlongItsPath) {
   for (int64_t j : {0, 7, 4093}) {
     int bins[10] = {};
     for (int64_t step = 0; step < 2000; ++step) {
-      const Vec3 q = swept_position(x, vt, dt, 0.f, 1.5f, 0, 1, sample_step_jitter(j, step), Vec3(), 0.f,
+      const Vec3 q = swept_position(x, vt, dt, 0.f, 1.5f, 0, 1, step_uniform(j, step), Vec3(), 0.f,
                                     Vec3(0, 0, 0), Vec3(256, 256, 0));
       const float u = (q.x - (x.x - vt.x * dt)) / (vt.x * dt);
       ASSERT_GE(u, 0.f);
@@ -307,7 +307,7 @@ TEST_F(BristleParticleTest, AbsorptionConservesMassAndTakesEachParticleOnce) {
   t.update_capacity(s.view(), load, env_for(w));
   const double particles_before = p.total_mass(ws_), load_before = load.total_mass(ws_);
   TransferRecord rec;
-  t.absorb(s.view(), load, p);
+  t.absorb(s.view(), load, p, 1.f / 60.f);
   t.collect(rec);
   EXPECT_GT(rec.absorbed_count, 0);
   // Each absorbed particle is flagged once and counted once; the sample side equals it.
@@ -366,7 +366,7 @@ TEST_F(BristleParticleTest, AbsorptionNeedsTheNearestSampleOnlyWithinTheLargestL
     const BristleLoadHost lh = load.to_host();
     for (float R : lh.radius) EXPECT_LE(R, prm.absorb_range() * (1.f + 1e-6f)) << "a load sphere beyond the range";
     TransferRecord rec;
-    t.absorb(s.view(), load, p);
+    t.absorb(s.view(), load, p, 1.f / 60.f);
     t.collect(rec);
     EXPECT_GT(rec.absorbed_count, 0);
     return Result{p.dead.to_host(), load.to_host()};
@@ -402,7 +402,7 @@ TEST_F(BristleParticleTest, AbsorptionStopsAtCapacityAndLimit) {
   Transfer t(device_, prm);
   t.update_capacity(s.view(), load, env_for(w));
   TransferRecord rec;
-  t.absorb(s.view(), load, p);
+  t.absorb(s.view(), load, p, 1.f / 60.f);
   t.collect(rec);
   // §5.1: the sample absorbs while m_j < M_j, so it ends within one particle above M_j.
   EXPECT_EQ(rec.absorbed_count, 10);
@@ -418,10 +418,80 @@ TEST_F(BristleParticleTest, AbsorptionStopsAtCapacityAndLimit) {
   query_nearest(s, p3, 5.f);
   t3.update_capacity(s.view(), load3, env_for(w));
   TransferRecord rec3;
-  t3.absorb(s.view(), load3, p3);
+  t3.absorb(s.view(), load3, p3, 1.f / 60.f);
   t3.collect(rec3);
   EXPECT_EQ(rec3.absorbed_count, 3);
   EXPECT_NEAR(load3.total_mass(ws_), 3.0 * mk, 1e-6 * mk);
+}
+
+TEST(TransferSweep, FilmPickupGrowsWithTheDistanceSlidUpToOnePass) {
+  const float split = 0.5f, R = 0.75f;
+  EXPECT_EQ(film_pickup(split, R, 0.f), 0.f) << "a sample resting on the film sweeps none of it";
+  EXPECT_NEAR(film_pickup(split, R, 0.1f), 2.f * film_pickup(split, R, 0.05f), 1e-7f) << "linear in the slide";
+  EXPECT_FLOAT_EQ(film_pickup(split, R, 10.f), 1.f - split) << "a whole pass in one step";
+  EXPECT_EQ(film_pickup(1.f, R, 10.f), 0.f) << "split 1: the film stays on the surface";
+  // A particle in the sample's reach lies under its path for a mean chord of pi R / 2: the steps
+  // of one pass take (1 - split) of it in all, in few steps or many.
+  for (int steps : {2, 8, 64}) {
+    const float travel = 3.14159265f * R / 2.f / float(steps);
+    EXPECT_NEAR(float(steps) * film_pickup(split, R, travel), 1.f - split, 1e-5f) << steps << " steps";
+  }
+}
+
+TEST_F(BristleParticleTest, TouchingSampleTakesTheFilmItSweepsWholeParticlesOnly) {
+  // One empty sample 0.4 cells over the canvas (its reach R = 0.75: it touches) above a film of
+  // 600 light particles within its reach. Resting, or sliding with the film, it takes none;
+  // sliding over it, a share film_pickup of them, each whole: no particle is split.
+  TransferParams prm;
+  prm.absorb_limit = 1024;  // the per-step limit is not what is measured here
+  const float dt = 1.f / 60.f, mk = 1e-14f;
+  std::vector<Vec3> xs;
+  for (int i = 0; i < 600; ++i) {
+    const float a = 2.39996323f * float(i), r = 0.6f * std::sqrt((float(i) + 0.5f) / 600.f);
+    xs.push_back(Vec3(8.f + r * std::cos(a), 8.f + r * std::sin(a), 0.1f + 0.2f * float(i % 3) / 2.f));
+  }
+  PaintWindow w = make_window({16, 16, 8}, {0, 0, 0}, [](int, int, int) { return 0.f; }, Vec3());
+  const auto taken = [&](Vec3 v_sample, Vec3 v_film) {
+    HostSamples h;
+    h.resize(1, 1);
+    h.x[0] = Vec3(8.f, 8.f, 0.4f);
+    h.v[0] = v_sample;
+    DeviceSamples s(device_);
+    s.upload(h);
+    BristleLoad load(device_, 1, prm);
+    ParticleStore p(device_);
+    p.append(particles_at(xs, mk, Vec3(0.f, 1.f, 0.f), 0.3f, v_film));
+    query_nearest(s, p, 5.f);
+    Transfer t(device_, prm);
+    TransferEnv env = env_for(w);
+    env.dt = dt;
+    t.update_capacity(s.view(), load, env);
+    const BristleLoadHost lh = load.to_host();
+    EXPECT_LT(lh.gap[0], lh.radius[0]) << "the sample touches the canvas";
+    EXPECT_GT(lh.capacity[0], 2.f * float(xs.size()) * mk) << "room for all of them";
+    TransferRecord rec;
+    t.absorb(s.view(), load, p, dt);
+    t.collect(rec);
+    const ParticleHost ph = p.to_host();
+    const std::vector<uint32_t> flags = p.dead.to_host();
+    int dead = 0;
+    for (size_t k = 0; k < xs.size(); ++k) {
+      if (flags[k]) ++dead;
+      else EXPECT_EQ(ph.m[k], mk) << "particle " << k << " was split";
+    }
+    EXPECT_EQ(rec.absorbed_count, dead);
+    EXPECT_NEAR(rec.absorbed_into_bristles, double(dead) * mk, 1e-5 * double(dead) * mk);  // float sums
+    return double(dead) / double(xs.size());
+  };
+  const float R = load_radius(prm.M_max, prm.cell_mass());
+  EXPECT_EQ(taken(Vec3(), Vec3()), 0.0) << "resting on the film";
+  EXPECT_EQ(taken(Vec3(30.f, 0.f, 0.f), Vec3(30.f, 0.f, 0.f)), 0.0) << "carrying the film along";
+  for (float travel : {0.25f * R, 0.5f * R, 4.f * R}) {
+    const double expect = film_pickup(prm.split, R, travel), got = taken(Vec3(travel / dt, 0.f, 0.f), Vec3());
+    // Binomial spread of 600 draws: sqrt(p (1 - p) / 600) <= 0.021; 4 of it.
+    EXPECT_NEAR(got, expect, 0.085) << "slid " << travel << " cells";
+    EXPECT_GT(got, 0.0);
+  }
 }
 
 TEST_F(BristleParticleTest, SaturatedSampleAbsorbsNoMassButBleedsColour) {
@@ -447,7 +517,7 @@ TEST_F(BristleParticleTest, SaturatedSampleAbsorbsNoMassButBleedsColour) {
   t.update_capacity(s.view(), load, env_for(w));
   const double load_before = load.total_mass(ws_), part_before = p.total_mass(ws_);
   TransferRecord rec;
-  t.absorb(s.view(), load, p);
+  t.absorb(s.view(), load, p, 1.f / 60.f);
   t.collect(rec);
   EXPECT_EQ(rec.absorbed_count, 0);
   EXPECT_EQ(rec.bleeding_count, 4);

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 #include <cmath>
 #include <limits>
 
@@ -135,7 +136,10 @@ TEST_F(GridParticleTest, LayerNearTheBristlesBecomesParticlesWithExactMass) {
   EXPECT_NEAR(particle_mass, removed * cm, 1e-6 * particle_mass);
   EXPECT_NEAR(rec.to_particles_from_grid, removed * cm, 1e-6 * particle_mass);
   // Each particle: in a cell that was within D0 (up to the block slack), the cell's colour and
-  // oil, and at most its nominal mass rho(p) cell_mass / 27; the clamp bites at the layer's top.
+  // oil, and at most its nominal mass rho(p) cell_mass / n^3; the clamp bites at the layer's top.
+  // The cells are 0.8 full: 8 candidates of at least 1/27 of a full cell each, not 27.
+  const int n = cell_candidate_split(0.8f, prm.candidate_split);
+  ASSERT_EQ(n, 2);
   PaintWindowView hv = host_view(before, w);
   int clamped = 0;
   for (size_t k = 0; k < ph.size(); ++k) {
@@ -143,7 +147,7 @@ TEST_F(GridParticleTest, LayerNearTheBristlesBecomesParticlesWithExactMass) {
     EXPECT_FLOAT_EQ(ph.pigment_y[k], 1.f);
     EXPECT_FLOAT_EQ(ph.oil[k], 0.2f);
     const Vec3 q(ph.x[k].x - float(origin.x), ph.x[k].y - float(origin.y), ph.x[k].z);
-    const float nominal = liquid_density_at(hv, q, 0.95f) * float(cm) / 27.f;
+    const float nominal = liquid_density_at(hv, q, 0.95f) * float(cm) / float(n * n * n);
     EXPECT_LE(ph.m[k], nominal * (1.f + 1e-5f));
     if (ph.m[k] < nominal * (1.f - 1e-3f)) ++clamped;
   }
@@ -165,7 +169,7 @@ TEST_F(GridParticleTest, ClampOnAnIsolatedCellCreatesNoPaint) {
   TransferRecord rec;
   t.grid_to_particles(p, env, rec);
   t.collect(rec);
-  EXPECT_EQ(rec.to_particles_count, 27);
+  EXPECT_EQ(rec.to_particles_count, 8) << "a cell 0.3 full: 8 candidates of at least 1/27 of a cell";
   const WindowFields after = w.to_host();
   const size_t c = (size_t(2) * 16 + 8) * 16 + 8;
   const double removed = (0.3 - double(after[0][c])) * prm.cell_mass();
@@ -214,6 +218,57 @@ TEST_F(GridParticleTest, CandidateSplitSetsTheParticlesACellGives) {
     EXPECT_NEAR(p.total_mass(ws_), before - after, 1e-5 * before) << split;
     EXPECT_LT(rec.max_closure_error(), 1e-6) << split;
   }
+}
+
+TEST(GridParticleCandidates, AThinCellGivesFewerCandidatesEachAtLeastAFullCellsShare) {
+  for (int n = 1; n <= 3; ++n) {
+    EXPECT_EQ(cell_candidate_split(1.f, n), n) << "a full cell: the n^3 of Eq. 15";
+    EXPECT_EQ(cell_candidate_split(1e-3f, n), 1) << "a trace: one candidate";
+    for (float rho = 0.01f; rho <= 1.f; rho += 0.01f) {
+      const int s = cell_candidate_split(rho, n);
+      ASSERT_GE(s, 1);
+      ASSERT_LE(s, n);
+      if (s > 1) EXPECT_GE(rho / float(s * s * s), 1.f / float(n * n * n) * (1.f - 1e-6f)) << rho;
+      if (s < n) EXPECT_LT(rho / float((s + 1) * (s + 1) * (s + 1)), 1.f / float(n * n * n)) << rho << ": could split finer";
+    }
+  }
+}
+
+TEST_F(GridParticleTest, ThinPaintNearTheBristlesGivesOneCandidateACell) {
+  // A trace (2 % of a cell) and a half-full layer near a bristle: a cell of the trace gives one
+  // particle holding its paint, one of the layer 8 (rho 27 >= 8); the books close.
+  PaintWindow w = make_window({16, 16, 8}, {0, 0, 0},
+                              [](int i, int, int k) { return k > 1 ? 0.f : (i < 8 ? 0.02f : 0.5f); },
+                              Vec3(1.f, 0.f, 0.f));
+  HostSamples h = vertical_brush(1, 4, 0.8f, 8.f, 8.5f, 3.f, 1.f);
+  DeviceSamples s(device_);
+  s.upload(h);
+  TransferParams prm;
+  Transfer t(device_, prm);
+  ParticleStore p(device_);
+  TransferEnv env = env_for(w, 10.f);
+  const double before = w.total_density(ws_) * prm.cell_mass();
+  t.update_distance(s.view(), env);
+  TransferRecord rec;
+  t.grid_to_particles(p, env, rec);
+  t.collect(rec);
+  const ParticleHost ph = p.to_host();
+  std::map<int, int> per_cell;
+  for (const Vec3& x : ph.x) ++per_cell[(int(std::floor(x.z)) * 16 + int(std::floor(x.y))) * 16 + int(std::floor(x.x))];
+  int thin = 0, half = 0;
+  for (const auto& [c, count] : per_cell) {
+    if (c % 16 < 8) {
+      EXPECT_EQ(count, 1) << "trace cell " << c;
+      ++thin;
+    } else {
+      EXPECT_EQ(count, 8) << "half-full cell " << c;
+      ++half;
+    }
+  }
+  EXPECT_GT(thin, 4);
+  EXPECT_GT(half, 4);
+  EXPECT_NEAR(p.total_mass(ws_), before - w.total_density(ws_) * prm.cell_mass(), 1e-5 * before);
+  EXPECT_LT(rec.max_closure_error(), 1e-6);
 }
 
 TEST_F(GridParticleTest, SlowFarParticlesReturnAndMixColour) {

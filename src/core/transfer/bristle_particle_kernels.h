@@ -149,6 +149,18 @@ WB_HD WB_INLINE float swept_deposit(float m, float r, float film, float travel, 
   return maxf(net, 0.f) * cell_mass * travel;
 }
 
+/// Share of a particle of the surface's film that a touching sample takes in a step (the pick-up
+/// side of swept_deposit; docs/TRANSFER.md "Swept contact"). Sliding `travel` cells relative to
+/// the particle, the sample's reach, a disc of radius R on the surface, sweeps a band of 2R travel:
+/// 2 travel / (pi R) of the film in the disc, and (1 - split) of what it sweeps goes with the
+/// bristle. A particle stays in the disc over a mean chord of pi R / 2, so one pass of the sample
+/// takes (1 - split) of it in all, however many steps the pass lasts; a sample resting on the
+/// film takes nothing more.
+WB_HD WB_INLINE float film_pickup(float split, float R, float travel) {
+  if (!(R > 0.f)) return 0.f;
+  return (1.f - split) * minf(2.f * maxf(travel, 0.f) / (3.14159265f * R), 1.f);
+}
+
 /// Share of its single-pass deposit a sample leaves when k samples sweep the same canvas column
 /// in one step (docs/TRANSFER.md "Swept contact"). Each pass moves the film f towards the
 /// balance thickness f* by split of the difference (swept_deposit per unit track area:
@@ -229,8 +241,9 @@ WB_HD WB_INLINE Vec3 swept_position(Vec3 x_j, Vec3 v_t, float dt, float a, float
   return p;
 }
 
-/// Deterministic value in [0, 1) for sample j at step `step` (stratification jitter).
-WB_HD WB_INLINE float sample_step_jitter(int64_t j, int64_t step) {
+/// Deterministic value in [0, 1) for item j (a sample, a particle) at step `step`: a stratification
+/// jitter, a draw.
+WB_HD WB_INLINE float step_uniform(int64_t j, int64_t step) {
   const uint32_t h = transfer_hash(uint32_t(j) * 2654435761u ^ uint32_t(step) * 40503u ^ 0x9e3779b9u);
   return float(h >> 8) * (1.f / 16777216.f);
 }

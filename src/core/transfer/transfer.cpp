@@ -30,8 +30,9 @@ float TransferParams::absorb_range() const {
 namespace {
 
 // One dispatcher per backend pass (WB_DISPATCH returns from the function it is in).
-void d_absorb(const Device& d, ParticleView p, SampleView s, BristleLoadView l, AbsorbScratch a, TransferParams prm) {
-  WB_DISPATCH(d, transfer_absorb(p, s, l, a, prm));
+void d_absorb(const Device& d, ParticleView p, SampleView s, BristleLoadView l, AbsorbScratch a, TransferParams prm,
+              float dt, int64_t step_index) {
+  WB_DISPATCH(d, transfer_absorb(p, s, l, a, prm, dt, step_index));
 }
 void d_wick(const Device& d, SampleView s, BristleLoadView l, int bristles, int per, float k_dt, float k_slide,
             float dt, float* a, float* b) {
@@ -210,7 +211,7 @@ TransferRecord Transfer::step(const SampleView& samples, BristleLoad& load, Part
   }
   {
     WB_PROFILE_SCOPE("transfer.absorb");
-    absorb(samples, load, particles);
+    absorb(samples, load, particles, env.dt);
   }
   {
     WB_PROFILE_SCOPE("transfer.distance");
@@ -280,7 +281,7 @@ void Transfer::wick(const SampleView& samples, BristleLoad& load, float dt) {
          params_.wick_slide, dt, s_f32_[0].data(), s_f32_[1].data());
 }
 
-void Transfer::absorb(const SampleView& samples, BristleLoad& load, ParticleStore& particles) {
+void Transfer::absorb(const SampleView& samples, BristleLoad& load, ParticleStore& particles, float dt) {
   const int64_t ns = samples.count(), np = particles.size();
   WB_REQUIRE(ns == load.size(), "Transfer::absorb: " + std::to_string(ns) + " samples but a load of " +
                                     std::to_string(load.size()));
@@ -304,7 +305,7 @@ void Transfer::absorb(const SampleView& samples, BristleLoad& load, ParticleStor
   a.counters = sums_ptr_->absorb_counts;  // address only: the counts accumulate in the record
   const BristleLoadView lv = load.view();
   if (np > 0 && ns > 0) {
-    d_absorb(device_, particles.view(), samples, lv, a, params_);
+    d_absorb(device_, particles.view(), samples, lv, a, params_, dt, step_index_);
     d_absorb_apply(device_, lv, a);
   }
   reduce_sum_add_into(device_, p_moved_.data(), np, sum_field(&TransferSums::absorbed_from_particles), ws_);

@@ -152,7 +152,8 @@ void transfer_wick(SampleView s, BristleLoadView load, int bristles, int per, fl
 
 // --- Eq. 14: absorption and colour bleeding ----------------------------------------------
 
-void transfer_absorb(ParticleView p, SampleView s, BristleLoadView load, AbsorbScratch a, TransferParams prm) {
+void transfer_absorb(ParticleView p, SampleView s, BristleLoadView load, AbsorbScratch a, TransferParams prm,
+                     float dt, int64_t step_index) {
   const int64_t ns = load.count;
   const float bleed = prm.bleed;
   const uint32_t limit = uint32_t(prm.absorb_limit > 0 ? prm.absorb_limit : 0);
@@ -167,30 +168,28 @@ void transfer_absorb(ParticleView p, SampleView s, BristleLoadView load, AbsorbS
     const float mj = load.m[j], Mj = load.capacity[j];
     const Vec3 ck(p.pigment_r[k], p.pigment_y[k], p.pigment_b[k]);
     if (mj < Mj && limit > 0) {
-      // A sample touching a surface shares the paint lying there (film splitting, as when it
-      // deposits: swept_deposit); away from surfaces it takes the whole particle (Eq. 14).
-      // A remainder below a thousandth of an emitted particle (1e-12 kg, 1e-4 of a cell) is
-      // taken too: splitting it again and again would only breed ever lighter particles.
-      float take = load.gap[j] < R ? (1.f - prm.split) * mk : mk;
-      if (mk - take < 1e-3f * prm.emit_mass) take = mk;
-      // Tickets enforce the per-step limit; the claimed mass reproduces the sequential test
-      // "m_j < M_j before this particle" of §5.1 (a rejected claim only makes later ones stricter).
+      // Tickets enforce the per-step limit on the particles a sample meets (§5.1); the claimed
+      // mass reproduces the sequential test "m_j < M_j before this particle" (a rejected claim
+      // only makes later ones stricter).
       const uint32_t t = atomic_add(&a.ticket[j], 1u);
-      if (t < limit && take > 0.f) {
-        const float before = atomic_add(&a.claimed[j], take);
+      if (t < limit) {
+        // A sample touching a surface takes the share of the film there that its footprint swept
+        // past this step (film_pickup: film splitting, as when it deposits), a particle whole
+        // with that chance, so the film is not split into ever lighter particles; a sample
+        // resting on the film sweeps none of it. Away from surfaces it takes the particle (Eq. 14).
+        if (load.gap[j] < R &&
+            !(step_uniform(k, step_index) < film_pickup(prm.split, R, slid_distance(s.v[j] - p.v[k], dt))))
+          return;
+        const float before = atomic_add(&a.claimed[j], mk);
         if (mj + before < Mj) {
-          if (take < mk) {
-            p.m[k] = mk - take;
-          } else {
-            p.dead[k] = 1u;
-          }
-          a.moved[k] = take;
-          atomic_add(&a.acc_m[j], take);
-          atomic_add(&a.acc_c[0][j], take * ck.x);
-          atomic_add(&a.acc_c[1][j], take * ck.y);
-          atomic_add(&a.acc_c[2][j], take * ck.z);
-          atomic_add(&a.acc_b[j], take * pigment_brightness(ck));
-          atomic_add(&a.acc_oil[j], take * p.oil[k]);
+          p.dead[k] = 1u;
+          a.moved[k] = mk;
+          atomic_add(&a.acc_m[j], mk);
+          atomic_add(&a.acc_c[0][j], mk * ck.x);
+          atomic_add(&a.acc_c[1][j], mk * ck.y);
+          atomic_add(&a.acc_c[2][j], mk * ck.z);
+          atomic_add(&a.acc_b[j], mk * pigment_brightness(ck));
+          atomic_add(&a.acc_oil[j], mk * p.oil[k]);
           atomic_add(&a.counters[0], int32_t(1));
           return;
         }
@@ -394,7 +393,7 @@ void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, NewB
         // Left on the surface along the path slid this step, at rest with it.
         const int q = i - n_static;
         const int64_t slot = (j + step_index * int64_t(n_swept) + int64_t(q)) % int64_t(P);
-        const float jitter = sample_step_jitter(j, step_index);
+        const float jitter = step_uniform(j, step_index);
         const Vec3 pattern = emission_pattern_point(int(slot), P);
         // Laid where the path touches the surface: a point over a hollow the bristle bridged
         // (its surface more than half a cell lower than at the contact) moves to the next point
@@ -432,7 +431,6 @@ void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, NewB
 void transfer_grid_count(PaintWindowView pw, DistanceBlocks db, KeepBox keep, TransferParams prm,
                          float dry_threshold, uint32_t* count) {
   const float min_rho = prm.min_cell_density;
-  const int split = prm.candidate_split, candidates = split * split * split;
   parallel_for(pw.size(), [=] WB_HD(int64_t c) {
     count[c] = 0u;
     const float rho = pw.density[c];
@@ -441,6 +439,7 @@ void transfer_grid_count(PaintWindowView pw, DistanceBlocks db, KeepBox keep, Tr
     const int i = int(c % pw.nx), j = int((c / pw.nx) % pw.ny), k = int(c / (int64_t(pw.nx) * pw.ny));
     // Paint outside the keep box stays grid paint: particles there would go straight back.
     if (!keep.contains(i, j, k) || !db.near(Vec3(float(i) + 0.5f, float(j) + 0.5f, float(k) + 0.5f))) return;
+    const int split = cell_candidate_split(rho, prm.candidate_split), candidates = split * split * split;
     uint32_t n = 0;
     for (int s = 0; s < candidates; ++s) {
       const Vec3 q = Vec3(float(i), float(j), float(k)) + candidate_offset(i + pw.ox, j + pw.oy, k + pw.oz, s, split);
@@ -453,10 +452,10 @@ void transfer_grid_count(PaintWindowView pw, DistanceBlocks db, KeepBox keep, Tr
 void transfer_grid_emit(PaintWindowView pw, MacView vel, ParticleView p, NewBatch batch, TransferParams prm,
                         float dry_threshold, float* demand) {
   const float h = prm.kernel_h, cm = prm.cell_mass();
-  const int split = prm.candidate_split, candidates = split * split * split;
-  const float share = 1.f / float(candidates);
   parallel_for(pw.size(), [=] WB_HD(int64_t c) {
     if (batch.count[c] == 0u) return;
+    const int split = cell_candidate_split(pw.density[c], prm.candidate_split), candidates = split * split * split;
+    const float share = 1.f / float(candidates);
     const int64_t off = batch.slot(c);
     if (off >= batch.n) return;
     const int i = int(c % pw.nx), j = int((c / pw.nx) % pw.ny), k = int(c / (int64_t(pw.nx) * pw.ny));
