@@ -5,7 +5,6 @@
 // break up, so a profiler set to `outermost` times only the outermost scope, as NAME:whole.
 #pragma once
 #include <chrono>
-#include <map>
 #include <string>
 #include <vector>
 
@@ -17,15 +16,15 @@ namespace wb {
 class Profiler {
  public:
   explicit Profiler(Device device = {}) : device_(device) {}
-  void add(const std::string& name, double ms, int64_t host_reads = 0, int64_t launches = 0) {
-    samples_[name].push_back(ms);
-    reads_[name].push_back(host_reads);
-    launches_[name].push_back(launches);
-  }
+  /// Records one call of the scope `name` (NAME:whole when `whole`). A scope's series is found
+  /// by the address of its name (the literal of WB_PROFILE_SCOPE) before its text, so a step
+  /// allocates nothing once each of its scopes has been seen, and clear() keeps the series.
+  void add(const char* name, bool whole, double ms, int64_t host_reads = 0, int64_t launches = 0);
   /// Median of the recorded samples of `name` in ms (0 when none).
   double median_ms(const std::string& name) const;
   double total_ms(const std::string& name) const;
   size_t count(const std::string& name) const;
+  /// The scopes with samples, in the order of their names.
   std::vector<std::string> names() const;
   /// Every recorded duration of `name`, in ms, in order.
   const std::vector<double>& samples(const std::string& name) const;
@@ -33,11 +32,8 @@ class Profiler {
   const std::vector<int64_t>& host_reads(const std::string& name) const;
   /// Launches (mem::launches) made in each recorded call of `name`, in order.
   const std::vector<int64_t>& launches(const std::string& name) const;
-  void clear() {
-    samples_.clear();
-    reads_.clear();
-    launches_.clear();
-  }
+  /// Forgets the samples; the series keep their storage (a long session clears it often).
+  void clear();
   /// Time only the outermost scope (no synchronisation inside it), recorded as NAME:whole.
   void set_outermost(bool on) { outermost_ = on; }
   bool outermost() const { return outermost_; }
@@ -48,10 +44,21 @@ class Profiler {
   static void set_current(Profiler* p);
 
  private:
+  struct Series {
+    std::string name;  ///< the scope's name, with ":whole" for an outermost-only record
+    std::vector<double> ms;
+    std::vector<int64_t> reads, launches;
+  };
+  struct Key {
+    const char* literal;  ///< the address of a WB_PROFILE_SCOPE name
+    bool whole;
+    size_t series;
+  };
+  const Series* find(const std::string& name) const;
+
   Device device_;
-  std::map<std::string, std::vector<double>> samples_;
-  std::map<std::string, std::vector<int64_t>> reads_;
-  std::map<std::string, std::vector<int64_t>> launches_;
+  std::vector<Series> series_;
+  std::vector<Key> keys_;
   bool outermost_ = false;
 };
 
@@ -74,8 +81,7 @@ class ProfileScope {
     if (!prof_) return;
     prof_->device().synchronize();
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count();
-    prof_->add(open_ ? std::string(name_) + ":whole" : std::string(name_), ms,
-               mem::host_reads() - reads_, mem::launches() - launches_);
+    prof_->add(name_, open_ != nullptr, ms, mem::host_reads() - reads_, mem::launches() - launches_);
   }
   ProfileScope(const ProfileScope&) = delete;
   ProfileScope& operator=(const ProfileScope&) = delete;
