@@ -127,7 +127,7 @@ WB_HD WB_INLINE Vec3 candidate_offset(int cx, int cy, int cz, int s, int n) {
               (float(s / (n * n)) + 0.5f + jz * 0.666f) * part);
 }
 
-/// Candidates per axis for a cell of density rho (docs/TRANSFER.md "Candidates"): the n^3 of
+/// Candidates per axis for a cell of density rho (docs/TRANSFER.md "Grid → particles"): the n^3 of
 /// Eq. 15 (n = candidate_split) where the cell is full, fewer where it holds less, so that each
 /// candidate carries at least a 1/n^3 share of a full cell: n' = the largest in [1, n] with
 /// n'^3 <= rho n^3. A thin cell is one candidate, not n^3 specks.

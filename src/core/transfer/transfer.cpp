@@ -286,6 +286,7 @@ void Transfer::absorb(const SampleView& samples, BristleLoad& load, ParticleStor
   WB_REQUIRE(ns == load.size(), "Transfer::absorb: " + std::to_string(ns) + " samples but a load of " +
                                     std::to_string(load.size()));
   WB_REQUIRE(particles.device() == device_, "Transfer: the particles live on another device");
+  WB_REQUIRE(std::isfinite(dt) && dt >= 0.f, "Transfer::absorb: dt must be finite and >= 0");
   ensure_samples(ns);
   ensure_particles(np);
   for (auto& b : s_f32_) b.fill_zero();

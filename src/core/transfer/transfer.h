@@ -176,8 +176,10 @@ class Transfer {
   /// of bristles.
   void share_contact(const SampleView& samples, BristleLoad& load, const TransferEnv& env);
   /// Eq. 14: particles within R_j of their nearest sample j join it while m_j < M_j (at most
-  /// absorb_limit per sample), else bleed colour. Absorbed particles are flagged dead. The
-  /// stages that take a record fill its host-known fields; their sums wait for collect().
+  /// absorb_limit met per sample), else bleed colour; a sample touching a surface takes a particle
+  /// of its film with the chance its slide over dt sweeps it (film_pickup). Absorbed particles are
+  /// flagged dead. The stages that take a record fill its host-known fields; their sums wait for
+  /// collect().
   void absorb(const SampleView& samples, BristleLoad& load, ParticleStore& particles, float dt);
   /// The coarse distance from every window block to the bristles (decides "within D0").
   void update_distance(const SampleView& samples, const TransferEnv& env);
@@ -264,7 +266,7 @@ void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadVi
   void transfer_contact_share(SampleView s, BristleLoadView load, float dt, int ox, int oy, int nx, int ny,       \
                               const uint32_t* passes, float split);                                               \
   void transfer_absorb(ParticleView p, SampleView s, BristleLoadView load, AbsorbScratch a, TransferParams prm,  \
-                       float dt, int64_t step_index);    \
+                       float dt, int64_t step_index);                                                              \
   void transfer_absorb_apply(BristleLoadView load, AbsorbScratch a);                                               \
   void transfer_wick(SampleView s, BristleLoadView load, int bristles, int per, float k_dt, float k_slide, float dt, \
                      float* a, float* d);                 \
