@@ -38,6 +38,18 @@ class GridParticleTest : public TransferTest {
     return make_window({48, 48, 12}, {0, 0, 0}, [](int i, int, int k) { return k < 2 && i > 20 ? 0.9f : 0.f; },
                        Vec3(0.f, 1.f, 0.f), 0.3f);
   }
+  /// Eq. 15 over the window near one vertical bristle above (x, 8.5, 3), D0 10: the particles
+  /// made, into p; the step's sums into rec.
+  void grid_near_one_bristle(PaintWindow& w, float x, ParticleStore& p, TransferRecord& rec) {
+    HostSamples h = vertical_brush(1, 4, 0.8f, x, 8.5f, 3.f, 1.f);
+    DeviceSamples s(device_);
+    s.upload(h);
+    Transfer t(device_, TransferParams{});
+    TransferEnv env = env_for(w, 10.f);
+    t.update_distance(s.view(), env);
+    t.grid_to_particles(p, env, rec);
+    t.collect(rec);
+  }
   static float min_distance(const HostSamples& h, Vec3 p) {
     float d = std::numeric_limits<float>::max();
     for (const Vec3& x : h.x) d = std::min(d, length(x - p));
@@ -158,17 +170,10 @@ TEST_F(GridParticleTest, ClampOnAnIsolatedCellCreatesNoPaint) {
   PaintWindow w = make_window({16, 16, 8}, {0, 0, 0},
                               [](int i, int j, int k) { return i == 8 && j == 8 && k == 2 ? 0.3f : 0.f; },
                               Vec3(1.f, 0.f, 0.f));
-  HostSamples h = vertical_brush(1, 4, 0.8f, 8.5f, 8.5f, 3.f, 1.f);
-  DeviceSamples s(device_);
-  s.upload(h);
-  TransferParams prm;
-  Transfer t(device_, prm);
+  const TransferParams prm;
   ParticleStore p(device_);
-  TransferEnv env = env_for(w, 10.f);
-  t.update_distance(s.view(), env);
   TransferRecord rec;
-  t.grid_to_particles(p, env, rec);
-  t.collect(rec);
+  grid_near_one_bristle(w, 8.5f, p, rec);
   EXPECT_EQ(rec.to_particles_count, 8) << "a cell 0.3 full: 8 candidates of at least 1/27 of a cell";
   const WindowFields after = w.to_host();
   const size_t c = (size_t(2) * 16 + 8) * 16 + 8;
@@ -240,18 +245,11 @@ TEST_F(GridParticleTest, ThinPaintNearTheBristlesGivesOneCandidateACell) {
   PaintWindow w = make_window({16, 16, 8}, {0, 0, 0},
                               [](int i, int, int k) { return k > 1 ? 0.f : (i < 8 ? 0.02f : 0.5f); },
                               Vec3(1.f, 0.f, 0.f));
-  HostSamples h = vertical_brush(1, 4, 0.8f, 8.f, 8.5f, 3.f, 1.f);
-  DeviceSamples s(device_);
-  s.upload(h);
-  TransferParams prm;
-  Transfer t(device_, prm);
-  ParticleStore p(device_);
-  TransferEnv env = env_for(w, 10.f);
+  const TransferParams prm;
   const double before = w.total_density(ws_) * prm.cell_mass();
-  t.update_distance(s.view(), env);
+  ParticleStore p(device_);
   TransferRecord rec;
-  t.grid_to_particles(p, env, rec);
-  t.collect(rec);
+  grid_near_one_bristle(w, 8.f, p, rec);
   const ParticleHost ph = p.to_host();
   std::map<int, int> per_cell;
   for (const Vec3& x : ph.x) ++per_cell[(int(std::floor(x.z)) * 16 + int(std::floor(x.y))) * 16 + int(std::floor(x.x))];
