@@ -141,23 +141,23 @@ int StrokePlayer::substeps_for(double ta, double tb, float* max_move) const {
   const float limit = stroke_.max_move_per_substep;
   const int cap = stroke_.max_substeps;
   Vec3 a[kRefPoints], b[kRefPoints];
-  // First guess: the longest reference-point path through this step (keys bend it).
-  std::vector<double> breaks{ta};
-  for (auto [it, end] = keys_inside(ta, tb); it != end; ++it) breaks.push_back(it->t);
-  breaks.push_back(tb);
+  // First guess: the longest reference-point path through this step, segment by segment
+  // between the keys inside it (keys bend it).
   float path = 0.f;
   {
     constexpr int kChunks = 8;  // rotations make reference paths curved within a segment
     float per_point[kRefPoints] = {};
     reference_points(pose_at(ta), stroke_.brush, a);
-    for (size_t s = 0; s + 1 < breaks.size(); ++s) {
+    const auto segment = [&](double t0, double t1) {
       for (int c = 1; c <= kChunks; ++c) {
-        const double t = breaks[s] + (breaks[s + 1] - breaks[s]) * double(c) / kChunks;
-        reference_points(pose_at(t), stroke_.brush, b);
+        reference_points(pose_at(t0 + (t1 - t0) * double(c) / kChunks), stroke_.brush, b);
         for (int i = 0; i < kRefPoints; ++i) per_point[i] += length(b[i] - a[i]);
         std::copy(b, b + kRefPoints, a);
       }
-    }
+    };
+    double t0 = ta;
+    for (auto [it, end] = keys_inside(ta, tb); it != end; ++it) segment(t0, it->t), t0 = it->t;
+    segment(t0, tb);
     for (float v : per_point) path = std::max(path, v);
   }
   int n = std::clamp(int(std::ceil(path / limit)), 1, cap);
