@@ -10,18 +10,32 @@
 #include "core/exec/profile.h"
 
 namespace {
-// Counts this binary's operator new calls while `counting` is set (this thread's and others').
+// Counts this binary's allocations through operator new while `counting` is set. Every
+// replaceable form that a library pairs with another is replaced, all on malloc and free, so
+// that each allocation meets its own kind of release (the sanitizer build checks the pairs).
 std::atomic<bool> counting{false};
 std::atomic<long> allocations{0};
-}  // namespace
 
-void* operator new(std::size_t n) {
+void* counted(std::size_t n) noexcept {
   if (counting.load(std::memory_order_relaxed)) allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n ? n : 1)) return p;
+  return std::malloc(n ? n : 1);
+}
+void* counted_or_throw(std::size_t n) {
+  if (void* p = counted(n)) return p;
   throw std::bad_alloc();
 }
+}  // namespace
+
+void* operator new(std::size_t n) { return counted_or_throw(n); }
+void* operator new[](std::size_t n) { return counted_or_throw(n); }
+void* operator new(std::size_t n, const std::nothrow_t&) noexcept { return counted(n); }
+void* operator new[](std::size_t n, const std::nothrow_t&) noexcept { return counted(n); }
 void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
 
 namespace wb::test {
 namespace {
