@@ -48,24 +48,27 @@ TEST(TransferSweep, DepositScalesWithDistanceSlidNotSteps) {
   const TransferParams p;
   const float cm = p.cell_mass(), m = p.M_max, split = 0.5f;
   // Proportional to the distance slid: one step of 4 cells leaves what two of 2 cells leave.
-  const float one = swept_deposit(m, 0.f, 0.f, 4.f, split, cm);
-  const float half = swept_deposit(m, 0.f, 0.f, 2.f, split, cm);
+  const float one = swept_deposit(m, 0.f, 4.f, split, cm);
+  const float half = swept_deposit(m, 0.f, 2.f, split, cm);
   EXPECT_NEAR(one, 2.f * half, 1e-6f * one);
   EXPECT_NEAR(one, split * cm * segment_area(load_radius(m, cm), 0.f) * 4.f, 1e-6f * one);
   // Not sliding, or not reaching the surface (a light load's sphere above it), leaves nothing.
-  EXPECT_EQ(swept_deposit(m, 0.f, 0.f, 0.f, split, cm), 0.f);
-  EXPECT_EQ(swept_deposit(0.01f * m, 0.5f, 0.f, 4.f, split, cm), 0.f) << "dry brush: the paint does not reach";
-  EXPECT_GT(swept_deposit(m, 0.5f, 0.f, 4.f, split, cm), 0.f);
-  // Wet paint already under the sample splits back: the deposit falls as the film thickens and
-  // stops where the two balance, split A = (1 - split) 2a film.
-  const float Rm = load_radius(m, cm);
-  const float balance = split * segment_area(Rm, 0.f) / ((1.f - split) * 2.f * Rm);
+  EXPECT_EQ(swept_deposit(m, 0.f, 0.f, split, cm), 0.f);
+  EXPECT_EQ(swept_deposit(0.01f * m, 0.5f, 4.f, split, cm), 0.f) << "dry brush: the paint does not reach";
+  EXPECT_GT(swept_deposit(m, 0.5f, 4.f, split, cm), 0.f);
+  // The film under a full, pressed sample (R_m = R) balances where what it lays per cell slid
+  // equals what it takes back of a film f: film_pickup per cell slid of the film in its reach,
+  // pi R^2 f. split A(R, 0) = (1 - split) 2 R f at f = 0.59 cells.
+  const float R = load_radius(m, cm), travel = 0.25f;
+  const auto taken = [&](float f) { return film_pickup(split, R, travel) * 3.14159265f * R * R * f * cm; };
+  const float balance = split * segment_area(R, 0.f) / ((1.f - split) * 2.f * R);
   EXPECT_NEAR(balance, 0.59f, 0.01f) << "a full, pressed sample lays 0.59 cells";
-  EXPECT_LT(swept_deposit(m, 0.f, 0.5f * balance, 4.f, split, cm), one);
-  EXPECT_GT(swept_deposit(m, 0.f, 0.5f * balance, 4.f, split, cm), 0.f);
-  EXPECT_EQ(swept_deposit(m, 0.f, balance * 1.01f, 4.f, split, cm), 0.f);
+  const float laid = swept_deposit(m, 0.f, travel, split, cm);
+  EXPECT_NEAR(taken(balance), laid, 1e-5f * laid);
+  EXPECT_LT(taken(0.5f * balance), laid) << "a thinner film grows";
+  EXPECT_GT(taken(2.f * balance), laid) << "a thicker one thins";
   // split = 0 is the paper's model: nothing leaves by sliding.
-  EXPECT_EQ(swept_deposit(m, 0.f, 0.f, 4.f, 0.f, cm), 0.f);
+  EXPECT_EQ(swept_deposit(m, 0.f, 4.f, 0.f, cm), 0.f);
 }
 
 TEST(TransferSweep, ParticlesLayTheTrailAlongThePath) {
@@ -132,29 +135,6 @@ TEST(TransferSweep, SamplesSweepingOneColumnShareTheirPassesDeposit) {
   });
   EXPECT_GE(n, 5);
   EXPECT_LE(n, 6);
-}
-
-TEST(TransferSweep, FilmIsTheWetPaintOnTheSolidNotTheDriedPaint) {
-  // Columns of 8 cells: a dried layer 3 cells thick (z 0..3), then 1 cell of wet paint (z 3..4).
-  // A sample at z 4.5 with the solid 1.5 below meets a film of the wet cell only.
-  const int n = 4, nz = 8;
-  std::vector<float> rho(size_t(n) * n * nz, 0.f), dry(rho.size(), 0.f);
-  for (int k = 0; k < 4; ++k)
-    for (int c = 0; c < n * n; ++c) {
-      rho[size_t(k) * n * n + c] = 1.f;
-      dry[size_t(k) * n * n + c] = k < 3 ? 1.f : 0.f;
-    }
-  const CellField density{rho.data(), n, n, nz, 0, 0, 0}, dryness{dry.data(), n, n, nz, 0, 0, 0};
-  const CellField none{nullptr, n, n, nz, 0, 0, 0};
-  const Vec3 x(2.f, 2.f, 4.5f);
-  // Trilinear reads blur the wet cell's edges over half a cell each way: about 0.9 of it.
-  const float wet = film_below(x, 1.5f, density, dryness, 0.9f, none, 0.05f);
-  EXPECT_NEAR(wet, 0.875f, 0.05f);
-  // Over the bare dried layer (the wet cell taken away) there is no film at all.
-  for (int c = 0; c < n * n; ++c) rho[size_t(3) * n * n + c] = 0.f;
-  EXPECT_NEAR(film_below(Vec3(2.f, 2.f, 3.5f), 0.5f, density, dryness, 0.9f, none, 0.05f), 0.f, 1e-6f);
-  // Read without the dryness, the dried layer's top would count as film.
-  EXPECT_GT(film_below(Vec3(2.f, 2.f, 3.5f), 0.5f, density, none, 0.9f, none, 0.05f), 0.1f);
 }
 
 TEST(TransferCapacity, CapFormulaMatchesNumericIntegration) {

@@ -498,7 +498,6 @@ void Simulator::step(const BrushPose* pen_poses, int substeps, float dt) {
     }
     TransferEnv env = transfer_env();
     env.dt = dt;  // wicking along the bristles over this step
-    env.particle_density = grid_->particle_density();  // this step's raster, if any
     // The device's sums include the particles deposited before the window moved.
     rec = transfer_->step(brush_->samples(), *load_, particles_, env);
   }

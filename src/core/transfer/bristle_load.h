@@ -24,7 +24,6 @@
   X(capacity, "capacity M_j of Eq. 13, kg (last transfer step)")             \
   X(radius, "load radius R_j, cells (last transfer step)")                  \
   X(gap, "distance to the solid below (canvas, dried paint), cells, in [0, R_j] (last transfer step)") \
-  X(film, "wet paint on the solid under the sample, up to it: column volume per area, cells (last step)") \
   X(sweep, "swept contact: the capacity pass's rate sigma_j (per step), then the wick's deposit, kg")
 
 namespace wb {

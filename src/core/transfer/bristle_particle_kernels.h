@@ -130,23 +130,19 @@ WB_HD WB_INLINE float segment_area(float R, float r) {
 /// `split` of it stays on the surface. Proportional to the distance slid, not to the steps taken;
 /// a lightly loaded sample whose paint does not reach the surface leaves nothing (dry brush).
 ///
-/// Film splitting goes both ways: wet paint already on the surface (`film` cells thick under the
-/// sample) splits too, and (1 - split) of the film the footprint (width 2a, a = sqrt(R_m^2 - r^2))
-/// sweeps goes back to the bristle. The net deposit per cell slid is therefore
-/// split A(R_m, r) - (1 - split) 2a min(film, R_m): a loaded bristle lays a film up to the
-/// thickness where the two balance (0.59 cells under a full, pressed sample at split 0.5) and
-/// no thicker, however many bristles or samples pass. Only the deposit is made here; the
-/// pick-up is the absorption of Eq. 14 with the same split.
+/// Film splitting goes both ways: wet paint already on the surface splits too, and (1 - split) of
+/// what the sample sweeps of it goes with the bristle. That is the absorption's film_pickup, on
+/// the film's particles; here only the deposit. Per cell slid a full, pressed sample lays
+/// split A(R, 0) and takes back (1 - split) 2R f of a film f thick, so the film it leaves tends to
+/// the thickness where the two balance, split pi R / (4 (1 - split)) (0.59 cells at split 0.5),
+/// however many bristles or samples pass.
 /// This is what the sample's paint would leave if its load stayed m all along the path; the
 /// wick solve takes it from the bristle implicitly (sigma = deposit / m, a sink in
 /// transfer_wick), so a fast stroke draws paint down the bristle within the step instead of
 /// emptying the contact sample and waiting for the next one.
-WB_HD WB_INLINE float swept_deposit(float m, float r, float film, float travel, float split, float cell_mass) {
+WB_HD WB_INLINE float swept_deposit(float m, float r, float travel, float split, float cell_mass) {
   if (!(m > 0.f) || !(travel > 0.f)) return 0.f;
-  const float Rm = load_radius(m, cell_mass);
-  const float a = sqrtf(maxf(Rm * Rm - r * r, 0.f));
-  const float net = split * segment_area(Rm, r) - (1.f - split) * 2.f * a * clampf(film, 0.f, Rm);
-  return maxf(net, 0.f) * cell_mass * travel;
+  return split * segment_area(load_radius(m, cell_mass), r) * cell_mass * travel;
 }
 
 /// Share of a particle of the surface's film that a touching sample takes in a step (the pick-up
@@ -190,23 +186,6 @@ WB_HD WB_INLINE void for_path_columns(Vec3 x, Vec3 v, float dt, int ox, int oy, 
     px = ix, py = iy;
     if (ix >= 0 && iy >= 0 && ix < nx && iy < ny) f(ix, iy);
   }
-}
-
-/// Wet paint under a sample at x: the column integral of the wet density (grid plus particles,
-/// cell fractions; dried cells count as empty) from the solid `gap` cells below it up to it, in
-/// steps of `step` cells (midpoint rule): the film thickness the sample meets, thin films of
-/// any density included. Dried paint is the solid the film lies on, not film: counted as film,
-/// the top of a dried ridge read as a wet layer the bristle had already laid, and a brush
-/// skimming dried ridges left nothing on their tops.
-WB_HD WB_INLINE float film_below(Vec3 x, float gap, const CellField& density, const CellField& dryness,
-                                 float dry_threshold, const CellField& particles, float step) {
-  float film = 0.f;
-  for (float s = 0.f; s < gap; s += step) {
-    const float h = minf(step, gap - s);
-    const Vec3 p(x.x, x.y, x.z - s - 0.5f * h);
-    film += (wet_density_at(density, dryness, dry_threshold, p) + cell_field_at(particles, p)) * h;
-  }
-  return film;
 }
 
 /// Particles that carry a swept deposit: mass_each at most emit_mass, at most two per cell slid

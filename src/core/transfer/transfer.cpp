@@ -152,12 +152,12 @@ double TransferRecord::max_closure_error() const {
 }
 
 void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadView& load, const CellField& psi,
-                       const CellField& density, const CellField& dryness, const CellField& particles,
-                       const TransferParams& prm, float floor_z, float dry_threshold, float dt) {
+                       const CellField& density, const CellField& dryness, const TransferParams& prm,
+                       float floor_z, float dry_threshold, float dt) {
   WB_REQUIRE(s.count() == load.count, "transfer_capacity: " + std::to_string(s.count()) + " samples but a load of " +
                                           std::to_string(load.count));
   validate(prm);
-  WB_DISPATCH(d, transfer_capacity(s, load, psi, density, dryness, particles, prm, floor_z, dry_threshold, dt));
+  WB_DISPATCH(d, transfer_capacity(s, load, psi, density, dryness, prm, floor_z, dry_threshold, dt));
 }
 
 Transfer::Transfer(const Device& device, const TransferParams& params)
@@ -255,8 +255,7 @@ void Transfer::update_capacity(const SampleView& samples, BristleLoad& load, con
   const CellField psi{env.psi, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
   const CellField density{pw.density, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
   const CellField dryness{pw.dryness, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
-  const CellField particles{env.particle_density, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
-  transfer_capacity(device_, samples, load.view(), psi, density, dryness, particles, params_, env.floor_z,
+  transfer_capacity(device_, samples, load.view(), psi, density, dryness, params_, env.floor_z,
                     env.dry_threshold, env.dt);
 }
 

@@ -28,9 +28,6 @@ namespace wb {
 struct TransferEnv {
   PaintWindowView paint{};     ///< the active window's paint; §5.2 changes density, pigment, oil, dryness
   const float* psi = nullptr;  ///< bristle density psi on the same window (Brush::rasterize); null: psi = 0
-  /// Particle density on the same window this step (cell fractions; null: none), so that the
-  /// wet film under a sample counts the paint particles hold too (swept contact).
-  const float* particle_density = nullptr;
   MacView velocity{};          ///< window MAC velocity for new grid particles; u == nullptr: at rest
   float floor_z = 0.f;         ///< canvas surface height, cells (ParticleParams::floor_z)
   float dry_threshold = 0.95f; ///< dryness at which paint is solid (GridParams::dry_threshold)
@@ -255,12 +252,12 @@ class Transfer {
 
 /// Validates and runs Eq. 12-13 for every sample (the dispatcher behind Transfer::update_capacity).
 void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadView& load, const CellField& psi,
-                       const CellField& density, const CellField& dryness, const CellField& particles,
-                       const TransferParams& prm, float floor_z, float dry_threshold, float dt);
+                       const CellField& density, const CellField& dryness, const TransferParams& prm,
+                       float floor_z, float dry_threshold, float dt);
 
 #define WB_TRANSFER_BACKEND_DECLS                                                                                  \
   void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellField density, CellField dryness,  \
-                         CellField particles, TransferParams prm, float floor_z, float dry_threshold, float dt);   \
+                         TransferParams prm, float floor_z, float dry_threshold, float dt);                       \
   void transfer_contact_paths(SampleView s, BristleLoadView load, float dt, int ox, int oy, int nx, int ny,       \
                               uint32_t* passes);                                                                  \
   void transfer_contact_share(SampleView s, BristleLoadView load, float dt, int ox, int oy, int nx, int ny,       \

@@ -13,7 +13,7 @@ namespace wb::WB_BACKEND_NS {
 // --- Eq. 12-13: capacity ----------------------------------------------------------------
 
 void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellField density, CellField dryness,
-                       CellField particles, TransferParams prm, float floor_z, float dry_threshold, float dt) {
+                       TransferParams prm, float floor_z, float dry_threshold, float dt) {
   const float mu = prm.mu, M_max = prm.M_max, M_min = prm.M_min, cm = prm.cell_mass();
   const float thr = prm.surface_density, step = prm.march_step;
   parallel_for(s.count(), [=] WB_HD(int64_t j) {
@@ -29,14 +29,12 @@ void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellFi
     // thicker than the load sphere carries the sample above it (it ploughs, Eq. 13 emits).
     const float gap = surface_distance(x, R, floor_z, density, thr, step, dryness, dry_threshold);
     load.gap[j] = gap;
-    const float film = film_below(x, gap, density, dryness, dry_threshold, particles, step);
-    load.film[j] = film;
     // Swept contact: the share of its load the sample would leave sliding this step (sigma_j of
     // the wick's sink).
     const Vec3 v = s.v[j];
     const float m = load.m[j];
     const float travel = slid_distance(v, dt);
-    load.sweep[j] = m > 0.f ? swept_deposit(m, gap, film, travel, prm.split, cm) / m : 0.f;
+    load.sweep[j] = m > 0.f ? swept_deposit(m, gap, travel, prm.split, cm) / m : 0.f;
   });
 }
 
