@@ -329,12 +329,12 @@ TEST_F(LayerPropertiesTest, CleanBrushPloughsAWetLayer) {
               track, left, right, far, sim.census().bristles);
   // Tolerances: the track loses at least 15 % of the layer (measured 70 % here; 26 % at 120 mm/s,
   // where the grid sees the bristles 10 cells apart, docs/PARTICLES.md); each side rises by at
-  // least 2 % of it (0.08 cells, 20x the far field's deviation; measured 4.19-4.22 / 4.12-4.14,
-  // the clean bristles holding 1.7e-5 kg of the layer); the layer away from the brush is untouched.
+  // least 3 % of it (0.12 cells, 30x the far field's deviation; measured 4.22-4.24 / 4.18-4.20);
+  // the layer away from the brush is untouched.
   EXPECT_NEAR(far, kLayer, 0.01 * kLayer) << "the layer away from the brush";
   EXPECT_LT(track, 0.85 * kLayer) << "the brush lowers its track";
-  EXPECT_GT(left, 1.02 * kLayer) << "paint pushed up beside the track";
-  EXPECT_GT(right, 1.02 * kLayer) << "paint pushed up beside the track";
+  EXPECT_GT(left, 1.03 * kLayer) << "paint pushed up beside the track";
+  EXPECT_GT(right, 1.03 * kLayer) << "paint pushed up beside the track";
 }
 
 TEST_F(LayerPropertiesTest, LightBrushScumblesTheTopsOfADriedRidgedLayer) {
