@@ -383,7 +383,7 @@ TEST_F(StrokePropertiesTest, APressedBrushRollingSlowlyKeepsTheFilmInWholePartic
   // whole or not at all, and a thin cell near the bristles becomes one candidate, not 27
   // (docs/TRANSFER.md "Swept contact", "Candidates"). Measured at the most particles: 432 000, 38 %
   // of them lighter than 1/64 of a cell, when a touching sample took half of every particle it
-  // rested on each step and every cell became 27; 206 000 and 4.9 % now.
+  // rested on each step and every cell became 27; 209 000 and 5.1 % now.
   SimConfig c = small_config(CanvasDims{kW, 160, 32});
   c.brush = default_brush(BrushShape::Flat);
   c.window = Int3{128, 128, 32};
