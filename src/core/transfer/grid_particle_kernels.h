@@ -61,19 +61,10 @@ WB_HD WB_INLINE float cell_field_at(const CellField& g, Vec3 p) {
   return trilinear_cells(g, p, [&](int64_t id) { return g.f[id]; });
 }
 
-/// Trilinear value of the wet part of a cell-centred density field at canvas position p: cells
-/// that are solid (dried, `cell_is_solid`) count as empty; nodes outside the field read 0.
-WB_HD WB_INLINE float wet_density_at(const CellField& density, const CellField& dryness, float dry_threshold, Vec3 p) {
-  if (density.f == nullptr) return 0.f;
-  return trilinear_cells(density, p, [&](int64_t id) {
-    const float rho = density.f[id];
-    return dryness.f && cell_is_solid(rho, dryness.f[id], dry_threshold) ? 0.f : rho;
-  });
-}
-
-/// The same for the dried (solid) paint only: wet cells count as empty. The dryness of each cell
-/// decides, not an interpolated dryness (air cells have none, and interpolating it across a
-/// dried top put that top half a cell too low).
+/// Trilinear value of the dried (solid, `cell_is_solid`) part of a cell-centred density field at
+/// canvas position p: wet cells count as empty; nodes outside the field read 0. The dryness of
+/// each cell decides, not an interpolated dryness (air cells have none, and interpolating it
+/// across a dried top put that top half a cell too low).
 WB_HD WB_INLINE float dried_density_at(const CellField& density, const CellField& dryness, float dry_threshold, Vec3 p) {
   if (density.f == nullptr) return 0.f;
   return trilinear_cells(density, p, [&](int64_t id) {
