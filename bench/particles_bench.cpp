@@ -125,18 +125,15 @@ void BM_Rasterise(benchmark::State& state) {
   Scene& s = scene();
   // A 128 x 128 x 32 window around the brush.
   const int nx = 128, ny = 128, nz = 32;
-  DeviceBuffer<float> mass(s.d, size_t(nx) * ny * nz), mom[3], wt[3];
-  ParticleRasterView g{mass.data(), {}, {}, nx, ny, nz, 1936, 1936, 0};
+  DeviceBuffer<FloatPair> cell(s.d, size_t(nx) * ny * nz), face[3];
+  ParticleRasterView g{cell.data(), {}, nx, ny, nz, 1936, 1936, 0};
   for (int c = 0; c < 3; ++c) {
-    const size_t nf = size_t(nx + (c == 0)) * (ny + (c == 1)) * (nz + (c == 2));
-    mom[c] = DeviceBuffer<float>(s.d, nf);
-    wt[c] = DeviceBuffer<float>(s.d, nf);
-    g.mom[c] = mom[c].data();
-    g.weight[c] = wt[c].data();
+    face[c] = DeviceBuffer<FloatPair>(s.d, size_t(nx + (c == 0)) * (ny + (c == 1)) * (nz + (c == 2)));
+    g.face[c] = face[c].data();
   }
   for (auto _ : state) {
-    mass.fill_zero();
-    for (int c = 0; c < 3; ++c) mom[c].fill_zero(), wt[c].fill_zero();
+    cell.fill_zero();
+    for (int c = 0; c < 3; ++c) face[c].fill_zero();
     particles_rasterise(s.d, s.store.view(), g);
     s.d.synchronize();
   }

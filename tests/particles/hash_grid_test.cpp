@@ -37,6 +37,9 @@ TEST_F(HashGridTest, NearestSampleEqualsBruteForce) {
   }
   std::vector<Vec3> px(8000);
   for (auto& x : px) x = Vec3(960.f + 140.f * U(rng), 1960.f + 140.f * U(rng), -20.f + 140.f * U(rng));
+  // As many again within a cell or two of a sample, as most particles of a stroke lie.
+  for (int k = 0; k < 8000; ++k)
+    px.push_back(hs.x[size_t(k * 7) % hs.x.size()] + Vec3(U(rng) - 0.5f, U(rng) - 0.5f, U(rng) - 0.5f) * 3.f);
   DeviceSamples ds(device_);
   ds.upload(hs);
   ParticleStore store(device_);

@@ -87,6 +87,26 @@ WB_HD WB_INLINE float atomic_max(float* addr, float v) {
 #endif
 }
 
+/// Two floats added to together: the particles' raster adds a mass and what it carries (oil,
+/// momentum) to the same cell or face. The CPU adds both with one 8-byte compare-and-swap
+/// (each atomic is the cost there, so a pair halves it); CUDA adds each.
+struct alignas(8) FloatPair {
+  float first;
+  float second;
+};
+
+WB_HD WB_INLINE void atomic_add(FloatPair* addr, float a, float b) {
+#if defined(__CUDA_ARCH__)
+  atomicAdd(&addr->first, a);
+  atomicAdd(&addr->second, b);
+#else
+  std::atomic_ref<FloatPair> r(*addr);
+  FloatPair cur = r.load(std::memory_order_relaxed);
+  while (!r.compare_exchange_weak(cur, FloatPair{cur.first + a, cur.second + b}, std::memory_order_relaxed)) {
+  }
+#endif
+}
+
 /// A load that may race with the atomics above (relaxed: a flag read before setting it).
 WB_HD WB_INLINE int32_t atomic_load(const int32_t* addr) {
 #if defined(__CUDA_ARCH__)

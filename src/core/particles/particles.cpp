@@ -34,14 +34,15 @@ void particles_adhesion_step(const Device& d, const ParticleView& p, const Sampl
 
 void particles_rasterise(const Device& d, const ParticleView& p, const ParticleRasterView& g) {
   check_grid(g.nx, g.ny, g.nz, "rasterisation target");
-  const bool faces = g.mom[0] && g.mom[1] && g.mom[2] && g.weight[0] && g.weight[1] && g.weight[2];
-  const bool mass_only = !g.mom[0] && !g.mom[1] && !g.mom[2] && !g.weight[0] && !g.weight[1] && !g.weight[2];
-  WB_REQUIRE(g.mass && (faces || mass_only), "particles_rasterise: a target field is null");
+  const bool faces = g.face[0] && g.face[1] && g.face[2];
+  const bool cells_only = !g.face[0] && !g.face[1] && !g.face[2];
+  WB_REQUIRE(g.cell && (faces || cells_only), "particles_rasterise: a target field is null");
   WB_DISPATCH(d, particles_rasterise(p, g));
 }
 
 void particles_face_velocity(const Device& d, const ParticleRasterView& g, float* const vel[3], float empty) {
   check_grid(g.nx, g.ny, g.nz, "face velocity");
+  WB_REQUIRE(g.face[0] && g.face[1] && g.face[2], "particles_face_velocity: a rasterised face field is null");
   WB_REQUIRE(vel[0] && vel[1] && vel[2], "particles_face_velocity: an output field is null");
   WB_DISPATCH(d, particles_face_velocity(g, vel[0], vel[1], vel[2], empty));
 }

@@ -30,9 +30,9 @@ void particles_rasterise(ParticleView p, ParticleRasterView g) {
 void particles_face_velocity(ParticleRasterView g, float* u, float* v, float* w, float empty) {
   const int64_t nu = int64_t(g.nx + 1) * g.ny * g.nz, nv = int64_t(g.nx) * (g.ny + 1) * g.nz,
                 nw = int64_t(g.nx) * g.ny * (g.nz + 1);
-  parallel_for(nu, [=] WB_HD(int64_t f) { u[f] = face_velocity(g.mom[0][f], g.weight[0][f], empty); });
-  parallel_for(nv, [=] WB_HD(int64_t f) { v[f] = face_velocity(g.mom[1][f], g.weight[1][f], empty); });
-  parallel_for(nw, [=] WB_HD(int64_t f) { w[f] = face_velocity(g.mom[2][f], g.weight[2][f], empty); });
+  parallel_for(nu, [=] WB_HD(int64_t f) { u[f] = face_velocity(g.face[0][f], empty); });
+  parallel_for(nv, [=] WB_HD(int64_t f) { v[f] = face_velocity(g.face[1][f], empty); });
+  parallel_for(nw, [=] WB_HD(int64_t f) { w[f] = face_velocity(g.face[2][f], empty); });
 }
 
 void particles_flip_pic(ParticleView p, MacView before, MacView after, float gamma) {

@@ -7,10 +7,15 @@ namespace wb {
 void joint_scale(const Device& d, const float* in, float* out, int64_t n, float scale) {
   WB_DISPATCH(d, joint_scale(in, out, n, scale));
 }
+void joint_raster_density(const Device& d, const FloatPair* cell, float* density, float* oil, int64_t n, float scale) {
+  WB_REQUIRE(n == 0 || (cell && density), "joint_raster_density: a field is null");
+  WB_DISPATCH(d, joint_raster_density(cell, density, oil, n, scale));
+}
 void joint_blend_velocity(const Device& d, GridView g, PaintWindowView paint, ParticleRasterView raster,
                           float cell_mass) {
   WB_REQUIRE(raster.nx == g.d.nx && raster.ny == g.d.ny && raster.nz == g.d.nz,
              "joint_blend_velocity: particle raster and grid differ in size");
+  WB_REQUIRE(raster.face[0] && raster.face[1] && raster.face[2], "joint_blend_velocity: the raster has no faces");
   WB_DISPATCH(d, joint_blend_velocity(g, paint, raster, cell_mass));
 }
 void joint_cell_velocity(const Device& d, GridView g, float* vx, float* vy, float* vz) {

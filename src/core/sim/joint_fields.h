@@ -14,6 +14,9 @@ namespace wb {
 
 /// out[i] = in[i] * scale (kg to cell-volume fractions and back).
 void joint_scale(const Device& d, const float* in, float* out, int64_t n, float scale);
+/// The particles' raster as densities: density[i] = cell[i].first * scale and, where oil is
+/// not null, oil[i] = cell[i].second * scale (scale 1 / cell_mass: kg to cell-volume fractions).
+void joint_raster_density(const Device& d, const FloatPair* cell, float* density, float* oil, int64_t n, float scale);
 /// Blends the particles' face momentum into the grid's face velocity, per face:
 /// u = (w_g u + P) / (w_g + W), w_g = cell_mass * mean density of the two cells (Eq. 11's u).
 void joint_blend_velocity(const Device& d, GridView g, PaintWindowView paint, ParticleRasterView raster,
@@ -38,6 +41,7 @@ void joint_ground_under(const Device& d, PaintWindowView pw, float dry_threshold
 
 #define WB_JOINT_BACKEND_DECLS                                                                          \
   void joint_scale(const float* in, float* out, int64_t n, float scale);                               \
+  void joint_raster_density(const FloatPair* cell, float* density, float* oil, int64_t n, float scale);   \
   void joint_blend_velocity(GridView g, PaintWindowView paint, ParticleRasterView raster, float cell_mass); \
   void joint_cell_velocity(GridView g, float* vx, float* vy, float* vz);                                \
   void joint_zero_nonfinite(float* v, int64_t n);                                                       \

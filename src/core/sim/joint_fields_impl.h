@@ -9,6 +9,14 @@ void joint_scale(const float* in, float* out, int64_t n, float scale) {
   parallel_for(n, [=] WB_HD(int64_t i) { out[i] = in[i] * scale; });
 }
 
+void joint_raster_density(const FloatPair* cell, float* density, float* oil, int64_t n, float scale) {
+  parallel_for(n, [=] WB_HD(int64_t i) {
+    const FloatPair c = cell[i];
+    density[i] = c.first * scale;
+    if (oil) oil[i] = c.second * scale;
+  });
+}
+
 void joint_ground_under(PaintWindowView pw, float dry_threshold, float cx, float cy, float r, float floor_z,
                         float* out) {
   parallel_for(int64_t(pw.nx) * pw.ny, [=] WB_HD(int64_t c) {
@@ -37,13 +45,13 @@ void joint_blend_velocity(GridView g, PaintWindowView paint, ParticleRasterView 
   const GridDims d = g.d;
   for (int c = 0; c < 3; ++c) {
     float* u = g.vel[c];
-    const float* mom = raster.mom[c];
-    const float* wgt = raster.weight[c];
+    const FloatPair* face = raster.face[c];
     const float* rho = paint.density;
     const int ex = d.nx + (c == 0), ey = d.ny + (c == 1);
     const int64_t faces = int64_t(ex) * ey * (d.nz + (c == 2));
     parallel_for(faces, [=] WB_HD(int64_t f) {
-      const float wp = wgt[f];
+      const FloatPair pf = face[f];
+      const float wp = pf.first;
       if (!(wp > 0.f)) return;
       const int i = int(f % ex), j = int((f / ex) % ey), k = int(f / (int64_t(ex) * ey));
       // Grid paint on the two sides of the face, as mass.
@@ -53,7 +61,7 @@ void joint_blend_velocity(GridView g, PaintWindowView paint, ParticleRasterView 
       if (ia >= 0 && ja >= 0 && ka >= 0) rg += rho[(int64_t(ka) * d.ny + ja) * d.nx + ia], ++n;
       if (i < d.nx && j < d.ny && k < d.nz) rg += rho[(int64_t(k) * d.ny + j) * d.nx + i], ++n;
       const float wg = n ? cell_mass * rg / float(n) : 0.f;
-      u[f] = (wg * u[f] + mom[f]) / (wg + wp);
+      u[f] = (wg * u[f] + pf.second) / (wg + wp);
     });
   }
 }

@@ -55,7 +55,8 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
     b.fill_zero();
   };
   cells(psi_);
-  cells(raster_mass_);
+  raster_cell_.set_device(d);
+  raster_cell_.resize(size_t(g.cells()));
   cells(raster_oil_);
   cells(raster_density_);
   cells(overlay_mass_);
@@ -74,10 +75,8 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
   for (int c = 0; c < 3; ++c) {
     cells(bristle_v_[c]);
     cells(cell_v_[c]);
-    raster_mom_[c].set_device(d);
-    raster_mom_[c].resize(size_t(g.faces(c)));
-    raster_w_[c].set_device(d);
-    raster_w_[c].resize(size_t(g.faces(c)));
+    raster_face_[c].set_device(d);
+    raster_face_[c].resize(size_t(g.faces(c)));
   }
   books_.open(census());
 }
@@ -569,11 +568,11 @@ void Simulator::particle_stage(float dt) {
   // particles (§5.2), and its grid part alone would read as air that its particles fall through.
   ActiveWindow& win = grid_->window();
   const Int3 n = win.dims(), o = win.origin();
-  raster_mass_.fill_zero();
+  raster_cell_.fill_zero();
   particles_rasterise(device(), particles_.view(),
-                      ParticleRasterView{raster_mass_.data(), {}, {}, n.x, n.y, n.z, o.x, o.y, o.z});
-  joint_scale(device(), raster_mass_.data(), raster_density_.data(), int64_t(raster_mass_.size()),
-              1.f / transfer_->params().cell_mass());
+                      ParticleRasterView{raster_cell_.data(), {}, n.x, n.y, n.z, o.x, o.y, o.z});
+  joint_raster_density(device(), raster_cell_.data(), raster_density_.data(), nullptr, int64_t(raster_cell_.size()),
+                       1.f / transfer_->params().cell_mass());
   particles_solid_height(device(), win.paint().view(), raster_density_.data(), config_.params.grid.dry_threshold,
                          config_.params.grid.liquid_threshold, prm.floor_z, solid_height_.data(), wet_top_.data());
   SolidView solid;
@@ -600,22 +599,17 @@ void Simulator::joint_fields_stage() {
   WB_PROFILE_SCOPE("particles.rasterise");
   ActiveWindow& win = grid_->window();
   const Int3 n = win.dims(), o = win.origin();
-  raster_mass_.fill_zero();
-  raster_oil_.fill_zero();
-  for (int c = 0; c < 3; ++c) {
-    raster_mom_[c].fill_zero();
-    raster_w_[c].fill_zero();
-  }
-  ParticleRasterView rv{raster_mass_.data(),
-                        {raster_mom_[0].data(), raster_mom_[1].data(), raster_mom_[2].data()},
-                        {raster_w_[0].data(), raster_w_[1].data(), raster_w_[2].data()},
-                        n.x, n.y, n.z, o.x, o.y, o.z, raster_oil_.data()};
+  raster_cell_.fill_zero();
+  for (int c = 0; c < 3; ++c) raster_face_[c].fill_zero();
+  ParticleRasterView rv{raster_cell_.data(),
+                        {raster_face_[0].data(), raster_face_[1].data(), raster_face_[2].data()},
+                        n.x, n.y, n.z, o.x, o.y, o.z};
   particles_rasterise(device(), particles_.view(), rv);
   const float cell_mass = transfer_->params().cell_mass();
-  const int64_t cells = int64_t(raster_mass_.size());
-  joint_scale(device(), raster_mass_.data(), raster_density_.data(), cells, 1.f / cell_mass);
-  // The particles' oil in the density's units, for the joint paint's rheology (JointOil).
-  joint_scale(device(), raster_oil_.data(), raster_oil_.data(), cells, 1.f / cell_mass);
+  // The particles' mass and oil in the density's units (the oil for the joint paint's
+  // rheology, JointOil).
+  joint_raster_density(device(), raster_cell_.data(), raster_density_.data(), raster_oil_.data(),
+                       int64_t(raster_cell_.size()), 1.f / cell_mass);
   grid_->set_particle_density(raster_density_.data(), raster_oil_.data());
   raster_step_ = counters_.steps, raster_origin_ = o;
   joint_blend_velocity(device(), grid_->view(), win.paint().view(), rv, cell_mass);

@@ -11,6 +11,7 @@
 #include "core/brush/brush.h"
 #include "core/canvas/tile_store.h"
 #include "core/exec/device.h"
+#include "core/exec/atomics.h"
 #include "core/exec/profile.h"
 #include "core/exec/workspace.h"
 #include "core/grid/grid.h"
@@ -194,8 +195,8 @@ class Simulator {
   // Window-sized scratch, allocated once: bristle psi and velocity, the grid's cell velocity
   // for the drag, the particles' raster (mass, face momentum and weight) and their density.
   DeviceBuffer<float> psi_, bristle_v_[3], cell_v_[3];
-  DeviceBuffer<float> raster_mass_, raster_density_, raster_mom_[3], raster_w_[3];
-  DeviceBuffer<float> raster_oil_;  ///< the particles' mass times oil fraction, then per cell mass
+  DeviceBuffer<FloatPair> raster_cell_, raster_face_[3];  ///< the particles' raster (flip_kernels.h)
+  DeviceBuffer<float> raster_density_, raster_oil_;  ///< its mass and oil per cell mass
   DeviceBuffer<float> overlay_mass_;
   /// The step's record on the device: the transfer's sums, the census's, the non-finite
   /// counts of every checked array (at the end, then on entry), the brush's rolled-back
