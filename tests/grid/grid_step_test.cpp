@@ -328,7 +328,7 @@ TEST_F(GridStepTest, StagesVisitOnlyThePaintsLayersAndLeaveTheRestAsTheWholeWind
     mem::copy_to_host(device_, out.data(), src, size_t(n) * sizeof(float));
     return out;
   };
-  int first_layers = 0, last_layers = 0, checked = 0;
+  int first_layers = 0, last_layers = 0, first_box = 0, last_box = 0, checked = 0;
   std::string tops;  // the paint's top / the layers visited, by step
   float x0 = 4.f;
   for (int s = 0; s < 30; ++s) {
@@ -339,8 +339,9 @@ TEST_F(GridStepTest, StagesVisitOnlyThePaintsLayersAndLeaveTheRestAsTheWholeWind
     x0 += 0.5f;
     GridExtent e{};
     g.extent().copy_to_host(&e, 1);
-    if (s == 0) first_layers = e.layers;
+    if (s == 0) first_layers = e.layers, first_box = (e.x1 - e.x0) * (e.y1 - e.y0);
     last_layers = e.layers;
+    last_box = (e.x1 - e.x0) * (e.y1 - e.y0);
     // The extent covers the paint and the layer above it, and no more once the first step
     // has cleared the window.
     const auto rho = host_density(g);
@@ -378,31 +379,43 @@ TEST_F(GridStepTest, StagesVisitOnlyThePaintsLayersAndLeaveTheRestAsTheWholeWind
     }
     EXPECT_EQ(liquid_above, 0) << "step " << s;
     // As the step would have made them without the extent: the classes of its cells and the
-    // layer above, the fractions of their faces, and the fluid flags everywhere (none above).
-    // Classes and fractions higher up are the advection's or an earlier step's: nothing reads them.
+    // layer above, the fractions of their faces, and the fluid flags everywhere (none outside).
+    // Classes and fractions elsewhere are the advection's or an earlier step's: nothing reads them.
     g.classify();
-    auto prefix = [](auto v, int64_t n) {
-      v.resize(size_t(n));
-      return v;
+    auto in_extent = [](auto v, int64_t n, auto index) {
+      decltype(v) out;
+      for (int64_t t = 0; t < n; ++t) out.push_back(v[size_t(index(t))]);
+      return out;
     };
-    EXPECT_EQ(prefix(copy_u8(v.cls, d.cells()), e.classes), prefix(cls, e.classes)) << "step " << s;
-    const int64_t w_layers = std::min(e.layers + 1, d.nz + 1);
-    const int64_t below[3] = {int64_t(d.nx + 1) * d.ny * e.layers, int64_t(d.nx) * (d.ny + 1) * e.layers,
-                              int64_t(d.nx) * d.ny * w_layers};
+    auto cell_at = [&](int64_t t) { return extent_cell(d, e, t); };
+    EXPECT_EQ(in_extent(copy_u8(v.cls, d.cells()), e.classes, cell_at), in_extent(cls, e.classes, cell_at))
+        << "step " << s;
+    std::vector<int64_t> face_index[3];
+    for (int64_t t = 0; t < e.faces; ++t) {
+      int c;
+      int64_t f;
+      extent_face(d, e, t, c, f);
+      face_index[c].push_back(f);
+    }
     for (int c = 0; c < 3; ++c) {
-      EXPECT_EQ(prefix(copy_f(v.theta[c], d.faces(c)), below[c]), prefix(theta[size_t(c)], below[c]))
+      auto at = [&](int64_t t) { return face_index[c][size_t(t)]; };
+      const int64_t n = int64_t(face_index[c].size());
+      EXPECT_EQ(in_extent(copy_f(v.theta[c], d.faces(c)), n, at), in_extent(theta[size_t(c)], n, at))
           << "step " << s << " component " << c;
-      EXPECT_EQ(prefix(copy_f(v.solid_vel[c], d.faces(c)), below[c]), prefix(solid[size_t(c)], below[c]))
+      EXPECT_EQ(in_extent(copy_f(v.solid_vel[c], d.faces(c)), n, at), in_extent(solid[size_t(c)], n, at))
           << "step " << s << " component " << c;
       EXPECT_EQ(copy_u8(v.fluid[c], d.faces(c)), fluid[size_t(c)]) << "step " << s << " component " << c;
     }
     ++checked;
   }
-  std::printf("[ extent ] layers visited: %d at the first step, %d at the last (of %d)\n", first_layers, last_layers,
-              d.nz);
+  std::printf("[ extent ] layers visited: %d at the first step, %d at the last (of %d); columns %d, %d (of %d)\n",
+              first_layers, last_layers, d.nz, first_box, last_box, d.nx * d.ny);
   std::printf("[ extent ] paint's top / layers visited by step:%s\n", tops.c_str());
   EXPECT_EQ(checked, 30);
   EXPECT_EQ(first_layers, d.nz) << "the first step visits every layer once";
+  EXPECT_EQ(first_box, d.nx * d.ny) << "and every column";
+  // The layer of paint spans x in [8, 40) and every row; the stroke spreads it a little.
+  EXPECT_LE(last_box, 40 * d.ny) << "the extent follows the paint across";
   EXPECT_LT(last_layers, 12) << "the extent follows the paint down when the particles are gone";
 }
 

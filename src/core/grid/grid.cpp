@@ -19,11 +19,11 @@ void classify_d(const Device& d, GridView g, PaintWindowView pw, BristleField br
                 float lt, float dt) {
   WB_DISPATCH(d, grid_classify(g, pw, br, pd, cd.width, cd.height, cd.depth, lt, dt));
 }
-void tops_d(const Device& d, GridDims g, const float* rho, const float* pd, float* top, float* jt) {
-  WB_DISPATCH(d, grid_paint_tops(g, rho, pd, top, jt));
+void column_tops_d(const Device& d, GridDims g, const float* rho, const float* pd, float trace, float* out) {
+  WB_DISPATCH(d, grid_column_tops(g, rho, pd, trace, out));
 }
-void first_extent_d(const Device& d, GridDims g, const float* jt, GridExtent* e) {
-  WB_DISPATCH(d, grid_first_extent(g, jt, e));
+void first_extent_d(const Device& d, GridDims g, const float* maxima, GridExtent* e) {
+  WB_DISPATCH(d, grid_first_extent(g, maxima, e));
 }
 void outflow_d(const Device& d, GridView g, const float* rho, float* out) { WB_DISPATCH(d, grid_paint_outflow(g, rho, out)); }
 void advect_axis_d(const Device& d, GridView g, PaintWindowView s, PaintWindowView t, int axis, float dt,
@@ -40,8 +40,9 @@ void paint_tiles_d(const Device& d, GridDims g, const float* rho, const float* d
 void copy_tiles_d(const Device& d, GridDims g, PaintTiles t, PaintWindowView s, PaintWindowView dst, bool reads) {
   WB_DISPATCH(d, grid_copy_paint_tiles(g, t, s, dst, reads));
 }
-void advect_vel_d(const Device& d, GridView g, const float* u, const float* v, const float* w, float dt, int layers) {
-  WB_DISPATCH(d, grid_advect_velocity(g, u, v, w, dt, layers));
+void advect_vel_d(const Device& d, GridView g, const float* u, const float* v, const float* w, float dt) {
+  WB_REQUIRE(g.extent, "grid advection: the velocity's extent is not set");
+  WB_DISPATCH(d, grid_advect_velocity(g, u, v, w, dt));
 }
 void gravity_d(const Device& d, GridView g, float* ph, float g_dt) { WB_DISPATCH(d, grid_gravity(g, ph, g_dt)); }
 void mu_d(const Device& d, GridView g, JointOil oil, HerschelBulkley s, HerschelBulkley o, float m, float* mu) {
@@ -99,12 +100,10 @@ void apply_all_d(const Device& d, PoissonView s, const float* x, float* out) {
 }
 void apply_pressure_d(const Device& d, GridView g, const float* p) { WB_DISPATCH(d, grid_apply_pressure(g, p)); }
 void extrapolate_d(const Device& d, GridView g) { WB_DISPATCH(d, grid_extrapolate(g)); }
-void layer_top_d(const Device& d, GridDims g, const float* rho, const float* pd, float* top) {
-  WB_DISPATCH(d, grid_layer_top(g, rho, pd, top));
-}
 void extent_d(const Device& d, GridDims g, const float* before, const float* after, GridExtent* e) {
   WB_DISPATCH(d, grid_extent(g, before, after, e));
 }
+void extent_moved_d(const Device& d, GridDims g, GridExtent* e) { WB_DISPATCH(d, grid_extent_moved(g, e)); }
 void dry_d(const Device& d, PaintWindowView pw, float amount) { WB_DISPATCH(d, grid_dry(pw, amount)); }
 void max_speed_d(const Device& d, GridView g, float* out) { WB_DISPATCH(d, grid_max_abs_fluid_velocity(g, out)); }
 void square_d(const Device& d, const float* x, float* out, int64_t n) { WB_DISPATCH(d, grid_square(x, out, n)); }
@@ -265,6 +264,8 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
     b->resize(size_t(g.cells()));
     b->fill_zero();
   }
+  // Also six values a column (grid_column_tops), more than the cells of a window under 6 layers.
+  cell_tmp_.resize(std::max(size_t(g.cells()), size_t(6) * size_t(g.nx) * size_t(g.ny)));
   const size_t all_faces = size_t(g.nu() + g.nv() + g.nw());
   face_tmp_.set_device(d);
   face_tmp_.resize(all_faces);
@@ -291,10 +292,12 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   tile_counts_.resize(5);
   pass_below_.set_device(d);
   pass_below_.resize(2);
-  // Every layer until the first step has found the paint's (its stages then visit them all once).
+  // Every cell until the first step has found the paint's (its stages then visit them all once).
   GridExtent all{};
   set_layers(all, g, g.nz);
   all.dirty = g.nz;
+  all.dirty_box[1] = g.nx;
+  all.dirty_box[3] = g.ny;
   extent_.set_device(d);
   extent_.copy_from_host(&all, 1);
   advect_extent_.set_device(d);
@@ -323,6 +326,7 @@ bool Grid::move_window(Int3 new_origin) {
   WB_PROFILE_SCOPE("grid.move_window");
   const bool moved = !(new_origin == window_.origin());
   window_.move_to(new_origin);
+  if (moved) extent_moved_d(device(), dims(), extent_.data());
   stats_.window_moved = moved;
   return moved;
 }
@@ -348,12 +352,15 @@ void Grid::advect(float dt) {
   // step's sub-steps, which alternate the order x y z and z y x (Strang).
   const int64_t cells = g.cells();
   // The classes and face fractions the advection reads (solids for the backtrace, dried paint
-  // never moved) lie in the layers of the paint and particles and a few above: those below the
-  // joint top first, found on the device, for the outflow rates; the rest once the one read has
-  // told how far the paint rises (below). Above, nothing in the step reads them (docs/GRID.md).
-  tops_d(d, g, paint.density.data(), particle_density_, cell_tmp_.data(), rhs_.data());
-  reduce_max_into(d, cell_tmp_.data(), cells, advect_max_.data() + kPaintTop, ws_);
-  reduce_max_into(d, rhs_.data(), cells, advect_max_.data() + kJointTop, ws_);
+  // never moved) lie in the cells of the paint and particles and a few beyond: those of the
+  // columns and layers holding them first, found on the device, for the outflow rates; the rest
+  // once the one read has told how far the paint moves (below). Beyond, nothing in the step
+  // reads them (docs/GRID.md).
+  const int64_t columns = int64_t(g.nx) * g.ny;
+  column_tops_d(d, g, paint.density.data(), particle_density_, kTraceDensity, cell_tmp_.data());
+  reduce_max_into(d, cell_tmp_.data(), columns, advect_max_.data() + kPaintTop, ws_);
+  for (int s = 0; s < 5; ++s)
+    reduce_max_into(d, cell_tmp_.data() + (s + 1) * columns, columns, advect_max_.data() + kJointTop + s, ws_);
   first_extent_d(d, g, advect_max_.data() + kJointTop, advect_extent_.data());
   within(advect_extent_.data(), [&] { classify(); });
   outflow_d(d, view(), paint.density.data(), face_tmp_.data());
@@ -362,8 +369,8 @@ void Grid::advect(float dt) {
   // (face_tmp_, one value per face, holds the three rates: there are more faces than 3 cells.)
   for (int a = 0; a < 3; ++a)
     reduce_max_into(d, face_tmp_.data() + a * cells, cells, advect_max_.data() + kRateX + a, ws_);
-  float maxima[kJointTop + 1];
-  advect_max_.copy_to_host(maxima, kJointTop + 1);
+  float maxima[kJointTop + 5];
+  advect_max_.copy_to_host(maxima, kJointTop + 5);
   int passes[3];
   float courant = 0.f;
   for (int a = 0; a < 3; ++a) {
@@ -376,10 +383,14 @@ void Grid::advect(float dt) {
   // The velocity's layers (below): the paint's and particles', risen a cell a z pass, and the
   // stencils that reach them. The paint's passes read less (the paint's top plus its z passes,
   // and the donor and slope cells beyond).
+  // Across, the paint's and particles' columns, as far as its x and y passes reach, and the
+  // stencils' two cells beyond.
   const int layers = std::min(g.nz, joint_top + passes[2] + 2);
-  if (layers > joint_top) {
+  int box[4];
+  column_box(g, maxima + kJointTop + 1, std::max(passes[0], passes[1]) + 2, box);
+  {
     GridExtent e{};
-    set_layers(e, g, layers);
+    set_extent(e, g, layers, box[0], box[1], box[2], box[3]);
     advect_extent_.copy_range_from_host(&e, 1, 1);
     within(advect_extent_.data() + 1, [&] { classify(); });
   }
@@ -393,8 +404,9 @@ void Grid::advect(float dt) {
   // writes it again, and nothing in the step reads it where there is no paint (docs/GRID.md).
   for (int c = 0; c < 3; ++c)
     mem::copy_on_device(d, vel_tmp_[c].data(), v.vel[c], size_t(g.faces(c)) * sizeof(float));
-  v = view();
-  advect_vel_d(d, v, vel_tmp_[0].data(), vel_tmp_[1].data(), vel_tmp_[2].data(), dt, layers);
+  within(advect_extent_.data() + 1, [&] {
+    advect_vel_d(d, view(), vel_tmp_[0].data(), vel_tmp_[1].data(), vel_tmp_[2].data(), dt);
+  });
 }
 
 void Grid::advect_paint(float dt, const int passes[3], int top) {
@@ -458,8 +470,10 @@ void Grid::advect_paint(float dt, const int passes[3], int top) {
 
 void Grid::find_extent() {
   const GridDims g = dims();
-  layer_top_d(device(), g, window_.paint().density.data(), particle_density_, cell_tmp_.data());
-  reduce_max_into(device(), cell_tmp_.data(), g.cells(), advect_max_.data() + kExtentTop, ws_);
+  const int64_t columns = int64_t(g.nx) * g.ny;
+  column_tops_d(device(), g, window_.paint().density.data(), particle_density_, 0.f, cell_tmp_.data());
+  for (int s = 0; s < 5; ++s)
+    reduce_max_into(device(), cell_tmp_.data() + (s + 1) * columns, columns, advect_max_.data() + kExtentTop + s, ws_);
   extent_d(device(), g, advect_max_.data() + kJointTop, advect_max_.data() + kExtentTop, extent_.data());
 }
 

@@ -162,9 +162,11 @@ class Grid {
   DeviceBuffer<int64_t> cg_count_;
   int cg_last_iterations_ = 0;  ///< the last viscous solve's CG iterations: the next one plans on them
   /// The advection's maxima, read in one copy: the outflow rate along each axis (slots 0-2), the
-  /// top layers holding paint and paint or particles; then the joint top after the particles
-  /// joined (find_extent, not read).
-  enum AdvectMax { kRateX = 0, kPaintTop = 3, kJointTop = 4, kExtentTop = 5, kAdvectMaxSlots = 6 };
+  /// top layers holding paint and paint or particles and the box of the latter; then the joint
+  /// top and box after the particles joined (find_extent, not read).
+  /// kJointTop and kExtentTop are each followed by the maxima of x, -x, y, -y of the columns
+  /// holding paint or particles (grid_column_tops).
+  enum AdvectMax { kRateX = 0, kPaintTop = 3, kJointTop = 4, kExtentTop = 9, kAdvectMaxSlots = 14 };
   DeviceBuffer<float> advect_max_;
   DeviceBuffer<int32_t> tile_mark_, tile_active_, tile_halo_;  ///< the advection's tiles (PaintTiles)
   /// Per tile: whether it held paint after the last pass and after this one (swapped each
@@ -201,8 +203,8 @@ class Grid {
 #define WB_GRID_BACKEND_DECLS                                                                                        \
   void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float* particle_density, int canvas_w, int canvas_h, int canvas_d,     \
                      float liquid_threshold, float dry_threshold);                                                   \
-  void grid_paint_tops(GridDims d, const float* rho, const float* particle_density, float* top, float* joint_top); \
-  void grid_first_extent(GridDims d, const float* joint_top, GridExtent* e);                                       \
+  void grid_column_tops(GridDims d, const float* rho, const float* particle_density, float trace, float* out);    \
+  void grid_first_extent(GridDims d, const float* maxima, GridExtent* e);                                          \
   void grid_paint_outflow(GridView g, const float* rho, float* out);                                                \
   void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt,             \
                               PaintTiles tiles, const int32_t* process, int32_t* painted, const int32_t* below,      \
@@ -212,7 +214,7 @@ class Grid {
                         int reach, int32_t* mark, int32_t* active,                                                \
                         int32_t* halo, int64_t* counts, int32_t* below);                                             \
   void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst, bool reads);   \
-  void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt, int layers);                  \
+  void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt);                  \
   void grid_gravity(GridView g, float* ph, float g_dt);                                                              \
   void grid_effective_viscosity(GridView g, JointOil oil, HerschelBulkley stiff, HerschelBulkley oily, float m,    \
                                 float* mu);                                                                          \
@@ -239,8 +241,8 @@ class Grid {
   void poisson_apply_all(PoissonView s, const float* x, float* out);                                                 \
   void grid_apply_pressure(GridView g, const float* p);                                                              \
   void grid_extrapolate(GridView g);                                                                                 \
-  void grid_layer_top(GridDims d, const float* rho, const float* particle_density, float* top);                     \
-  void grid_extent(GridDims d, const float* top_before, const float* top_after, GridExtent* e);                      \
+  void grid_extent(GridDims d, const float* before, const float* after, GridExtent* e);                              \
+  void grid_extent_moved(GridDims d, GridExtent* e);                                                                 \
   void grid_dry(PaintWindowView pw, float amount);                                                                   \
   void grid_shift_lattice(const float* src, float* dst, int ex, int ey, int ez, int dx, int dy, int dz);            \
   void grid_max_abs_fluid_velocity(GridView g, float* out);                                                          \

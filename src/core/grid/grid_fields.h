@@ -70,18 +70,21 @@ struct GridDims {
   }
 };
 
-/// Layers of the window a stage visits (device memory; docs/GRID.md "Work in proportion to the
-/// paint"): those after the joint fields (grid_extent) and the advection's (grid_first_extent,
-/// set_layers). Cells at k < layers may hold paint, particles or liquid; above them no face is
-/// fluid. Stages over this extent leave the rest as it was, and the layers the last step used
-/// (`dirty`) are visited once more, so that what they held goes back to its value for cells
-/// without liquid.
+/// The part of the window a stage visits (device memory; docs/GRID.md "Work in proportion to the
+/// paint"): after the joint fields (grid_extent) and the advection's (grid_first_extent,
+/// grid_advect_extent). The columns [x0, x1) x [y0, y1) below `layers` hold every cell with
+/// paint, particles or liquid and a margin around them; outside it no face is fluid. Stages
+/// over this extent leave the rest as it was, and what the last step visited for its liquid
+/// (`dirty`, `dirty_box`) is visited once more, so that what it held goes back to its value for
+/// cells without liquid.
 struct GridExtent {
-  int64_t cells;    ///< nx ny layers
+  int64_t cells;    ///< the box's cells: (x1 - x0) (y1 - y0) layers
   int64_t faces;    ///< the faces of those cells: u and v below `layers`, w up to layer `layers`
   int32_t layers;   ///< cells with k < layers
   int32_t dirty;    ///< the layers holding liquid at the last step
   int64_t classes;  ///< the cells classify writes: one layer more, whose class the top faces read
+  int32_t x0, x1, y0, y1;  ///< the columns visited
+  int32_t dirty_box[4];    ///< the columns holding liquid at the last step (x0, x1, y0, y1)
 };
 
 /// The oil fraction of the joint paint (§4.3: grid and particles) in a cell, mass-weighted: the
@@ -140,12 +143,54 @@ WB_HD WB_INLINE int64_t faces_below(int nx, int ny, int nz, int layers) {
   return int64_t(nx + 1) * ny * layers + int64_t(nx) * (ny + 1) * layers + int64_t(nx) * ny * w_layers;
 }
 
-/// An extent of `layers` layers (dirty unchanged).
-WB_HD WB_INLINE void set_layers(GridExtent& e, const GridDims& d, int layers) {
+/// Density below which paint in a cell is a trace, cells: it neither sets the advection's passes
+/// nor its bounds.
+constexpr float kTraceDensity = 1e-6f;
+
+/// An extent of the columns [x0, x1) x [y0, y1) below `layers` (dirty unchanged).
+WB_HD WB_INLINE void set_extent(GridExtent& e, const GridDims& d, int layers, int x0, int x1, int y0, int y1) {
   e.layers = layers;
-  e.cells = int64_t(d.nx) * d.ny * layers;
-  e.faces = faces_below(d.nx, d.ny, d.nz, layers);
-  e.classes = int64_t(d.nx) * d.ny * (layers < d.nz ? layers + 1 : d.nz);
+  e.x0 = x0, e.x1 = x1, e.y0 = y0, e.y1 = y1;
+  const int64_t bx = x1 - x0, by = y1 - y0;
+  e.cells = bx * by * layers;
+  e.faces = faces_below(int(bx), int(by), d.nz, layers);
+  e.classes = bx * by * (layers < d.nz ? layers + 1 : d.nz);
+}
+/// The columns [x0, x1) x [y0, y1) of the box whose maxima of x, -x, y, -y are m[0..3], grown
+/// by `margin` and clamped to the window; empty (all 0) where no column counted.
+WB_HD WB_INLINE void column_box(const GridDims& d, const float* m, int margin, int box[4]) {
+  if (!(m[0] >= -m[1] && m[2] >= -m[3])) {
+    box[0] = box[1] = box[2] = box[3] = 0;
+    return;
+  }
+  const int x0 = int(-m[1]) - margin, x1 = int(m[0]) + 1 + margin;
+  const int y0 = int(-m[3]) - margin, y1 = int(m[2]) + 1 + margin;
+  box[0] = x0 > 0 ? x0 : 0;
+  box[1] = x1 < d.nx ? x1 : d.nx;
+  box[2] = y0 > 0 ? y0 : 0;
+  box[3] = y1 < d.ny ? y1 : d.ny;
+}
+
+/// An extent of `layers` layers, every column (dirty unchanged).
+WB_HD WB_INLINE void set_layers(GridExtent& e, const GridDims& d, int layers) {
+  set_extent(e, d, layers, 0, d.nx, 0, d.ny);
+}
+/// The cell of index t among an extent's cells (x fastest, then y, then z).
+WB_HD WB_INLINE int64_t extent_cell(const GridDims& d, const GridExtent& e, int64_t t) {
+  const int64_t bx = e.x1 - e.x0, by = e.y1 - e.y0;
+  const int64_t row = t / bx, layer = row / by;
+  return (layer * d.ny + e.y0 + (row - layer * by)) * d.nx + e.x0 + (t - row * bx);
+}
+/// The face of index t among an extent's faces (u | v | w, each x fastest): its component c and
+/// index f in the component's array.
+WB_HD WB_INLINE void extent_face(const GridDims& d, const GridExtent& e, int64_t t, int& c, int64_t& f) {
+  const int64_t bx = e.x1 - e.x0, by = e.y1 - e.y0;
+  const int64_t nu = (bx + 1) * by * e.layers, nv = bx * (by + 1) * e.layers;
+  c = t < nu ? 0 : (t < nu + nv ? 1 : 2);
+  const int64_t s = c == 0 ? t : (c == 1 ? t - nu : t - nu - nv);
+  const int64_t ex = bx + (c == 0), ey = by + (c == 1);  // the box's faces along x and y
+  const int64_t row = s / ex, layer = row / ey;
+  f = (layer * (d.ny + (c == 1)) + e.y0 + (row - layer * ey)) * (d.nx + (c == 0)) + e.x0 + (s - row * ex);
 }
 
 /// The pressure system A p = b on liquid cells (Batty et al. 2007 face fractions):

@@ -30,36 +30,52 @@ WB_HD WB_INLINE void split_face_below(const GridDims& d, int layers, int64_t t, 
   }
 }
 template <class F>
-struct FacesBelow {
+struct CellsIn {
+  GridDims d;
+  const GridExtent* e;
+  F fn;
+  WB_HD void operator()(int64_t t) const { fn(extent_cell(d, *e, t)); }
+};
+template <class F>
+struct FacesIn {
   GridDims d;
   const GridExtent* e;
   F fn;
   WB_HD void operator()(int64_t t) const {
     int c;
     int64_t f;
-    split_face_below(d, e ? e->layers : d.nz, t, c, f);
+    extent_face(d, *e, t, c, f);
+    fn(c, f);
+  }
+};
+template <class F>
+struct AllFaces {
+  GridDims d;
+  F fn;
+  WB_HD void operator()(int64_t t) const {
+    int c;
+    int64_t f;
+    split_face_below(d, d.nz, t, c, f);
     fn(c, f);
   }
 };
 }  // namespace detail
 
-/// fn(c) for every cell a stage visits: those below the extent's layers, or all.
+/// fn(c) for every cell a stage visits: the extent's, or all.
 template <class F>
 void for_cells(const GridDims& d, const GridExtent* e, F fn) {
   if (e)
-    parallel_for_count(&e->cells, d.cells(), fn);
+    parallel_for_count(&e->cells, d.cells(), detail::CellsIn<F>{d, e, fn});
   else
     parallel_for(d.cells(), fn);
 }
-/// fn(c, f) (component, index) for every face a stage visits: those of the cells below the
-/// extent's layers, or all.
+/// fn(c, f) (component, index) for every face a stage visits: those of the extent's cells, or all.
 template <class F>
 void for_faces(const GridDims& d, const GridExtent* e, F fn) {
-  const detail::FacesBelow<F> loop{d, e, fn};
   if (e)
-    parallel_for_count(&e->faces, detail::all_faces(d), loop);
+    parallel_for_count(&e->faces, detail::all_faces(d), detail::FacesIn<F>{d, e, fn});
   else
-    parallel_for(detail::all_faces(d), loop);
+    parallel_for(detail::all_faces(d), detail::AllFaces<F>{d, fn});
 }
 
 void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float* particle_density, int canvas_w,
@@ -76,7 +92,7 @@ void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float*
   };
   // The extent's cells and the layer above them: the faces on top read its class.
   if (g.extent)
-    parallel_for_count(&g.extent->classes, d.cells(), cell);
+    parallel_for_count(&g.extent->classes, d.cells(), detail::CellsIn<decltype(cell)>{d, g.extent, cell});
   else
     parallel_for(d.cells(), cell);
   // Open fraction, solid velocity and fluid flag of each face in one pass: the flag reads only
@@ -92,27 +108,38 @@ void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float*
   });
 }
 
-/// Density below which paint in a cell is a trace, cells: it neither sets the advection's passes
-/// nor its layer bound.
-constexpr float kTraceDensity = 1e-6f;
 
-void grid_paint_tops(GridDims d, const float* rho, const float* particle_density, float* top, float* joint_top) {
-  parallel_for(d.cells(), [=] WB_HD(int64_t c) {
-    int i, j, k;
-    d.decompose_cell(c, i, j, k);
-    // Traces above the top (a lifting bristle carries them up a fraction of a cell a sub-step)
-    // stay where they are for the step.
-    const bool paint = rho[c] > kTraceDensity;
-    top[c] = paint ? float(k + 1) : 0.f;
-    joint_top[c] = paint || (particle_density && particle_density[c] > kTraceDensity) ? float(k + 1) : 0.f;
+void grid_column_tops(GridDims d, const float* rho, const float* particle_density, float trace, float* out) {
+  const int64_t n = int64_t(d.nx) * d.ny;
+  parallel_for(n, [=] WB_HD(int64_t col) {
+    // The column's top layer (k + 1) holding paint above `trace`, and holding paint or particles;
+    // where it holds either, its x, -x, y and -y, whose maxima are the box of such columns.
+    float top = 0.f, joint = 0.f;
+    for (int k = d.nz - 1; k >= 0 && joint == 0.f; --k) {
+      const int64_t c = int64_t(k) * n + col;
+      if (rho[c] > trace) top = joint = float(k + 1);
+      else if (particle_density && particle_density[c] > trace) joint = float(k + 1);
+    }
+    for (int k = int(joint) - 1; k >= 0 && top == 0.f; --k)
+      if (rho[int64_t(k) * n + col] > trace) top = float(k + 1);
+    const float none = -INFINITY, i = float(col % d.nx), j = float(col / d.nx);
+    out[col] = top;
+    out[n + col] = joint;
+    out[2 * n + col] = joint > 0.f ? i : none;
+    out[3 * n + col] = joint > 0.f ? -i : none;
+    out[4 * n + col] = joint > 0.f ? j : none;
+    out[5 * n + col] = joint > 0.f ? -j : none;
   });
 }
 
-void grid_first_extent(GridDims d, const float* joint_top, GridExtent* e) {
+void grid_first_extent(GridDims d, const float* maxima, GridExtent* e) {
   parallel_for(1, [=] WB_HD(int64_t) {
-    // The layers holding paint or particles: the faces of their cells carry the outflow.
-    const float top = maxf(*joint_top, 0.f);
-    set_layers(*e, d, top < float(d.nz) ? int(top) : d.nz);
+    // The cells holding paint or particles and a cell around them: the faces of their cells
+    // carry the outflow.
+    const float top = maxf(maxima[0], 0.f);
+    int box[4];
+    column_box(d, maxima + 1, 1, box);
+    set_extent(*e, d, top < float(d.nz) ? int(top) : d.nz, box[0], box[1], box[2], box[3]);
   });
 }
 
@@ -288,14 +315,9 @@ void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst
                                                        below});
 }
 
-void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt, int layers) {
+void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt) {
   const GridDims d = g.d;
-  // The faces of the cells below `layers` (x fastest, z last: a prefix of each component's array).
-  const int64_t nu = int64_t(d.nx + 1) * d.ny * layers, nv = int64_t(d.nx) * (d.ny + 1) * layers;
-  const int64_t nw = int64_t(d.nx) * d.ny * (layers < d.nz ? layers + 1 : d.nz + 1);
-  parallel_for(nu + nv + nw, [=] WB_HD(int64_t t) {
-    const int c = t < nu ? 0 : (t < nu + nv ? 1 : 2);
-    const int64_t f = c == 0 ? t : (c == 1 ? t - nu : t - nu - nv);
+  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f) {
     int i, j, k;
     if (g.theta[c][f] <= 0.f) {
       g.vel[c][f] = g.solid_vel[c][f];
@@ -313,6 +335,7 @@ void grid_gravity(GridView g, float* ph, float g_dt) {
   const GridExtent* e = g.extent;
   parallel_for(int64_t(d.nx) * d.ny, [=] WB_HD(int64_t col) {
     const int i = int(col % d.nx), j = int(col / d.nx);
+    if (e && (i < e->x0 || i >= e->x1 || j < e->y0 || j >= e->y1)) return;
     float head = 0.f;
     for (int k = (e ? e->layers : d.nz) - 1; k >= 0; --k) {
       const int64_t c = d.cell(i, j, k);
@@ -544,20 +567,39 @@ void grid_extrapolate(GridView g) {
   });
 }
 
-void grid_layer_top(GridDims d, const float* rho, const float* particle_density, float* top) {
-  parallel_for(d.cells(), [=] WB_HD(int64_t c) {
-    const bool paint = rho[c] > 0.f || (particle_density && particle_density[c] > 0.f);
-    top[c] = paint ? float(c / (int64_t(d.nx) * d.ny) + 1) : 0.f;
+void grid_extent(GridDims d, const float* before, const float* after, GridExtent* e) {
+  parallel_for(1, [=] WB_HD(int64_t) {
+    // The liquid's cells before the advection and now, and a cell around them: the faces
+    // extrapolation writes. before and after: the joint top, then the box's maxima.
+    const float top = maxf(maxf(before[0], after[0]), 0.f);
+    const int now = top + 1.f < float(d.nz) ? int(top) + 1 : d.nz;
+    int a[4], b[4];
+    column_box(d, before + 1, 1, a);
+    column_box(d, after + 1, 1, b);
+    int box[4] = {imin(a[0], b[0]), imax(a[1], b[1]), imin(a[2], b[2]), imax(a[3], b[3])};
+    if (a[0] == a[1]) for (int s = 0; s < 4; ++s) box[s] = b[s];  // an empty box adds nothing
+    if (b[0] == b[1] && a[0] != a[1]) for (int s = 0; s < 4; ++s) box[s] = a[s];
+    // With what the last step visited for its liquid, which goes back to its value now.
+    int visit[4] = {box[0], box[1], box[2], box[3]};
+    const int* was = e->dirty_box;
+    if (was[0] != was[1]) {
+      if (box[0] == box[1]) {
+        for (int s = 0; s < 4; ++s) visit[s] = was[s];
+      } else {
+        visit[0] = imin(box[0], was[0]), visit[1] = imax(box[1], was[1]);
+        visit[2] = imin(box[2], was[2]), visit[3] = imax(box[3], was[3]);
+      }
+    }
+    set_extent(*e, d, now > e->dirty ? now : e->dirty, visit[0], visit[1], visit[2], visit[3]);
+    e->dirty = now;
+    for (int s = 0; s < 4; ++s) e->dirty_box[s] = box[s];
   });
 }
 
-void grid_extent(GridDims d, const float* top_before, const float* top_after, GridExtent* e) {
+void grid_extent_moved(GridDims d, GridExtent* e) {
+  // The classes and faces are not shifted with the window: every column is visited once more.
   parallel_for(1, [=] WB_HD(int64_t) {
-    // The liquid's layers, and the one above them, whose faces extrapolation writes.
-    const float top = maxf(maxf(*top_before, *top_after), 0.f);
-    const int now = top + 1.f < float(d.nz) ? int(top) + 1 : d.nz;
-    set_layers(*e, d, now > e->dirty ? now : e->dirty);
-    e->dirty = now;
+    e->dirty_box[0] = 0, e->dirty_box[1] = d.nx, e->dirty_box[2] = 0, e->dirty_box[3] = d.ny;
   });
 }
 

@@ -44,6 +44,8 @@ WB_HD WB_INLINE float clampf(float v, float lo, float hi) { return v < lo ? lo :
 WB_HD WB_INLINE int clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
 WB_HD WB_INLINE float minf(float a, float b) { return a < b ? a : b; }
 WB_HD WB_INLINE float maxf(float a, float b) { return a > b ? a : b; }
+WB_HD WB_INLINE int imin(int a, int b) { return a < b ? a : b; }
+WB_HD WB_INLINE int imax(int a, int b) { return a > b ? a : b; }
 /// a + b and a - b rounded as written, never fused with the multiply that made an operand (nvcc
 /// contracts x*y + z into one FMA): for sums two threads must round alike, such as a face's
 /// flux given by one cell and taken by the other. The host build turns contraction off

@@ -28,8 +28,6 @@ struct HashGridView {
   const int32_t* coarse;       ///< per bucket of coarse cell (cell >> kCoarseShift): 1 when it may hold a sample
 };
 
-WB_HD WB_INLINE int imax(int a, int b) { return a > b ? a : b; }
-WB_HD WB_INLINE int imin(int a, int b) { return a < b ? a : b; }
 
 /// A cell coordinate defined for every float: beyond +-1e9 cells (no canvas is that large) and
 /// for a non-finite value (a point the step's containment is about to remove) it is clamped, as

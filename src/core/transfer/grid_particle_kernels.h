@@ -15,9 +15,6 @@ namespace wb {
 /// Squared distance standing for "no sample anywhere" in the distance transform.
 inline constexpr float kFarDistance2 = 1e20f;
 
-WB_HD WB_INLINE int imax_t(int a, int b) { return a > b ? a : b; }
-WB_HD WB_INLINE int imin_t(int a, int b) { return a < b ? a : b; }
-
 /// Dried paint is solid (dried_solid): it neither becomes particles nor receives them (§4.2 "dryness").
 WB_HD WB_INLINE bool cell_is_solid(float density, float dryness, float dry_threshold) {
   return dried_solid(density, dryness, dry_threshold);
@@ -138,9 +135,9 @@ WB_HD WB_INLINE float tent(float d, float h) { return maxf(1.f - fabsf(d) / h, 0
 /// each such cell and returns the number of cells (0: none, q cannot exchange with the grid).
 template <typename F>
 WB_HD WB_INLINE int for_each_kernel_cell(const PaintWindowView& pw, Vec3 q, float h, float dry_threshold, F f) {
-  const int i0 = imax_t(int(ceilf(q.x - 0.5f - h)), 0), i1 = imin_t(int(floorf(q.x - 0.5f + h)), pw.nx - 1);
-  const int j0 = imax_t(int(ceilf(q.y - 0.5f - h)), 0), j1 = imin_t(int(floorf(q.y - 0.5f + h)), pw.ny - 1);
-  const int k0 = imax_t(int(ceilf(q.z - 0.5f - h)), 0), k1 = imin_t(int(floorf(q.z - 0.5f + h)), pw.nz - 1);
+  const int i0 = imax(int(ceilf(q.x - 0.5f - h)), 0), i1 = imin(int(floorf(q.x - 0.5f + h)), pw.nx - 1);
+  const int j0 = imax(int(ceilf(q.y - 0.5f - h)), 0), j1 = imin(int(floorf(q.y - 0.5f + h)), pw.ny - 1);
+  const int k0 = imax(int(ceilf(q.z - 0.5f - h)), 0), k1 = imin(int(floorf(q.z - 0.5f + h)), pw.nz - 1);
   // Every liquid-capable cell the tent touches, with its raw weight.
   auto visit = [&](auto&& g) {
     for (int k = k0; k <= k1; ++k)
