@@ -27,7 +27,6 @@ WB_BRUSH_CALL(brush_integrate, (BristleState s, BristleRest r, BrushFrame f, Bru
 WB_BRUSH_CALL(brush_solve, (BristleState s, BristleRest r, BrushFrame f, SolidField so, int it, float mu),
               (s, r, f, so, it, mu))
 WB_BRUSH_CALL(brush_grid_keys, (BristleState s, float h, uint32_t m, uint32_t* k, uint32_t* i), (s, h, m, k, i))
-WB_BRUSH_CALL(brush_grid_clear, (uint32_t * a, uint32_t* b, int64_t n), (a, b, n))
 WB_BRUSH_CALL(brush_grid_ranges, (const uint32_t* k, int64_t n, uint32_t* a, uint32_t* b), (k, n, a, b))
 WB_BRUSH_CALL(brush_density_lambda, (BristleState s, MinDensityGrid g, float* l), (s, g, l))
 WB_BRUSH_CALL(brush_density_delta, (BristleState s, MinDensityGrid g, const float* l), (s, g, l))
@@ -297,7 +296,8 @@ void Brush::apply_min_density(int iterations) {
   for (int it = 0; it < iterations; ++it) {
     brush_grid_keys_on(device_, s, g.h, grid_mask_, grid_keys_.data(), grid_ids_.data());
     sort_by_key(device_, grid_keys_.data(), grid_ids_.data(), N, grid_bits_, ws_);
-    brush_grid_clear_on(device_, cell_start_.data(), cell_end_.data(), int64_t(grid_mask_) + 1);
+    cell_start_.fill_zero();  // start == end: an empty bucket
+    cell_end_.fill_zero();
     brush_grid_ranges_on(device_, grid_keys_.data(), N, cell_start_.data(), cell_end_.data());
     brush_density_lambda_on(device_, s, g, lambda_.data());
     brush_density_delta_on(device_, s, g, lambda_.data());

@@ -82,13 +82,6 @@ void brush_grid_keys(BristleState s, float h, uint32_t mask, uint32_t* keys, uin
   });
 }
 
-void brush_grid_clear(uint32_t* cell_start, uint32_t* cell_end, int64_t table) {
-  parallel_for(table, [=] WB_HD(int64_t i) {
-    cell_start[i] = 0xFFFFFFFFu;
-    cell_end[i] = 0u;
-  });
-}
-
 void brush_grid_ranges(const uint32_t* keys, int64_t n, uint32_t* cell_start, uint32_t* cell_end) {
   parallel_for(n, [=] WB_HD(int64_t i) {
     const uint32_t key = keys[i];
@@ -113,9 +106,7 @@ WB_HD WB_INLINE void for_each_neighbour(const BristleState& s, const MinDensityG
   for (int c = 0; c < 8; ++c) {
     const int nx = cx + ((c & 1) ? ox : 0), ny = cy + ((c & 2) ? oy : 0), nz = cz + ((c & 4) ? oz : 0);
     const uint32_t key = brush::hash_cell(nx, ny, nz, grid.mask);
-    const uint32_t b = grid.cell_start[key];
-    if (b == 0xFFFFFFFFu) continue;
-    const uint32_t e = grid.cell_end[key];
+    const uint32_t b = grid.cell_start[key], e = grid.cell_end[key];
     for (uint32_t q = b; q < e; ++q) {
       const int64_t j = grid.ids[q];
       if (j / V == g / V) continue;

@@ -13,7 +13,7 @@ namespace wb {
 /// Sorted hash grid over the vertices for the minimum-density constraint.
 struct MinDensityGrid {
   const uint32_t* ids;         ///< vertex ids sorted by cell hash
-  const uint32_t* cell_start;  ///< per hash bucket: first sorted index, 0xFFFFFFFF = empty
+  const uint32_t* cell_start;  ///< per hash bucket: first sorted index (start == end: empty)
   const uint32_t* cell_end;    ///< per hash bucket: one past the last sorted index
   uint32_t mask;               ///< table size - 1 (power of two)
   float h;                     ///< kernel radius = grid cell size, cells
@@ -35,7 +35,6 @@ struct SamplePrev {
                        float dt);                                                                                  \
   void brush_solve(BristleState s, BristleRest r, BrushFrame f, SolidField solid, int iterations, float friction_it); \
   void brush_grid_keys(BristleState s, float h, uint32_t mask, uint32_t* keys, uint32_t* ids);                      \
-  void brush_grid_clear(uint32_t* cell_start, uint32_t* cell_end, int64_t table);                                  \
   void brush_grid_ranges(const uint32_t* keys, int64_t n, uint32_t* cell_start, uint32_t* cell_end);               \
   void brush_density_lambda(BristleState s, MinDensityGrid g, float* lambda);                                      \
   void brush_density_delta(BristleState s, MinDensityGrid g, const float* lambda);                                 \
