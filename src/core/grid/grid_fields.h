@@ -71,8 +71,8 @@ struct GridDims {
 };
 
 /// The part of the window a stage visits (device memory; docs/GRID.md "Work in proportion to the
-/// paint"): after the joint fields (grid_extent) and the advection's (grid_first_extent,
-/// grid_advect_extent). The columns [x0, x1) x [y0, y1) below `layers` hold every cell with
+/// paint"): after the joint fields (grid_extent) and the advection's (grid_first_extent, then
+/// the one the host sets from the advection's read). The columns [x0, x1) x [y0, y1) below `layers` hold every cell with
 /// paint, particles or liquid and a margin around them; outside it no face is fluid. Stages
 /// over this extent leave the rest as it was, and what the last step visited for its liquid
 /// (`dirty`, `dirty_box`) is visited once more, so that what it held goes back to its value for
@@ -169,6 +169,13 @@ WB_HD WB_INLINE void column_box(const GridDims& d, const float* m, int margin, i
   box[1] = x1 < d.nx ? x1 : d.nx;
   box[2] = y0 > 0 ? y0 : 0;
   box[3] = y1 < d.ny ? y1 : d.ny;
+}
+
+/// The smallest box (x0, x1, y0, y1) holding boxes a and b; an empty box adds nothing.
+WB_HD WB_INLINE void box_union(const int a[4], const int b[4], int out[4]) {
+  const bool a_empty = a[0] >= a[1] || a[2] >= a[3], b_empty = b[0] >= b[1] || b[2] >= b[3];
+  for (int s = 0; s < 4; ++s)
+    out[s] = a_empty ? b[s] : (b_empty ? a[s] : (s % 2 == 0 ? imin(a[s], b[s]) : imax(a[s], b[s])));
 }
 
 /// An extent of `layers` layers, every column (dirty unchanged).

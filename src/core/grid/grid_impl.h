@@ -108,7 +108,6 @@ void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float*
   });
 }
 
-
 void grid_column_tops(GridDims d, const float* rho, const float* particle_density, float trace, float* out) {
   const int64_t n = int64_t(d.nx) * d.ny;
   parallel_for(n, [=] WB_HD(int64_t col) {
@@ -573,23 +572,12 @@ void grid_extent(GridDims d, const float* before, const float* after, GridExtent
     // extrapolation writes. before and after: the joint top, then the box's maxima.
     const float top = maxf(maxf(before[0], after[0]), 0.f);
     const int now = top + 1.f < float(d.nz) ? int(top) + 1 : d.nz;
-    int a[4], b[4];
+    int a[4], b[4], box[4], visit[4];
     column_box(d, before + 1, 1, a);
     column_box(d, after + 1, 1, b);
-    int box[4] = {imin(a[0], b[0]), imax(a[1], b[1]), imin(a[2], b[2]), imax(a[3], b[3])};
-    if (a[0] == a[1]) for (int s = 0; s < 4; ++s) box[s] = b[s];  // an empty box adds nothing
-    if (b[0] == b[1] && a[0] != a[1]) for (int s = 0; s < 4; ++s) box[s] = a[s];
+    box_union(a, b, box);
     // With what the last step visited for its liquid, which goes back to its value now.
-    int visit[4] = {box[0], box[1], box[2], box[3]};
-    const int* was = e->dirty_box;
-    if (was[0] != was[1]) {
-      if (box[0] == box[1]) {
-        for (int s = 0; s < 4; ++s) visit[s] = was[s];
-      } else {
-        visit[0] = imin(box[0], was[0]), visit[1] = imax(box[1], was[1]);
-        visit[2] = imin(box[2], was[2]), visit[3] = imax(box[3], was[3]);
-      }
-    }
+    box_union(box, e->dirty_box, visit);
     set_extent(*e, d, now > e->dirty ? now : e->dirty, visit[0], visit[1], visit[2], visit[3]);
     e->dirty = now;
     for (int s = 0; s < 4; ++s) e->dirty_box[s] = box[s];
