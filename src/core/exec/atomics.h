@@ -87,7 +87,7 @@ WB_HD WB_INLINE float atomic_max(float* addr, float v) {
 #endif
 }
 
-/// Two floats added to together: the particles' raster adds a mass and what it carries (oil,
+/// Two floats added together: the particles' raster adds a mass and what it carries (oil,
 /// momentum) to the same cell or face. The CPU adds both with one 8-byte compare-and-swap
 /// (each atomic is the cost there, so a pair halves it); CUDA adds each.
 struct alignas(8) FloatPair {
