@@ -182,11 +182,12 @@ WB_HD WB_INLINE void box_union(const int a[4], const int b[4], int out[4]) {
 WB_HD WB_INLINE void set_layers(GridExtent& e, const GridDims& d, int layers) {
   set_extent(e, d, layers, 0, d.nx, 0, d.ny);
 }
-/// The cell of index t among an extent's cells (x fastest, then y, then z).
+/// The cell of index t among an extent's cells (x fastest, then y, then z). A window's cells
+/// and faces number fewer than 2^32 (GridDims::split): 32-bit divisions, the cheaper.
 WB_HD WB_INLINE int64_t extent_cell(const GridDims& d, const GridExtent& e, int64_t t) {
-  const int64_t bx = e.x1 - e.x0, by = e.y1 - e.y0;
-  const int64_t row = t / bx, layer = row / by;
-  return (layer * d.ny + e.y0 + (row - layer * by)) * d.nx + e.x0 + (t - row * bx);
+  int i, j, k;
+  GridDims::split(uint32_t(t), uint32_t(e.x1 - e.x0), uint32_t(e.y1 - e.y0), i, j, k);
+  return (int64_t(k) * d.ny + e.y0 + j) * d.nx + e.x0 + i;
 }
 /// The face of index t among an extent's faces (u | v | w, each x fastest): its component c and
 /// index f in the component's array.
@@ -195,9 +196,10 @@ WB_HD WB_INLINE void extent_face(const GridDims& d, const GridExtent& e, int64_t
   const int64_t nu = (bx + 1) * by * e.layers, nv = bx * (by + 1) * e.layers;
   c = t < nu ? 0 : (t < nu + nv ? 1 : 2);
   const int64_t s = c == 0 ? t : (c == 1 ? t - nu : t - nu - nv);
-  const int64_t ex = bx + (c == 0), ey = by + (c == 1);  // the box's faces along x and y
-  const int64_t row = s / ex, layer = row / ey;
-  f = (layer * (d.ny + (c == 1)) + e.y0 + (row - layer * ey)) * (d.nx + (c == 0)) + e.x0 + (s - row * ex);
+  const int ex = int(bx) + (c == 0), ey = int(by) + (c == 1);  // the box's faces along x and y
+  int i, j, k;
+  GridDims::split(uint32_t(s), uint32_t(ex), uint32_t(ey), i, j, k);
+  f = (int64_t(k) * (d.ny + (c == 1)) + e.y0 + j) * (d.nx + (c == 0)) + e.x0 + i;
 }
 
 /// The pressure system A p = b on liquid cells (Batty et al. 2007 face fractions):
