@@ -26,7 +26,7 @@ void particles_adhesion_step(const Device& d, const ParticleView& p, const Sampl
 /// trilinearly (flip_kernels.h); the mass only when the face fields are all null. Particles
 /// outside the window are skipped.
 void particles_rasterise(const Device& d, const ParticleView& p, const ParticleRasterView& g);
-/// vel[c][f] = mom / weight on faces with weight > 0, else `empty` (e.g. 0).
+/// vel[c][f] = momentum / weight on faces with weight > 0, else `empty` (e.g. 0).
 void particles_face_velocity(const Device& d, const ParticleRasterView& g, float* const vel[3], float empty);
 /// Eq. 11 for every particle: before = joint field u before projection, after = u_bar.
 void particles_flip_pic(const Device& d, const ParticleView& p, const MacView& before, const MacView& after,
