@@ -419,6 +419,46 @@ TEST_F(GridStepTest, StagesVisitOnlyThePaintsLayersAndLeaveTheRestAsTheWholeWind
   EXPECT_LT(last_layers, 12) << "the extent follows the paint down when the particles are gone";
 }
 
+TEST_F(GridStepTest, AfterAWindowMoveNoFaceOutsideTheLiquidIsFluid) {
+  // The classes, flags and pressure are not shifted with the window (the paint and velocities
+  // are): after a move the old liquid's cells are where the array held them, which the last
+  // step's box (`dirty_box`) covers. A blob of paint stepped, the window moved under it by 12
+  // cells, then stepped again: every step's fluid flags equal a whole-window classification's,
+  // no non-liquid cell keeps a pressure, and the step after the move visits the two blobs' box,
+  // not the window.
+  TileStore canvas(device_, CanvasDims{256, 256, 32});
+  GridParams p;
+  Grid g(canvas, p, Int3{48, 32, 16}, Int3{32, 32, 0});
+  const GridDims d = g.dims();
+  paint_cells(g, [](int i, int j, int k) { return i >= 4 && i < 14 && j >= 10 && j < 20 && k < 5 ? 1.f : 0.f; });
+  auto copy_u8 = [&](const uint8_t* src, int64_t n) {
+    std::vector<uint8_t> out(static_cast<size_t>(n));
+    mem::copy_to_host(device_, out.data(), src, size_t(n));
+    return out;
+  };
+  int columns_after_move = 0;
+  for (int s = 0; s < 12; ++s) {
+    if (s == 4) ASSERT_TRUE(g.move_window(Int3{44, 32, 0}));
+    g.step(p.dt);
+    GridExtent e{};
+    g.extent().copy_to_host(&e, 1);
+    if (s == 4) columns_after_move = (e.x1 - e.x0) * (e.y1 - e.y0);
+    GridView v = g.view();
+    const auto cls = copy_u8(v.cls, d.cells());
+    std::vector<std::vector<uint8_t>> fluid;
+    for (int c = 0; c < 3; ++c) fluid.push_back(copy_u8(v.fluid[c], d.faces(c)));
+    const auto pressure = g.pressure().to_host();
+    for (int64_t c = 0; c < d.cells(); ++c)
+      if (cls[size_t(c)] != kCellLiquid) ASSERT_EQ(pressure[size_t(c)], 0.f) << "step " << s << " cell " << c;
+    g.classify();  // the whole window
+    for (int c = 0; c < 3; ++c)
+      EXPECT_EQ(copy_u8(v.fluid[c], d.faces(c)), fluid[size_t(c)]) << "step " << s << " component " << c;
+  }
+  // The blob's 10 x 10 columns before and after the move, 12 apart, a cell around: 24 x 12.
+  EXPECT_LE(columns_after_move, 26 * 14) << "the step after a move visits the old and new liquid's columns";
+  EXPECT_GT(columns_after_move, 22 * 10);
+}
+
 TEST_F(GridStepTest, DriedCellsNeverMove) {
   TileStore canvas(device_, CanvasDims{256, 256, 64});
   GridParams p;

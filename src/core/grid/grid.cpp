@@ -103,7 +103,6 @@ void extrapolate_d(const Device& d, GridView g) { WB_DISPATCH(d, grid_extrapolat
 void extent_d(const Device& d, GridDims g, const float* before, const float* after, GridExtent* e) {
   WB_DISPATCH(d, grid_extent(g, before, after, e));
 }
-void extent_moved_d(const Device& d, GridDims g, GridExtent* e) { WB_DISPATCH(d, grid_extent_moved(g, e)); }
 void dry_d(const Device& d, PaintWindowView pw, float amount) { WB_DISPATCH(d, grid_dry(pw, amount)); }
 void max_speed_d(const Device& d, GridView g, float* out) { WB_DISPATCH(d, grid_max_abs_fluid_velocity(g, out)); }
 void square_d(const Device& d, const float* x, float* out, int64_t n) { WB_DISPATCH(d, grid_square(x, out, n)); }
@@ -326,7 +325,6 @@ bool Grid::move_window(Int3 new_origin) {
   WB_PROFILE_SCOPE("grid.move_window");
   const bool moved = !(new_origin == window_.origin());
   window_.move_to(new_origin);
-  if (moved) extent_moved_d(device(), dims(), extent_.data());
   stats_.window_moved = moved;
   return moved;
 }

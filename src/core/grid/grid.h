@@ -242,7 +242,6 @@ class Grid {
   void grid_apply_pressure(GridView g, const float* p);                                                              \
   void grid_extrapolate(GridView g);                                                                                 \
   void grid_extent(GridDims d, const float* before, const float* after, GridExtent* e);                              \
-  void grid_extent_moved(GridDims d, GridExtent* e);                                                                 \
   void grid_dry(PaintWindowView pw, float amount);                                                                   \
   void grid_shift_lattice(const float* src, float* dst, int ex, int ey, int ez, int dx, int dy, int dz);            \
   void grid_max_abs_fluid_velocity(GridView g, float* out);                                                          \

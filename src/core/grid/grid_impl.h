@@ -584,13 +584,6 @@ void grid_extent(GridDims d, const float* before, const float* after, GridExtent
   });
 }
 
-void grid_extent_moved(GridDims d, GridExtent* e) {
-  // The classes and faces are not shifted with the window: every column is visited once more.
-  parallel_for(1, [=] WB_HD(int64_t) {
-    e->dirty_box[0] = 0, e->dirty_box[1] = d.nx, e->dirty_box[2] = 0, e->dirty_box[3] = d.ny;
-  });
-}
-
 void grid_dry(PaintWindowView pw, float amount) {
   parallel_for(pw.size(), [=] WB_HD(int64_t c) {
     if (pw.density[c] > 0.f) pw.dryness[c] = minf(pw.dryness[c] + amount, 1.f);
