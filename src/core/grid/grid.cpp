@@ -354,11 +354,7 @@ void Grid::advect(float dt) {
   // columns and layers holding them first, found on the device, for the outflow rates; the rest
   // once the one read has told how far the paint moves (below). Beyond, nothing in the step
   // reads them (docs/GRID.md).
-  const int64_t columns = int64_t(g.nx) * g.ny;
-  column_tops_d(d, g, paint.density.data(), particle_density_, kTraceDensity, cell_tmp_.data());
-  reduce_max_into(d, cell_tmp_.data(), columns, advect_max_.data() + kPaintTop, ws_);
-  for (int s = 0; s < 5; ++s)
-    reduce_max_into(d, cell_tmp_.data() + (s + 1) * columns, columns, advect_max_.data() + kJointTop + s, ws_);
+  column_maxima(kTraceDensity, kPaintTop);
   first_extent_d(d, g, advect_max_.data() + kJointTop, advect_extent_.data());
   within(advect_extent_.data(), [&] { classify(); });
   outflow_d(d, view(), paint.density.data(), face_tmp_.data());
@@ -466,13 +462,17 @@ void Grid::advect_paint(float dt, const int passes[3], int top) {
   }
 }
 
-void Grid::find_extent() {
+void Grid::column_maxima(float trace, int slot) {
   const GridDims g = dims();
   const int64_t columns = int64_t(g.nx) * g.ny;
-  column_tops_d(device(), g, window_.paint().density.data(), particle_density_, 0.f, cell_tmp_.data());
-  for (int s = 0; s < 5; ++s)
-    reduce_max_into(device(), cell_tmp_.data() + (s + 1) * columns, columns, advect_max_.data() + kExtentTop + s, ws_);
-  extent_d(device(), g, advect_max_.data() + kJointTop, advect_max_.data() + kExtentTop, extent_.data());
+  column_tops_d(device(), g, window_.paint().density.data(), particle_density_, trace, cell_tmp_.data());
+  for (int s = 0; s < 6; ++s)
+    reduce_max_into(device(), cell_tmp_.data() + s * columns, columns, advect_max_.data() + slot + s, ws_);
+}
+
+void Grid::find_extent() {
+  column_maxima(0.f, kExtentPaintTop);
+  extent_d(device(), dims(), advect_max_.data() + kJointTop, advect_max_.data() + kExtentTop, extent_.data());
 }
 
 void Grid::rheology() {

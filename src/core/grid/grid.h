@@ -161,12 +161,10 @@ class Grid {
   /// The fluid faces the solve's kernels run over (ListCount::n).
   DeviceBuffer<int64_t> cg_count_;
   int cg_last_iterations_ = 0;  ///< the last viscous solve's CG iterations: the next one plans on them
-  /// The advection's maxima, read in one copy: the outflow rate along each axis (slots 0-2), the
-  /// top layers holding paint and paint or particles and the box of the latter; then the joint
-  /// top and box after the particles joined (find_extent, not read).
-  /// kJointTop and kExtentTop are each followed by the maxima of x, -x, y, -y of the columns
-  /// holding paint or particles (grid_column_tops).
-  enum AdvectMax { kRateX = 0, kPaintTop = 3, kJointTop = 4, kExtentTop = 9, kAdvectMaxSlots = 14 };
+  /// The advection's maxima, read in one copy: the outflow rate along each axis (slots 0-2), then
+  /// column_maxima's six (the top layers holding paint and paint or particles, the latter's box);
+  /// then column_maxima's six again after the particles joined (find_extent, not read).
+  enum AdvectMax { kRateX = 0, kPaintTop = 3, kJointTop = 4, kExtentPaintTop = 9, kExtentTop = 10, kAdvectMaxSlots = 15 };
   DeviceBuffer<float> advect_max_;
   DeviceBuffer<int32_t> tile_mark_, tile_active_, tile_halo_;  ///< the advection's tiles (PaintTiles)
   /// Per tile: whether it held paint after the last pass and after this one (swapped each
@@ -192,6 +190,9 @@ class Grid {
   }
   /// The layers holding paint or particles now, or liquid before the advection: extent_.
   void find_extent();
+  /// The maxima of grid_column_tops (paint and particles above `trace`) into advect_max_'s six
+  /// slots from `slot`: the paint's top, the joint top, then x, -x, y, -y of the joint columns.
+  void column_maxima(float trace, int slot);
   /// The paint's flux-form passes of advect(): passes[a] along axis a, the paint below layer top.
   void advect_paint(float dt, const int passes[3], int top);
   PaintWindow paint_tmp_;
