@@ -24,6 +24,7 @@ struct Scene {
   ParticleStore store{d};
   SampleHashGrid grid{d};
   ParticleParams prm;
+  test::Region region;  ///< the particles' box grown by the longest range queried (D0)
   float dt = 1.f / 60.f;
 
   Scene() {
@@ -62,6 +63,7 @@ struct Scene {
       ph.m[k] = 1e-9f;
     }
     store.append(ph);
+    region = test::region_around(ph.x, prm.D0);
   }
 };
 
@@ -73,7 +75,7 @@ Scene& scene() {
 void BM_SampleHashBuild(benchmark::State& state) {
   Scene& s = scene();
   for (auto _ : state) {
-    s.grid.build(s.ds.view(), float(state.range(0)), s.ws, s.dt);
+    s.grid.build(s.ds.view(), float(state.range(0)), s.region.lo, s.region.hi, s.ws, s.dt);
     s.d.synchronize();
   }
   state.SetItemsProcessed(state.iterations() * s.ds.view().count());
@@ -82,7 +84,7 @@ BENCHMARK(BM_SampleHashBuild)->Arg(4)->Unit(benchmark::kMicrosecond);
 
 void BM_NearestSampleQuery(benchmark::State& state) {
   Scene& s = scene();
-  s.grid.build(s.ds.view(), float(state.range(0)), s.ws, s.dt);
+  s.grid.build(s.ds.view(), float(state.range(0)), s.region.lo, s.region.hi, s.ws, s.dt);
   // 0: D1 (Eq. 10), 1: D0, 2: one cell (the absorption's load spheres, Eq. 14)
   const float range = state.range(1) == 0 ? s.prm.D1 : (state.range(1) == 1 ? s.prm.D0 : 1.f);
   for (auto _ : state) {
@@ -103,7 +105,7 @@ BENCHMARK(BM_NearestSampleQuery)
 
 void BM_AdhesionStep(benchmark::State& state) {
   Scene& s = scene();
-  s.grid.build(s.ds.view(), s.prm.hash_cell, s.ws, s.dt);
+  s.grid.build(s.ds.view(), s.prm.hash_cell, s.region.lo, s.region.hi, s.ws, s.dt);
   s.grid.query_nearest(s.store.view(), s.prm.D0);
   const ParticleHost start = s.store.to_host();
   SolidView solid;

@@ -93,7 +93,8 @@ struct TransferScene {
     load.from_host(load0);
     store.clear();
     store.append(particles0);
-    grid.build(ds.view(), 4.f, ws);
+    const test::Region r = test::region_around(particles0.x, 4.f);
+    grid.build(ds.view(), 4.f, r.lo, r.hi, ws);
     grid.query_nearest(store.view(), 4.f);  // absorption needs the nearest sample within R_j < 1 cell
     env.paint = window.view();
     d.synchronize();

@@ -91,7 +91,8 @@ TEST_F(AdhesionTest, BlendWeightsOfEq10) {
   ParticleStore store(device_);
   store.append(particles_at({start[0], start[1]}, v0));
   SampleHashGrid grid(device_);
-  grid.build(ds.view(), 4.f, ws_, kDt);
+  const Region r = region_around({start[0], start[1]}, 50.f);
+  grid.build(ds.view(), 4.f, r.lo, r.hi, ws_, kDt);
   grid.query_nearest(store.view(), 50.f);
   ParticleParams prm;
   prm.gravity = Vec3();
@@ -271,7 +272,8 @@ float figure8_max_distance(const Device& device, Workspace& ws, Method method, V
     ParticleHost h;
     if (method == Method::TwoStep) {
       ds.upload(hs);
-      grid.build(ds.view(), prm.hash_cell, ws, kDt);
+      const Region r = region_around(store.to_host().x, prm.D0);
+      grid.build(ds.view(), prm.hash_cell, r.lo, r.hi, ws, kDt);
       grid.query_nearest(store.view(), prm.D0);
       particles_adhesion_step(device, store.view(), ds.view(), solid, prm, kDt);
       h = store.to_host();

@@ -1,4 +1,4 @@
-// Sample hash grid (paper §6, Green 2010): the nearest-sample query against brute force.
+// Sample grid (paper §6, Green 2010): the nearest-sample query against brute force.
 #include <random>
 
 #include "backend_fixture.h"
@@ -45,11 +45,12 @@ TEST_F(HashGridTest, NearestSampleEqualsBruteForce) {
   ParticleStore store(device_);
   store.append(particles_at(px));
   SampleHashGrid grid(device_);
-  // Ranges below, near and above the coarse occupancy's cell (4 h), as the absorption's load
-  // sphere, Eq. 10's D1 and D0 use them.
+  // Ranges within a cell and over many cells, as the absorption's load sphere, Eq. 10's D1
+  // and D0 use them.
   for (float h : {2.f, 4.f, 15.f}) {
     for (float range : {0.75f, 5.f, 15.f, 50.f}) {
-      grid.build(ds.view(), h, ws_);
+      const Region r = region_around(px, range);
+      grid.build(ds.view(), h, r.lo, r.hi, ws_);
       grid.query_nearest(store.view(), range);
       const auto nearest = store.nearest.to_host();
       const auto dB = store.d_B.to_host();
@@ -65,6 +66,26 @@ TEST_F(HashGridTest, NearestSampleEqualsBruteForce) {
       if (range >= 15.f) EXPECT_LT(misses, int(px.size()) - 100);
     }
   }
+  // A region that cuts the brush: the particles of one corner, the region their box grown by
+  // the range. The samples outside it are not filed, and the answers stay exact.
+  std::vector<Vec3> corner;
+  for (const Vec3& x : px)
+    if (x.x < 1020.f && x.y < 2030.f) corner.push_back(x);
+  ASSERT_GT(corner.size(), 500u);
+  ParticleStore some(device_);
+  some.append(particles_at(corner));
+  const Region r = region_around(corner, 15.f);
+  grid.build(ds.view(), 2.f, r.lo, r.hi, ws_);
+  EXPECT_LT(grid.cell_capacity(), 60 * 60 * 60) << "the region's cells, not the samples'";
+  grid.query_nearest(some.view(), 15.f);
+  const auto nearest = some.nearest.to_host();
+  int hits = 0;
+  for (size_t k = 0; k < corner.size(); ++k) {
+    const NearestSample ref = nearest_sample_brute_force(hs.x.data(), int64_t(hs.x.size()), corner[k], 15.f);
+    ASSERT_EQ(nearest[k], ref.index) << "corner particle " << k;
+    hits += ref.index >= 0;
+  }
+  EXPECT_GT(hits, 100);
 }
 
 TEST_F(HashGridTest, RewindHashesStartOfStepPositions) {
@@ -77,10 +98,11 @@ TEST_F(HashGridTest, RewindHashesStartOfStepPositions) {
   ParticleStore store(device_);
   store.append(particles_at({Vec3(100.f, 108.f, 40.f)}));
   SampleHashGrid grid(device_);
-  grid.build(ds.view(), 4.f, ws_);
+  const Region r = region_around({Vec3(100.f, 108.f, 40.f)}, 50.f);
+  grid.build(ds.view(), 4.f, r.lo, r.hi, ws_);
   grid.query_nearest(store.view(), 50.f);
   EXPECT_NEAR(store.d_B.to_host()[0], 10.f, 1e-4f);
-  grid.build(ds.view(), 4.f, ws_, 1.f / 60.f);
+  grid.build(ds.view(), 4.f, r.lo, r.hi, ws_, 1.f / 60.f);
   grid.query_nearest(store.view(), 50.f);
   EXPECT_NEAR(store.d_B.to_host()[0], 0.f, 1e-4f);
   EXPECT_EQ(store.nearest.to_host()[0], 10);
@@ -95,13 +117,16 @@ TEST_F(HashGridTest, EmptySamplesAndBadInput) {
   store.append(particles_at({Vec3(1, 2, 3), Vec3(4, 5, 6)}));
   SampleHashGrid grid(device_);
   EXPECT_THROW(grid.query_nearest(store.view(), 15.f), Error);  // not built
-  grid.build(ds.view(), 4.f, ws_);
+  const Region r = region_around({Vec3(1, 2, 3), Vec3(4, 5, 6)}, 15.f);
+  grid.build(ds.view(), 4.f, r.lo, r.hi, ws_);
   grid.query_nearest(store.view(), 15.f);
   for (int k = 0; k < 2; ++k) {
     EXPECT_EQ(store.nearest.to_host()[k], -1);
     EXPECT_EQ(store.d_B.to_host()[k], 15.f);
   }
-  EXPECT_THROW(grid.build(ds.view(), 0.f, ws_), Error);
+  EXPECT_THROW(grid.build(ds.view(), 0.f, r.lo, r.hi, ws_), Error);
+  EXPECT_THROW(grid.build(ds.view(), 4.f, r.hi, r.lo, ws_), Error);                         // empty region
+  EXPECT_THROW(grid.build(ds.view(), 0.01f, Vec3(-1e4f, -1e4f, -1e4f), Vec3(1e4f, 1e4f, 1e4f), ws_), Error);         // too many cells
   EXPECT_THROW(grid.query_nearest(store.view(), -1.f), Error);
 }
 

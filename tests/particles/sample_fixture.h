@@ -10,6 +10,23 @@
 
 namespace wb::test {
 
+/// The box of `points` grown by `range`: the region a sample grid is built for when its queries
+/// of that range start from those points (SampleHashGrid::build).
+struct Region {
+  Vec3 lo, hi;
+};
+inline Region region_around(const std::vector<Vec3>& points, float range) {
+  if (points.empty()) return Region{Vec3(-range, -range, -range), Vec3(range, range, range)};
+  Region r{Vec3(1e30f, 1e30f, 1e30f), Vec3(-1e30f, -1e30f, -1e30f)};
+  for (const Vec3& p : points) {
+    r.lo = Vec3(fminf(r.lo.x, p.x), fminf(r.lo.y, p.y), fminf(r.lo.z, p.z));
+    r.hi = Vec3(fmaxf(r.hi.x, p.x), fmaxf(r.hi.y, p.y), fmaxf(r.hi.z, p.z));
+  }
+  r.lo = r.lo - Vec3(range, range, range);
+  r.hi = r.hi + Vec3(range, range, range);
+  return r;
+}
+
 struct HostSamples {
 #define WB_X(type, name, doc) std::vector<type> name;
   WB_SAMPLE_FIELDS(WB_X)

@@ -408,7 +408,8 @@ struct BooksScene {
   }
   TransferRecord step(Workspace& ws) {
     SampleHashGrid grid(device);
-    grid.build(s.view(), 2.f, ws);
+    const Region r = region_around(p.to_host().x, 12.f);
+    grid.build(s.view(), 2.f, r.lo, r.hi, ws);
     grid.query_nearest(p.view(), 12.f);
     TransferEnv env;
     env.paint = w.view();

@@ -68,7 +68,8 @@ class TransferTest : public BackendTest {
   /// Sets every particle's nearest sample (range `range`) with the sample hash grid.
   void query_nearest(DeviceSamples& s, ParticleStore& p, float range) {
     SampleHashGrid grid(device_);
-    grid.build(s.view(), 2.f, ws_);
+    const Region r = region_around(p.to_host().x, range);
+    grid.build(s.view(), 2.f, r.lo, r.hi, ws_);
     grid.query_nearest(p.view(), range);
   }
 

@@ -1,4 +1,4 @@
-// Sample hash grid: validation and the one runtime dispatch.
+// Sample grid: validation and the one runtime dispatch.
 #include "core/particles/hash_grid.h"
 
 #include <cmath>
@@ -10,29 +10,43 @@
 
 namespace wb {
 namespace {
-void keys(const Device& d, const Vec3* x, const Vec3* v, float rw, int64_t n, float inv_h, uint32_t mask, uint32_t* k,
-          uint32_t* idx, int32_t* bounds, int32_t* coarse) {
-  WB_DISPATCH(d, hash_grid_keys(x, v, rw, n, inv_h, mask, k, idx, bounds, coarse));
+void box(const Device& d, const Vec3* x, const Vec3* v, float rw, int64_t n, float inv_h, CellBox r, int32_t* b) {
+  WB_DISPATCH(d, hash_grid_box(x, v, rw, n, inv_h, r, b));
 }
-void ranges(const Device& d, const uint32_t* k, const uint32_t* idx, const Vec3* x, const Vec3* v, float rw, int64_t n,
-            uint32_t* s, uint32_t* e, Vec3* sx) {
-  WB_DISPATCH(d, hash_grid_ranges(k, idx, x, v, rw, n, s, e, sx));
+void keys(const Device& d, const Vec3* x, const Vec3* v, float rw, int64_t n, float inv_h, CellBox r,
+          const int32_t* b, uint32_t* k, uint32_t* idx) {
+  WB_DISPATCH(d, hash_grid_keys(x, v, rw, n, inv_h, r, b, k, idx));
+}
+void first(const Device& d, const uint32_t* k, const uint32_t* idx, const Vec3* x, const Vec3* v, float rw, int64_t n,
+           const int32_t* b, uint32_t* f, Vec3* sx) {
+  WB_DISPATCH(d, hash_grid_first(k, idx, x, v, rw, n, b, f, sx));
+}
+void coarse(const Device& d, const int32_t* b, const uint32_t* f, int64_t cap, uint8_t* occ) {
+  WB_DISPATCH(d, hash_grid_coarse(b, f, cap, occ));
+}
+void near(const Device& d, const int32_t* b, const uint8_t* occ, int reach, int64_t cap, uint8_t* out) {
+  WB_DISPATCH(d, hash_grid_near(b, occ, reach, cap, out));
 }
 void query(const Device& d, HashGridView g, ParticleView p, float r) { WB_DISPATCH(d, hash_grid_query(g, p, r)); }
+
+/// The grid's cell table holds at most this many cells (16 M, 64 MiB): a region larger than
+/// that is a caller's error, not a brush.
+constexpr int64_t kMaxCells = int64_t(1) << 24;
 }  // namespace
 
 SampleHashGrid::SampleHashGrid(const Device& device) : device_(device) {
   keys_.set_device(device);
   index_.set_device(device);
-  start_.set_device(device);
-  end_.set_device(device);
+  first_.set_device(device);
+  occupied_.set_device(device);
+  near_.set_device(device);
   sorted_x_.set_device(device);
-  bounds_.set_device(device);
-  bounds_.resize(6);
-  coarse_.set_device(device);
+  box_.set_device(device);
+  box_.resize(6);
 }
 
-void SampleHashGrid::build(const SampleView& s, float cell_size, Workspace& ws, float rewind_dt) {
+void SampleHashGrid::build(const SampleView& s, float cell_size, Vec3 region_lo, Vec3 region_hi, Workspace& ws,
+                           float rewind_dt) {
   WB_REQUIRE(std::isfinite(cell_size) && cell_size > 0.f,
              "SampleHashGrid::build: cell size must be positive, got " + std::to_string(cell_size));
   WB_REQUIRE(s.bristles >= 0 && s.per_bristle >= 0, "SampleHashGrid::build: negative sample counts");
@@ -41,43 +55,58 @@ void SampleHashGrid::build(const SampleView& s, float cell_size, Workspace& ws, 
   WB_REQUIRE(n == 0 || s.x != nullptr, "SampleHashGrid::build: sample positions are null");
   WB_REQUIRE(std::isfinite(rewind_dt) && rewind_dt >= 0.f, "SampleHashGrid::build: rewind time must be >= 0");
   WB_REQUIRE(rewind_dt == 0.f || n == 0 || s.v != nullptr, "SampleHashGrid::build: rewinding needs sample velocities");
+  WB_REQUIRE(isfinite3(region_lo) && isfinite3(region_hi), "SampleHashGrid::build: the region is not finite");
   count_ = n;
   h_ = cell_size;
-  // About two buckets per sample keeps collisions rare; at least 1024.
-  int bits = 10;
-  while ((int64_t(1) << bits) < 2 * n && bits < 30) ++bits;
-  mask_ = (uint32_t(1) << bits) - 1u;
-  const size_t buckets = size_t(mask_) + 1;
-  if (start_.size() < buckets) {
-    start_.grow_keep(buckets);
-    end_.grow_keep(buckets);
-    coarse_.grow_keep(buckets);
+  const float inv_h = 1.f / h_;
+  CellBox region;
+  int lo[3], hi[3];
+  hash_cell_of(region_lo, inv_h, lo[0], lo[1], lo[2]);
+  hash_cell_of(region_hi, inv_h, hi[0], hi[1], hi[2]);
+  int64_t cells = 1, coarse_cells = 1;
+  for (int a = 0; a < 3; ++a) {
+    WB_REQUIRE(lo[a] <= hi[a], "SampleHashGrid::build: the region is empty");
+    region.lo[a] = lo[a];
+    region.hi[a] = hi[a];
+    cells *= int64_t(hi[a]) - lo[a] + 1;
+    coarse_cells *= coarse_count(int64_t(hi[a]) - lo[a] + 1);
+    WB_REQUIRE(cells <= kMaxCells, "SampleHashGrid::build: the region spans more than " +
+                                       std::to_string(kMaxCells) + " cells of " + std::to_string(cell_size));
   }
-  start_.fill_zero();
-  end_.fill_zero();
-  coarse_.fill_zero();
+  capacity_ = cells;
+  coarse_capacity_ = coarse_cells;
+  if (first_.size() < size_t(cells) + 1) first_.grow_keep(size_t(cells) + 1);
+  if (occupied_.size() < size_t(coarse_cells)) {
+    occupied_.grow_keep(size_t(coarse_cells));
+    near_.grow_keep(size_t(coarse_cells));
+  }
   if (keys_.size() < size_t(n)) {
     keys_.grow_keep(size_t(n));
     index_.grow_keep(size_t(n));
     sorted_x_.grow_keep(size_t(n));
   }
-  keys(device_, s.x, s.v, rewind_dt, n, 1.f / h_, mask_, keys_.data(), index_.data(), bounds_.data(),
-       coarse_.data());
-  if (n == 0) return;
-  sort_by_key(device_, keys_.data(), index_.data(), n, bits, ws);
-  ranges(device_, keys_.data(), index_.data(), s.x, s.v, rewind_dt, n, start_.data(), end_.data(), sorted_x_.data());
+  box(device_, s.x, s.v, rewind_dt, n, inv_h, region, box_.data());
+  keys(device_, s.x, s.v, rewind_dt, n, inv_h, region, box_.data(), keys_.data(), index_.data());
+  int bits = 1;  // keys run to the box's cells, at most the region's
+  while ((int64_t(1) << bits) <= cells) ++bits;
+  if (n > 0) sort_by_key(device_, keys_.data(), index_.data(), n, bits, ws);
+  first(device_, keys_.data(), index_.data(), s.x, s.v, rewind_dt, n, box_.data(), first_.data(), sorted_x_.data());
+  coarse(device_, box_.data(), first_.data(), coarse_capacity_, occupied_.data());
 }
 
 HashGridView SampleHashGrid::view() const {
-  return HashGridView{start_.data(), end_.data(), index_.data(), sorted_x_.data(), count_, h_, mask_, bounds_.data(),
-                      coarse_.data()};
+  return HashGridView{first_.data(), index_.data(), sorted_x_.data(), count_, h_, box_.data(), near_.data()};
 }
 
-void SampleHashGrid::query_nearest(const ParticleView& p, float max_range) const {
+void SampleHashGrid::query_nearest(const ParticleView& p, float max_range) {
   WB_REQUIRE(std::isfinite(max_range) && max_range > 0.f,
              "SampleHashGrid::query_nearest: range must be positive, got " + std::to_string(max_range));
-  WB_REQUIRE(start_.size() > 0, "SampleHashGrid::query_nearest: build() was not called");
+  WB_REQUIRE(first_.size() > 0, "SampleHashGrid::query_nearest: build() was not called");
   WB_REQUIRE(p.count >= 0, "SampleHashGrid::query_nearest: negative particle count");
+  // A sample within max_range of a point lies at most this many coarse cells from the point's
+  // (floor(a + d) - floor(a) <= ceil(d)), one more for the thousandth of a cell of rounding.
+  const int reach = int(max_range / (h_ * float(kCoarse)) + 1e-3f) + 1;
+  near(device_, box_.data(), occupied_.data(), reach, coarse_capacity_, near_.data());
   query(device_, view(), p, max_range);
 }
 

@@ -1,9 +1,11 @@
-// Sample hash grid (paper §6, Green 2010): built from the bristle samples every step,
-// queried from the particles for the nearest sample and the distance to it, within the
-// range its user needs (d_B of Eq. 10 within D1; Eq. 14's absorber within the load sphere).
-// "Within D0" of §5.2 is the coarse distance field of the transfer stage, not this query.
-// Three launches to build: bucket keys (and the coarse occupancy), radix sort, bucket ranges;
-// one to gather the sorted positions.
+// Sample grid (paper §6, Green 2010): built from the bristle samples every step, queried
+// from the particles for the nearest sample and the distance to it, within the range its user
+// needs (d_B of Eq. 10 within D1; Eq. 14's absorber within the load sphere). "Within D0" of
+// §5.2 is the coarse distance field of the transfer stage, not this query. The samples are
+// sorted by their cell in the dense box of cells they occupy (within the region the queries
+// ask about), so that a run of cells along x is one range of the sorted list (docs/PARTICLES.md
+// "Nearest sample"). Four launches to build: the box, the keys, a radix sort, each cell's
+// first slot with the sorted positions.
 #pragma once
 #include <cstdint>
 
@@ -16,52 +18,67 @@
 
 namespace wb {
 
+/// A box of grid cells, inclusive: lo[a] <= cell <= hi[a] along each axis.
+struct CellBox {
+  int32_t lo[3], hi[3];
+};
+
 class SampleHashGrid {
  public:
   SampleHashGrid() = default;
   explicit SampleHashGrid(const Device& device);
 
-  /// Hashes the samples into cells of size cell_size (canvas cells), at x - v rewind_dt.
-  /// The brush step runs first, so its samples hold t + dt while the particles are still at
-  /// t: the simulator passes the step's dt to compare both at t (the frame Eq. 9 starts
-  /// from, see local_frame_step); 0 hashes x as it is. Buffers grow geometrically and are
-  /// kept: no allocation once warm.
-  void build(const SampleView& samples, float cell_size, Workspace& ws, float rewind_dt = 0.f);
+  /// Files the samples that lie in `region` (canvas cells, lo to hi) into cells of size
+  /// cell_size (canvas cells), at x - v rewind_dt. The region is where the queries' points lie,
+  /// grown by their range: a query then sees every sample within its range, and the grid's
+  /// memory is bounded by the region's cells whatever the samples do (the simulator's: the
+  /// window, where the particles live). The brush step runs first, so its samples hold t + dt
+  /// while the particles are still at t: the simulator passes the step's dt to compare both
+  /// at t (the frame Eq. 9 starts from, see local_frame_step); 0 files x as it is. Buffers
+  /// grow geometrically and are kept: no allocation once warm.
+  void build(const SampleView& samples, float cell_size, Vec3 region_lo, Vec3 region_hi, Workspace& ws,
+             float rewind_dt = 0.f);
   /// For every particle: nearest = nearest sample within max_range (-1: none), d_B = its
-  /// distance (max_range when none), key = the particle's bucket.
-  void query_nearest(const ParticleView& particles, float max_range) const;
+  /// distance (max_range when none). Exact for a particle whose range lies in the region; one
+  /// beyond sees only the region's samples.
+  void query_nearest(const ParticleView& particles, float max_range);
 
   HashGridView view() const;
   const Device& device() const { return device_; }
   int64_t sample_count() const { return count_; }
-  uint32_t bucket_count() const { return mask_ + 1; }
+  /// Cells the last build could use (the region's), the size of its cell table less one.
+  int64_t cell_capacity() const { return capacity_; }
 
  private:
   Device device_;
   int64_t count_ = 0;
   float h_ = 1.f;
-  uint32_t mask_ = 0;
-  DeviceBuffer<uint32_t> keys_, index_, start_, end_;
+  int64_t capacity_ = 0, coarse_capacity_ = 0;
+  DeviceBuffer<uint32_t> keys_, index_, first_;
+  DeviceBuffer<uint8_t> occupied_, near_;  ///< per coarse cell: holds a sample; one within the range
   DeviceBuffer<Vec3> sorted_x_;
-  DeviceBuffer<int32_t> bounds_, coarse_;  ///< the samples' cell box; coarse occupancy per bucket
+  DeviceBuffer<int32_t> box_;  ///< the cells of the samples in the region
 };
 
 /// Reference for tests: the nearest sample to p among all n (host arrays), within max_range.
 NearestSample nearest_sample_brute_force(const Vec3* samples, int64_t n, Vec3 p, float max_range);
 
+#define WB_HASH_GRID_BACKEND_DECLS                                                                               \
+  void hash_grid_box(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, CellBox region,      \
+                     int32_t* box);                                                                              \
+  void hash_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, CellBox region,     \
+                      const int32_t* box, uint32_t* keys, uint32_t* index);                                      \
+  void hash_grid_first(const uint32_t* sorted_keys, const uint32_t* index, const Vec3* x, const Vec3* v,         \
+                       float rewind_dt, int64_t n, const int32_t* box, uint32_t* first, Vec3* sorted_x);         \
+  void hash_grid_coarse(const int32_t* box, const uint32_t* first, int64_t capacity, uint8_t* occupied);           \
+  void hash_grid_near(const int32_t* box, const uint8_t* occupied, int reach, int64_t capacity, uint8_t* near);      \
+  void hash_grid_query(HashGridView g, ParticleView p, float max_range);
+
 namespace cpu {
-void hash_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, uint32_t mask,
-                    uint32_t* keys, uint32_t* index, int32_t* bounds, int32_t* coarse);
-void hash_grid_ranges(const uint32_t* sorted_keys, const uint32_t* index, const Vec3* x, const Vec3* v, float rewind_dt,
-                      int64_t n, uint32_t* start, uint32_t* end, Vec3* sorted_x);
-void hash_grid_query(HashGridView g, ParticleView p, float max_range);
+WB_HASH_GRID_BACKEND_DECLS
 }  // namespace cpu
 namespace cuda {
-void hash_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, uint32_t mask,
-                    uint32_t* keys, uint32_t* index, int32_t* bounds, int32_t* coarse);
-void hash_grid_ranges(const uint32_t* sorted_keys, const uint32_t* index, const Vec3* x, const Vec3* v, float rewind_dt,
-                      int64_t n, uint32_t* start, uint32_t* end, Vec3* sorted_x);
-void hash_grid_query(HashGridView g, ParticleView p, float max_range);
+WB_HASH_GRID_BACKEND_DECLS
 }  // namespace cuda
 
 }  // namespace wb

@@ -21,7 +21,6 @@
 #define WB_PARTICLE_SCRATCH_FIELDS(X)                                                        \
   X(int32_t, nearest, "index of the nearest bristle sample within the query range, -1: none") \
   X(float, d_B, "distance to the nearest bristle sample, cells, capped at the query range")   \
-  X(uint32_t, key, "hash bucket of the particle's cell in the sample hash grid")             \
   X(uint32_t, dead, "1: remove at the next compaction (absorbed, moved to the grid)")
 
 #define WB_PARTICLE_FIELDS(X) \

@@ -59,7 +59,7 @@ void particles_solid_height(const Device& d, const PaintWindowView& pw, const fl
 /// first that is not. Paint held up in the air above a gap is not ground.
 void particles_ground_surface(const Device& d, const PaintWindowView& pw, const float* particle_density,
                               float dry_threshold, float liquid_threshold, float floor_z, float* surface);
-/// Scratch of particles [first, first + n): nearest = -1, d_B = 0, key = 0, dead = 0.
+/// Scratch of particles [first, first + n): nearest = -1, d_B = 0, dead = 0.
 void particles_init_scratch(const Device& d, const ParticleView& p, int64_t first, int64_t n);
 
 #define WB_PARTICLES_BACKEND_DECLS                                                                                 \

@@ -71,7 +71,6 @@ void particles_init_scratch(ParticleView p, int64_t first, int64_t n) {
     const int64_t k = first + i;
     p.nearest[k] = -1;
     p.d_B[k] = 0.f;
-    p.key[k] = 0u;
     p.dead[k] = 0u;
   });
 }

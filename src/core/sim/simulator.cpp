@@ -492,8 +492,9 @@ void Simulator::step(const BrushPose* pen_poses, int substeps, float dt) {
     if (config_.particles) {
       // The absorption candidates are found against this step's samples, as far as the
       // largest load sphere reaches (Eq. 14 takes a particle only inside R_j).
-      hash_.build(brush_->samples(), config_.params.particles.hash_cell, ws_, 0.f);
-      hash_.query_nearest(particles_.view(), transfer_->params().absorb_range());
+      const float range = transfer_->params().absorb_range();
+      build_sample_grid(range, 0.f);
+      hash_.query_nearest(particles_.view(), range);
     }
     TransferEnv env = transfer_env();
     env.dt = dt;  // wicking along the bristles over this step
@@ -560,7 +561,7 @@ void Simulator::particle_stage(float dt) {
   const ParticleParams& prm = config_.params.particles;
   // Samples are at t + dt, particles at t: hash the samples rewound to t (hash_grid.h). The
   // query reaches D1, the range of Eq. 10: beyond it no sample moves a particle.
-  hash_.build(brush_->samples(), prm.hash_cell, ws_, dt);
+  build_sample_grid(prm.D1, dt);
   hash_.query_nearest(particles_.view(), prm.D1);
   // The particles rest on the canvas and on dried paint (d_k of Eq. 8 is measured to both), and
   // free ones land on the wet paint's surface. The wet paint is the joint paint, grid and
@@ -585,6 +586,18 @@ void Simulator::particle_stage(float dt) {
   solid.oy = win.origin().y;
   particles_adhesion_step(device(), particles_.view(), brush_->samples(), solid, prm, dt);
   clamp_particles_to_canvas();
+}
+
+void Simulator::build_sample_grid(float range, float rewind_dt) {
+  // Where the particles are: in the window's columns (one that enters its rim goes to the grid,
+  // docs/TRANSFER.md "The particle zone"), at any height of the canvas (paint held by bristles
+  // above the window's layers). The samples within `range` of that are all their queries can
+  // find, and the grid's cells are bounded by it.
+  const ActiveWindow& win = grid_->window();
+  const Int3 o = win.origin(), n = win.dims();
+  const Vec3 lo(float(o.x) - range, float(o.y) - range, -range);
+  const Vec3 hi(float(o.x + n.x) + range, float(o.y + n.y) + range, float(config_.canvas.depth) + range);
+  hash_.build(brush_->samples(), config_.params.particles.hash_cell, lo, hi, ws_, rewind_dt);
 }
 
 void Simulator::clamp_particles_to_canvas() {

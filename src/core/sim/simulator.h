@@ -166,6 +166,9 @@ class Simulator {
   static constexpr size_t kCheckedArrays = kPaintFieldCount + 3 + 5 + kNonfiniteParticleArrays;
   std::array<std::pair<float*, int64_t>, kCheckedArrays> checked_arrays();
   void clamp_particles_to_canvas();
+  /// Files the brush's samples (at x - v rewind_dt) in hash_ for queries of `range` from the
+  /// particles: the window's columns and the canvas's depth.
+  void build_sample_grid(float range, float rewind_dt);
   TransferEnv transfer_env();
   /// The ground per column of the window as it is now (TransferEnv::surface).
   const float* paint_surface();
