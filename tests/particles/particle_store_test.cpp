@@ -1,5 +1,6 @@
 // Particle store (paper §4.3, §5): growth, append, flag-and-compact removal.
 #include <numeric>
+#include <random>
 
 #include "backend_fixture.h"
 #include "core/particles/particle_store.h"
@@ -107,6 +108,63 @@ TEST_F(ParticleStoreTest, LimitAndBadBatches) {
   EXPECT_THROW(store.set_limit(1000), Error);
   EXPECT_THROW(ParticleStore(device_, 0), Error);
   EXPECT_EQ(ParticleStore(device_).limit(), 2000000);
+}
+
+}  // namespace wb::test
+
+namespace wb::test {
+
+TEST_F(ParticleStoreTest, SortByCellOrdersByHalfCellAndKeepsEachParticleWhole) {
+  // 3000 particles over a 20 x 16 x 8 window at (100, 50, 0) and a few cells around it (those
+  // outside go last), each carrying its index in its pigment so that it can be followed.
+  const Int3 origin{100, 50, 0}, dims{20, 16, 8};
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> U(0.f, 1.f);
+  const int n = 3000;
+  ParticleHost h;
+  h.resize(n);
+  for (int i = 0; i < n; ++i) {
+    h.x[i] = Vec3(97.f + 26.f * U(rng), 47.f + 22.f * U(rng), -2.f + 12.f * U(rng));
+    h.v[i] = Vec3(float(i), 0.f, 1.f);
+    h.m[i] = 1e-9f;
+    h.pigment_r[i] = float(i);
+  }
+  ParticleStore store(device_);
+  store.append(h);
+  Workspace ws(device_);
+  store.sort_by_cell(origin, dims, ws);
+  ASSERT_EQ(store.size(), n);
+  const ParticleHost s = store.to_host();
+  auto key = [&](Vec3 x) -> int64_t {
+    const float q[3] = {x.x - origin.x, x.y - origin.y, x.z - origin.z};
+    const int e[3] = {dims.x, dims.y, dims.z};
+    int64_t k = 0;
+    for (int a = 2; a >= 0; --a) {
+      if (!(q[a] >= 0.f && q[a] < float(e[a]))) return int64_t(8) * dims.x * dims.y * dims.z;
+      k = k * (2 * e[a]) + int64_t(2.f * q[a]);
+    }
+    return k;
+  };
+  std::vector<int> seen(n, 0);
+  int outside = 0;
+  for (int i = 0; i < n; ++i) {
+    const int id = int(s.pigment_r[i]);
+    ASSERT_GE(id, 0);
+    ASSERT_LT(id, n);
+    ++seen[id];
+    // Every field moved with its particle.
+    EXPECT_EQ(s.x[i].x, h.x[id].x);
+    EXPECT_EQ(s.x[i].z, h.x[id].z);
+    EXPECT_EQ(s.v[i].x, float(id));
+    outside += key(s.x[i]) == int64_t(8) * dims.x * dims.y * dims.z;
+    if (i == 0) continue;
+    const int64_t k0 = key(s.x[i - 1]), k1 = key(s.x[i]);
+    ASSERT_LE(k0, k1) << "half cells in order, x fastest: " << i;
+    if (k0 == k1) EXPECT_LT(int(s.pigment_r[i - 1]), id) << "stable within a half cell";
+  }
+  for (int id = 0; id < n; ++id) EXPECT_EQ(seen[id], 1) << id;
+  EXPECT_GT(outside, 100);
+  EXPECT_LT(outside, n - 100);
 }
 
 }  // namespace wb::test

@@ -23,38 +23,69 @@ struct ParticleRasterView {
   int ox, oy, oz;  ///< canvas cell of the window's cell (0, 0, 0)
 };
 
-/// Splats the pair (a, b) trilinearly onto a node grid of ex x ey x ez nodes at offsets (ox, oy, oz):
-/// the cloud-in-cell weights of sample_nodes, so splat and sample are adjoint. Clamped at the
-/// edges like sampling, so the weights always sum to one and nothing is lost.
-WB_HD WB_INLINE void splat_nodes(FloatPair* f, int ex, int ey, int ez, float ox, float oy, float oz, Vec3 q, float a,
-                                  float b) {
-  const Stencil1 sx = stencil1(q.x, ox, ex), sy = stencil1(q.y, oy, ey), sz = stencil1(q.z, oz, ez);
-  const float wx[2] = {1.f - sx.w1, sx.w1}, wy[2] = {1.f - sy.w1, sy.w1}, wz[2] = {1.f - sz.w1, sz.w1};
-  const int ix[2] = {sx.i0, sx.i1}, iy[2] = {sy.i0, sy.i1}, iz[2] = {sz.i0, sz.i1};
-  for (int k = 0; k < 2; ++k)
-    for (int j = 0; j < 2; ++j)
-      for (int i = 0; i < 2; ++i) {
-        const float wgt = wx[i] * wy[j] * wz[k];
-        if (wgt != 0.f) atomic_add(&f[(int64_t(iz[k]) * ey + iy[j]) * ex + ix[i]], a * wgt, b * wgt);
+/// Splats pairs (a, b) trilinearly onto a node grid of ex x ey x ez nodes at offsets (ox, oy, oz):
+/// the cloud-in-cell weights of sample_nodes, so splat and sample are adjoint, clamped at the
+/// edges like sampling, so the weights always sum to one and nothing is lost. The splats of a
+/// run of consecutive particles whose stencils share their nodes (the same lower corner) are
+/// summed before they are added to the grid: a particle's eight atomic adds become one set a
+/// run. Particles sorted by cell (ParticleStore::sort_by_cell) come in such runs.
+struct SplatRun {
+  int64_t base = -1;  ///< node of the run's lower corner, -1: no run open
+  int64_t node[8];
+  FloatPair sum[8];
+  /// Adds the open run's sums to f (nodes whose sums are both zero are skipped) and closes it.
+  WB_HD void flush(FloatPair* f) {
+    if (base < 0) return;
+    for (int n = 0; n < 8; ++n)
+      if (sum[n].first != 0.f || sum[n].second != 0.f) atomic_add(&f[node[n]], sum[n].first, sum[n].second);
+    base = -1;
+  }
+  /// The weights of the pair (a, b) at q, into the run (flushed first if q's corner is another).
+  WB_HD void add(FloatPair* f, int ex, int ey, int ez, float ox, float oy, float oz, Vec3 q, float a, float b) {
+    const Stencil1 sx = stencil1(q.x, ox, ex), sy = stencil1(q.y, oy, ey), sz = stencil1(q.z, oz, ez);
+    const int64_t corner = (int64_t(sz.i0) * ey + sy.i0) * ex + sx.i0;
+    if (corner != base) {
+      flush(f);
+      base = corner;
+      const int ix[2] = {sx.i0, sx.i1}, iy[2] = {sy.i0, sy.i1}, iz[2] = {sz.i0, sz.i1};
+      for (int n = 0; n < 8; ++n) {
+        node[n] = (int64_t(iz[n >> 2]) * ey + iy[(n >> 1) & 1]) * ex + ix[n & 1];
+        sum[n] = FloatPair{0.f, 0.f};
       }
-}
+    }
+    const float wx[2] = {1.f - sx.w1, sx.w1}, wy[2] = {1.f - sy.w1, sy.w1}, wz[2] = {1.f - sz.w1, sz.w1};
+    for (int n = 0; n < 8; ++n) {
+      const float wgt = wx[n & 1] * wy[(n >> 1) & 1] * wz[n >> 2];
+      sum[n].first += a * wgt;
+      sum[n].second += b * wgt;
+    }
+  }
+};
 
 /// True when q (window cells) lies inside the window; particles outside are not rasterised.
 WB_HD WB_INLINE bool inside_window(Vec3 q, int nx, int ny, int nz) {
   return q.x >= 0.f && q.y >= 0.f && q.z >= 0.f && q.x < float(nx) && q.y < float(ny) && q.z < float(nz);
 }
 
-/// Rasterises one particle of mass m and velocity vel at canvas position p: mass and oil onto
-/// the cell centres, weight m and momentum m v_c onto the faces of each component c (the cells
-/// alone when g.face[0] is null).
-WB_HD WB_INLINE void rasterise_particle(const ParticleRasterView& g, Vec3 p, Vec3 vel, float m, float oil) {
-  const Vec3 q(p.x - float(g.ox), p.y - float(g.oy), p.z - float(g.oz));
-  if (!inside_window(q, g.nx, g.ny, g.nz)) return;
-  splat_nodes(g.cell, g.nx, g.ny, g.nz, 0.5f, 0.5f, 0.5f, q, m, m * oil);
-  if (g.face[0] == nullptr) return;
-  splat_nodes(g.face[0], g.nx + 1, g.ny, g.nz, 0.f, 0.5f, 0.5f, q, m, m * vel.x);
-  splat_nodes(g.face[1], g.nx, g.ny + 1, g.nz, 0.5f, 0.f, 0.5f, q, m, m * vel.y);
-  splat_nodes(g.face[2], g.nx, g.ny, g.nz + 1, 0.5f, 0.5f, 0.f, q, m, m * vel.z);
+/// Rasterises particles [k0, k1) of p, a run at a time (SplatRun): mass and oil onto the cell
+/// centres, weight m and momentum m v_c onto the faces of each component c (the cells alone when
+/// g.face[0] is null). Particles outside the window are skipped.
+WB_HD WB_INLINE void rasterise_particles(const ParticleRasterView& g, const Vec3* x, const Vec3* v, const float* m,
+                                         const float* oil, int64_t k0, int64_t k1) {
+  const Vec3 o(float(g.ox), float(g.oy), float(g.oz));
+  const int grids = g.face[0] == nullptr ? 1 : 4;
+  for (int c = 0; c < grids; ++c) {
+    SplatRun run;
+    for (int64_t k = k0; k < k1; ++k) {
+      const Vec3 q = x[k] - o;
+      if (!inside_window(q, g.nx, g.ny, g.nz)) continue;
+      if (c == 0) run.add(g.cell, g.nx, g.ny, g.nz, 0.5f, 0.5f, 0.5f, q, m[k], m[k] * oil[k]);
+      if (c == 1) run.add(g.face[0], g.nx + 1, g.ny, g.nz, 0.f, 0.5f, 0.5f, q, m[k], m[k] * v[k].x);
+      if (c == 2) run.add(g.face[1], g.nx, g.ny + 1, g.nz, 0.5f, 0.f, 0.5f, q, m[k], m[k] * v[k].y);
+      if (c == 3) run.add(g.face[2], g.nx, g.ny, g.nz + 1, 0.5f, 0.5f, 0.f, q, m[k], m[k] * v[k].z);
+    }
+    run.flush(c == 0 ? g.cell : g.face[c - 1]);
+  }
 }
 
 /// Face velocity from a rasterised face: momentum / weight where the face got mass, else `empty`.

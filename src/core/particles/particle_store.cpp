@@ -18,6 +18,13 @@ void compact_one(const Device& d, DeviceBuffer<T>& field, DeviceBuffer<Vec3>& sc
   particles_compact_field(d, field.data(), tmp, dead, pos, n);
   mem::copy_on_device(d, field.data(), tmp, size_t(kept) * sizeof(T));
 }
+template <typename T>
+void gather_one(const Device& d, DeviceBuffer<T>& field, DeviceBuffer<Vec3>& scratch, const uint32_t* from, int64_t n) {
+  static_assert(sizeof(T) <= sizeof(Vec3), "the scratch holds the widest field");
+  auto* tmp = reinterpret_cast<T*>(scratch.data());
+  particles_gather_field(d, field.data(), tmp, from, n);
+  mem::copy_on_device(d, field.data(), tmp, size_t(n) * sizeof(T));
+}
 }  // namespace
 
 void ParticleHost::resize(size_t n) {
@@ -31,6 +38,7 @@ ParticleStore::ParticleStore(const Device& device, int64_t limit) : device_(devi
   WB_PARTICLE_FIELDS(WB_X)
 #undef WB_X
   scan_.set_device(device);
+  order_.set_device(device);
   scratch_.set_device(device);
   set_limit(limit);
 }
@@ -106,6 +114,22 @@ void ParticleStore::remove_dead(const uint32_t* pos, int64_t kept) {
 #undef WB_X
   dead.fill_zero();
   count_ = kept;
+}
+
+void ParticleStore::sort_by_cell(Int3 origin, Int3 dims, Workspace& ws) {
+  const int64_t n = count_;
+  if (n <= 1) return;
+  if (scan_.size() < size_t(n)) scan_.grow_keep(size_t(n));
+  if (order_.size() < size_t(n)) order_.grow_keep(size_t(n));
+  if (scratch_.size() < size_t(n)) scratch_.grow_keep(size_t(n));
+  particles_cell_keys(device_, view(), origin, dims, scan_.data(), order_.data());
+  const int64_t cells = int64_t(8) * dims.x * dims.y * dims.z;  // half cells: the key of a particle outside
+  int bits = 1;
+  while ((int64_t(1) << bits) <= cells) ++bits;
+  sort_by_key(device_, scan_.data(), order_.data(), n, bits, ws);
+#define WB_X(type, name, doc) gather_one(device_, name, scratch_, order_.data(), n);
+  WB_PARTICLE_FIELDS(WB_X)
+#undef WB_X
 }
 
 ParticleView ParticleStore::view() {

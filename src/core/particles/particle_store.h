@@ -8,6 +8,7 @@
 #include "core/exec/buffer.h"
 #include "core/exec/device.h"
 #include "core/exec/workspace.h"
+#include "core/canvas/window.h"
 #include "core/particles/particle_fields.h"
 
 namespace wb {
@@ -45,6 +46,10 @@ class ParticleStore {
   /// The scatter of compact() for a scan made elsewhere: pos = exclusive scan of the keep flags
   /// (particles_keep_flags) of the size() particles, kept = their total.
   void remove_dead(const uint32_t* pos, int64_t kept);
+  /// Puts the particles in the order of their cells in the window of `dims` cells at canvas cell
+  /// `origin` (x fastest; those outside it last), each cell's in their order before (a stable
+  /// radix sort, then a gather of every field): neighbours in space are neighbours in memory.
+  void sort_by_cell(Int3 origin, Int3 dims, Workspace& ws);
   void clear() { count_ = 0; }
 
   ParticleView view();
@@ -61,7 +66,8 @@ class ParticleStore {
   int64_t count_ = 0;
   int64_t capacity_ = 0;
   int64_t limit_ = 2000000;
-  DeviceBuffer<uint32_t> scan_;     ///< keep flags, then their exclusive scan
+  DeviceBuffer<uint32_t> scan_;     ///< keep flags, then their exclusive scan; the sort's keys
+  DeviceBuffer<uint32_t> order_;    ///< the sort's old index of each new place
   DeviceBuffer<Vec3> scratch_;      ///< compaction target, reused by every field
 };
 

@@ -87,6 +87,24 @@ void particles_solid_height(const Device& d, const PaintWindowView& pw, const fl
   WB_DISPATCH(d, particles_solid_height(pw, particle_density, dry_threshold, liquid_threshold, floor_z, height, wet_top));
 }
 
+void particles_cell_keys(const Device& d, const ParticleView& p, Int3 origin, Int3 dims, uint32_t* keys,
+                         uint32_t* index) {
+  WB_REQUIRE(dims.x > 0 && dims.y > 0 && dims.z > 0 && int64_t(8) * dims.x * dims.y * dims.z < (int64_t(1) << 31),
+             "particles_cell_keys: the window's cells do not fit a key");
+  WB_DISPATCH(d, particles_cell_keys(p, origin, dims, keys, index));
+}
+void particles_gather_field(const Device& d, const float* src, float* dst, const uint32_t* from, int64_t n) {
+  WB_DISPATCH(d, particles_gather_field(src, dst, from, n));
+}
+void particles_gather_field(const Device& d, const Vec3* src, Vec3* dst, const uint32_t* from, int64_t n) {
+  WB_DISPATCH(d, particles_gather_field(src, dst, from, n));
+}
+void particles_gather_field(const Device& d, const int32_t* src, int32_t* dst, const uint32_t* from, int64_t n) {
+  WB_DISPATCH(d, particles_gather_field(src, dst, from, n));
+}
+void particles_gather_field(const Device& d, const uint32_t* src, uint32_t* dst, const uint32_t* from, int64_t n) {
+  WB_DISPATCH(d, particles_gather_field(src, dst, from, n));
+}
 void particles_init_scratch(const Device& d, const ParticleView& p, int64_t first, int64_t n) {
   WB_DISPATCH(d, particles_init_scratch(p, first, n));
 }

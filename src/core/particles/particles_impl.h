@@ -23,8 +23,21 @@ void particles_adhesion_step(ParticleView p, SampleView s, SolidView solid, Part
   });
 }
 
+#if defined(__CUDACC__)
+constexpr int64_t kRasterRun = 1;  // a thread a particle: the device's atomics are cheap
+#else
+constexpr int64_t kRasterRun = 64;  // a thread's particles in order, their runs summed first
+#endif
+
 void particles_rasterise(ParticleView p, ParticleRasterView g) {
-  parallel_for(p.count, [=] WB_HD(int64_t k) { rasterise_particle(g, p.x[k], p.v[k], p.m[k], p.oil[k]); });
+  const int64_t n = p.count, chunks = (n + kRasterRun - 1) / kRasterRun;
+  parallel_for(
+      chunks,
+      [=] WB_HD(int64_t c) {
+        const int64_t k0 = c * kRasterRun;
+        rasterise_particles(g, p.x, p.v, p.m, p.oil, k0, k0 + kRasterRun < n ? k0 + kRasterRun : n);
+      },
+      kMinParallelSize / kRasterRun);
 }
 
 void particles_face_velocity(ParticleRasterView g, float* u, float* v, float* w, float empty) {
@@ -64,6 +77,40 @@ void particles_compact_field(const int32_t* src, int32_t* dst, const uint32_t* d
 void particles_compact_field(const uint32_t* src, uint32_t* dst, const uint32_t* dead, const uint32_t* pos,
                              int64_t n) {
   compact_field(src, dst, dead, pos, n);
+}
+
+void particles_cell_keys(ParticleView p, Int3 origin, Int3 dims, uint32_t* keys, uint32_t* index) {
+  parallel_for(p.count, [=] WB_HD(int64_t k) {
+    const Vec3 x = p.x[k];
+    const float q[3] = {x.x - float(origin.x), x.y - float(origin.y), x.z - float(origin.z)};
+    const int n[3] = {dims.x, dims.y, dims.z};
+    int c[3];
+    bool inside = true;
+    for (int a = 0; a < 3; ++a) {
+      inside = inside && q[a] >= 0.f && q[a] < float(n[a]);  // false for a NaN as well
+      c[a] = inside ? int(2.f * q[a]) : 0;
+    }
+    keys[k] = inside ? uint32_t((int64_t(c[2]) * (2 * n[1]) + c[1]) * (2 * n[0]) + c[0])
+                     : uint32_t(int64_t(8) * n[0] * n[1] * n[2]);
+    index[k] = uint32_t(k);
+  });
+}
+
+template <typename T>
+void gather_field(const T* src, T* dst, const uint32_t* from, int64_t n) {
+  parallel_for(n, [=] WB_HD(int64_t i) { dst[i] = src[from[i]]; });
+}
+void particles_gather_field(const float* src, float* dst, const uint32_t* from, int64_t n) {
+  gather_field(src, dst, from, n);
+}
+void particles_gather_field(const Vec3* src, Vec3* dst, const uint32_t* from, int64_t n) {
+  gather_field(src, dst, from, n);
+}
+void particles_gather_field(const int32_t* src, int32_t* dst, const uint32_t* from, int64_t n) {
+  gather_field(src, dst, from, n);
+}
+void particles_gather_field(const uint32_t* src, uint32_t* dst, const uint32_t* from, int64_t n) {
+  gather_field(src, dst, from, n);
 }
 
 void particles_init_scratch(ParticleView p, int64_t first, int64_t n) {

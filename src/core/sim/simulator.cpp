@@ -559,6 +559,10 @@ void Simulator::particle_stage(float dt) {
   if (particles_.size() == 0) return;
   WB_PROFILE_SCOPE("particles");
   const ParticleParams& prm = config_.params.particles;
+  // Neighbours in space as neighbours in memory: the raster sums the splats of each run of
+  // particles in a cell before its atomic adds, and every pass over the particles reads the
+  // grid, the samples and the paint in order (docs/PARTICLES.md "Order").
+  particles_.sort_by_cell(grid_->window().origin(), grid_->window().dims(), ws_);
   // Samples are at t + dt, particles at t: hash the samples rewound to t (hash_grid.h). The
   // query reaches D1, the range of Eq. 10: beyond it no sample moves a particle.
   build_sample_grid(prm.D1, dt);
