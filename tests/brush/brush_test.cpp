@@ -326,7 +326,7 @@ TEST_F(BrushTest, NonFiniteFlowIsContained) {
   Brush brush(device_, spec, make_pose(Vec3(32, 32, 60)));
   brush.step(make_pose(Vec3(32, 32, 60)), kDt, BrushEnvironment{});
   // A paint flow holding NaN and infinities: the drag term is non-finite for every vertex.
-  const int n = 64 * 64 * 64;
+  const int n = 65 * 65 * 65;  // as many as any component's faces on 64^3 cells
   std::vector<float> bad(static_cast<size_t>(n)), ones(static_cast<size_t>(n), 1.f);
   for (int i = 0; i < n; ++i) bad[size_t(i)] = (i % 3 == 0) ? std::nanf("") : (i % 3 == 1 ? INFINITY : -INFINITY);
   DeviceBuffer<float> u(device_, size_t(n)), rho(device_, size_t(n));
@@ -412,7 +412,7 @@ TEST_F(BrushTest, DragFromThePaintFlowDeflectsTheBristles) {
   BrushSpec spec = default_brush(BrushShape::Round);
   spec.beta_B = 0.f;
   const int n = 128;
-  const size_t cells = size_t(n) * n * 64;
+  const size_t cells = size_t(n + 1) * (n + 1) * 65;  // as many as any component's faces
   std::vector<float> ux(cells, 3000.f), zero(cells, 0.f), rho(cells, 1.f);
   DeviceBuffer<float> dux(device_, cells), dz(device_, cells), drho(device_, cells);
   dux.copy_from_host(ux);

@@ -214,8 +214,8 @@ void Brush::step(const BrushPose* poses, int substeps, float dt, const BrushEnvi
   WB_REQUIRE(isfinite3(env.gravity), "Brush::step: gravity is not finite");
   if (env.drag) {
     const DragField& d = *env.drag;
-    WB_REQUIRE(d.vx && d.vy && d.vz && d.density && d.nx > 0 && d.ny > 0 && d.nz > 0,
-               "Brush::step: drag field needs vx, vy, vz, density and positive dimensions");
+    WB_REQUIRE(d.u && d.v && d.w && d.density && d.nx > 0 && d.ny > 0 && d.nz > 0,
+               "Brush::step: drag field needs u, v, w, density and positive dimensions");
     WB_REQUIRE(std::isfinite(d.k) && d.k >= 0.f, "Brush::step: drag coefficient must be finite and >= 0");
   }
   if (env.solid.valid)

@@ -8,6 +8,7 @@
 
 #include "core/brush/brush_views.h"
 #include "core/exec/hd.h"
+#include "core/math/trilinear.h"
 #include "core/math/vec.h"
 
 namespace wb::brush {
@@ -57,8 +58,7 @@ WB_HD WB_INLINE Vec3 drag_velocity_change(const DragField& d, Vec3 x, Vec3 v, fl
   const Vec3 local(x.x - d.ox, x.y - d.oy, x.z - d.oz);
   const float rho = sample_cell_centred(d.density, d.nx, d.ny, d.nz, local);
   if (!(rho > 0.f)) return Vec3();
-  const Vec3 u(sample_cell_centred(d.vx, d.nx, d.ny, d.nz, local), sample_cell_centred(d.vy, d.nx, d.ny, d.nz, local),
-               sample_cell_centred(d.vz, d.nx, d.ny, d.nz, local));
+  const Vec3 u = sample_mac(d.u, d.v, d.w, d.nx, d.ny, d.nz, local);
   const float s = minf(d.k * rho * dt, 1.f);
   return (u - v) * s;
 }

@@ -11,14 +11,15 @@
 
 namespace wb {
 
-/// Paint velocity field for the drag term of Eq. 2 (a_i), cell-centred on the active
-/// window: value (x, y, z) sits at canvas (ox + x + 0.5, oy + y + 0.5, oz + z + 0.5),
-/// index (z * ny + y) * nx + x. Velocities in canvas cells/s; density as in the window.
-/// The drag acceleration is k * density * (u - v_vertex), 1/s.
+/// The paint's flow for the drag term of Eq. 2 (a_i) on the active window of nx x ny x nz cells
+/// at canvas cell (ox, oy, oz): the grid's MAC velocity (sample_mac's layout, canvas cells/s),
+/// read where the bristle is, and the cell-centred density (value (x, y, z) at canvas
+/// (ox + x + 0.5, oy + y + 0.5, oz + z + 0.5)). The drag acceleration is
+/// k * density * (u - v_vertex), 1/s.
 struct DragField {
-  const float* vx = nullptr;
-  const float* vy = nullptr;
-  const float* vz = nullptr;
+  const float* u = nullptr;  ///< (nx + 1) x ny x nz faces
+  const float* v = nullptr;  ///< nx x (ny + 1) x nz faces
+  const float* w = nullptr;  ///< nx x ny x (nz + 1) faces
   const float* density = nullptr;
   int nx = 0, ny = 0, nz = 0;
   int ox = 0, oy = 0, oz = 0;

@@ -44,4 +44,13 @@ WB_HD WB_INLINE float sample_nodes(const float* f, int ex, int ey, int ez, float
   return c0 * (1.f - sz.w1) + c1 * sz.w1;
 }
 
+/// Velocity of the MAC field (u, v, w) at q (window cells): each component trilinear on its
+/// own faces, clamped at the window's edges. u(i,j,k) sits on the face at (i, j+1/2, k+1/2),
+/// v(i,j,k) at (i+1/2, j, k+1/2), w(i,j,k) at (i+1/2, j+1/2, k); u: (nx+1) x ny x nz,
+/// v: nx x (ny+1) x nz, w: nx x ny x (nz+1), x fastest.
+WB_HD WB_INLINE Vec3 sample_mac(const float* u, const float* v, const float* w, int nx, int ny, int nz, Vec3 q) {
+  return Vec3(sample_nodes(u, nx + 1, ny, nz, 0.f, 0.5f, 0.5f, q), sample_nodes(v, nx, ny + 1, nz, 0.5f, 0.f, 0.5f, q),
+              sample_nodes(w, nx, ny, nz + 1, 0.5f, 0.5f, 0.f, q));
+}
+
 }  // namespace wb

@@ -12,13 +12,6 @@
 
 namespace wb {
 
-/// Velocity of the MAC field (u, v, w) at q (window cells): each component trilinear on its
-/// own faces, clamped at the window's edges.
-WB_HD WB_INLINE Vec3 sample_mac(const float* u, const float* v, const float* w, int nx, int ny, int nz, Vec3 q) {
-  return Vec3(sample_nodes(u, nx + 1, ny, nz, 0.f, 0.5f, 0.5f, q), sample_nodes(v, nx, ny + 1, nz, 0.5f, 0.f, 0.5f, q),
-              sample_nodes(w, nx, ny, nz + 1, 0.5f, 0.5f, 0.f, q));
-}
-
 /// A MAC velocity field on the window, by value: faces as above, origin = canvas cell of the
 /// window's cell (0, 0, 0), so a particle at canvas position p is at q = p - origin.
 struct MacView {

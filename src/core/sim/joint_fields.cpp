@@ -18,9 +18,6 @@ void joint_blend_velocity(const Device& d, GridView g, PaintWindowView paint, Pa
   WB_REQUIRE(raster.face[0] && raster.face[1] && raster.face[2], "joint_blend_velocity: the raster has no faces");
   WB_DISPATCH(d, joint_blend_velocity(g, paint, raster, cell_mass));
 }
-void joint_cell_velocity(const Device& d, GridView g, float* vx, float* vy, float* vz) {
-  WB_DISPATCH(d, joint_cell_velocity(g, vx, vy, vz));
-}
 void joint_zero_nonfinite(const Device& d, float* v, int64_t n) { WB_DISPATCH(d, joint_zero_nonfinite(v, n)); }
 void joint_clamp_to_canvas(const Device& d, ParticleView p, Vec3 lo, Vec3 hi) {
   WB_DISPATCH(d, joint_clamp_to_canvas(p, lo, hi));

@@ -21,8 +21,6 @@ void joint_raster_density(const Device& d, const FloatPair* cell, float* density
 /// u = (w_g u + P) / (w_g + W), w_g = cell_mass * mean density of the two cells (Eq. 11's u).
 void joint_blend_velocity(const Device& d, GridView g, PaintWindowView paint, ParticleRasterView raster,
                           float cell_mass);
-/// Cell-centred velocity (mean of the two faces) for the bristles' drag (Eq. 2's a_i).
-void joint_cell_velocity(const Device& d, GridView g, float* vx, float* vy, float* vz);
 /// Replaces non-finite values by 0 in [n] floats; returns nothing (count them first).
 void joint_zero_nonfinite(const Device& d, float* v, int64_t n);
 /// Keeps particles inside the canvas box: its sides and floor are walls, so paint never leaves
@@ -43,7 +41,6 @@ void joint_ground_under(const Device& d, PaintWindowView pw, float dry_threshold
   void joint_scale(const float* in, float* out, int64_t n, float scale);                               \
   void joint_raster_density(const FloatPair* cell, float* density, float* oil, int64_t n, float scale);   \
   void joint_blend_velocity(GridView g, PaintWindowView paint, ParticleRasterView raster, float cell_mass); \
-  void joint_cell_velocity(GridView g, float* vx, float* vy, float* vz);                                \
   void joint_zero_nonfinite(float* v, int64_t n);                                                       \
   void joint_kill_nonfinite(ParticleView p);                                                            \
   void joint_clamp_to_canvas(ParticleView p, Vec3 lo, Vec3 hi);                                      \

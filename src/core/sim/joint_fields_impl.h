@@ -66,19 +66,6 @@ void joint_blend_velocity(GridView g, PaintWindowView paint, ParticleRasterView 
   }
 }
 
-void joint_cell_velocity(GridView g, float* vx, float* vy, float* vz) {
-  const GridDims d = g.d;
-  const float* u = g.vel[0];
-  const float* v = g.vel[1];
-  const float* w = g.vel[2];
-  parallel_for(d.cells(), [=] WB_HD(int64_t c) {
-    const int i = int(c % d.nx), j = int((c / d.nx) % d.ny), k = int(c / (int64_t(d.nx) * d.ny));
-    vx[c] = 0.5f * (u[(int64_t(k) * d.ny + j) * (d.nx + 1) + i] + u[(int64_t(k) * d.ny + j) * (d.nx + 1) + i + 1]);
-    vy[c] = 0.5f * (v[(int64_t(k) * (d.ny + 1) + j) * d.nx + i] + v[(int64_t(k) * (d.ny + 1) + j + 1) * d.nx + i]);
-    vz[c] = 0.5f * (w[(int64_t(k) * d.ny + j) * d.nx + i] + w[(int64_t(k + 1) * d.ny + j) * d.nx + i]);
-  });
-}
-
 void joint_zero_nonfinite(float* v, int64_t n) {
   parallel_for(n, [=] WB_HD(int64_t i) {
     if (!isfinite(v[i])) v[i] = 0.f;

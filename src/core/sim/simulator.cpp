@@ -74,7 +74,6 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
   transfer_->set_sums(&step_sums_.data()->transfer);
   for (int c = 0; c < 3; ++c) {
     cells(bristle_v_[c]);
-    cells(cell_v_[c]);
     raster_face_[c].set_device(d);
     raster_face_[c].resize(size_t(g.faces(c)));
   }
@@ -544,10 +543,10 @@ SolidField Simulator::solid_field() {
 
 void Simulator::brush_stage(const BrushPose* poses, int substeps, float dt) {
   ActiveWindow& win = grid_->window();
-  // The grid velocity kept from the last step drags the bristles (Eq. 2's a_i, §4.3).
-  joint_cell_velocity(device(), grid_->view(), cell_v_[0].data(), cell_v_[1].data(), cell_v_[2].data());
+  // The grid velocity kept from the last step drags the bristles (Eq. 2's a_i, §4.3), read on
+  // its faces where each bristle is.
   const Int3 n = win.dims(), o = win.origin();
-  DragField drag{cell_v_[0].data(), cell_v_[1].data(), cell_v_[2].data(), win.paint().density.data(),
+  DragField drag{win.velocity(0).data(), win.velocity(1).data(), win.velocity(2).data(), win.paint().density.data(),
                  n.x, n.y, n.z, o.x, o.y, o.z, config_.params.bristle_drag};
   BrushEnvironment env;
   env.drag = config_.params.bristle_drag > 0.f ? &drag : nullptr;

@@ -197,7 +197,7 @@ class Simulator {
   PaintBooks books_;
   // Window-sized scratch, allocated once: bristle psi and velocity, the grid's cell velocity
   // for the drag, the particles' raster (mass, face momentum and weight) and their density.
-  DeviceBuffer<float> psi_, bristle_v_[3], cell_v_[3];
+  DeviceBuffer<float> psi_, bristle_v_[3];
   DeviceBuffer<FloatPair> raster_cell_, raster_face_[3];  ///< the particles' raster (flip_kernels.h)
   DeviceBuffer<float> raster_density_, raster_oil_;  ///< its mass and oil per cell mass
   DeviceBuffer<float> overlay_mass_;
