@@ -35,8 +35,11 @@ WB_HD WB_INLINE Vec3 sample_velocity3(const float* u, const float* v, const floa
 /// The departure point is clamped into the window.
 WB_HD WB_INLINE Vec3 backtrace(const float* u, const float* v, const float* w, const GridDims& d, Vec3 x, float dt) {
   const Vec3 v0 = sample_velocity3(u, v, w, d, x);
+  // At rest at x the midpoint is x itself and its sample v0 again: the departure point is x,
+  // exactly as the full rule gives it. Most faces of the air above the paint are at rest.
+  const bool rest = v0.x == 0.f && v0.y == 0.f && v0.z == 0.f;
   const Vec3 mid = x - v0 * (0.5f * dt);
-  const Vec3 v1 = sample_velocity3(u, v, w, d, mid);
+  const Vec3 v1 = rest ? v0 : sample_velocity3(u, v, w, d, mid);
   Vec3 p = x - v1 * dt;
   p.x = clampf(p.x, 0.5f, float(d.nx) - 0.5f);
   p.y = clampf(p.y, 0.5f, float(d.ny) - 0.5f);
