@@ -29,9 +29,11 @@ void near(const Device& d, const int32_t* b, const uint8_t* occ, int reach, int6
 }
 void query(const Device& d, HashGridView g, ParticleView p, float r) { WB_DISPATCH(d, hash_grid_query(g, p, r)); }
 
-/// The grid's cell table holds at most this many cells (16 M, 64 MiB): a region larger than
-/// that is a caller's error, not a brush.
-constexpr int64_t kMaxCells = int64_t(1) << 24;
+/// The grid's cell table holds at most this many cells (128 M, 512 MiB). The simulator's region
+/// (its window's columns over the canvas's depth, up to 1024 cells) stays below it at the default
+/// 2-cell grid for windows up to about 980 x 980 columns (a 128 x 128 window over 64 cells: 0.3 M);
+/// a larger one is refused with the region's size.
+constexpr int64_t kMaxCells = int64_t(1) << 27;
 }  // namespace
 
 SampleHashGrid::SampleHashGrid(const Device& device) : device_(device) {
@@ -63,16 +65,21 @@ void SampleHashGrid::build(const SampleView& s, float cell_size, Vec3 region_lo,
   int lo[3], hi[3];
   hash_cell_of(region_lo, inv_h, lo[0], lo[1], lo[2]);
   hash_cell_of(region_hi, inv_h, hi[0], hi[1], hi[2]);
-  int64_t cells = 1, coarse_cells = 1;
+  int64_t n_axis[3];
+  double volume = 1.0;
   for (int a = 0; a < 3; ++a) {
     WB_REQUIRE(lo[a] <= hi[a], "SampleHashGrid::build: the region is empty");
     region.lo[a] = lo[a];
     region.hi[a] = hi[a];
-    cells *= int64_t(hi[a]) - lo[a] + 1;
-    coarse_cells *= coarse_count(int64_t(hi[a]) - lo[a] + 1);
-    WB_REQUIRE(cells <= kMaxCells, "SampleHashGrid::build: the region spans more than " +
-                                       std::to_string(kMaxCells) + " cells of " + std::to_string(cell_size));
+    n_axis[a] = int64_t(hi[a]) - lo[a] + 1;
+    volume *= double(n_axis[a]);
   }
+  WB_REQUIRE(volume <= double(kMaxCells),
+             "SampleHashGrid::build: the region is " + std::to_string(n_axis[0]) + " x " + std::to_string(n_axis[1]) +
+                 " x " + std::to_string(n_axis[2]) + " cells of " + std::to_string(cell_size) + ", more than " +
+                 std::to_string(kMaxCells));
+  const int64_t cells = n_axis[0] * n_axis[1] * n_axis[2];
+  const int64_t coarse_cells = int64_t(coarse_count(n_axis[0])) * coarse_count(n_axis[1]) * coarse_count(n_axis[2]);
   capacity_ = cells;
   coarse_capacity_ = coarse_cells;
   if (first_.size() < size_t(cells) + 1) first_.grow_keep(size_t(cells) + 1);
@@ -103,9 +110,11 @@ void SampleHashGrid::query_nearest(const ParticleView& p, float max_range) {
              "SampleHashGrid::query_nearest: range must be positive, got " + std::to_string(max_range));
   WB_REQUIRE(first_.size() > 0, "SampleHashGrid::query_nearest: build() was not called");
   WB_REQUIRE(p.count >= 0, "SampleHashGrid::query_nearest: negative particle count");
-  // A sample within max_range of a point lies at most this many coarse cells from the point's
-  // (floor(a + d) - floor(a) <= ceil(d)), one more for the thousandth of a cell of rounding.
-  const int reach = int(max_range / (h_ * float(kCoarse)) + 1e-3f) + 1;
+  // A sample within max_range of a point lies at most F = ceil(max_range / h) cells from the
+  // point's along each axis (floor(a + d) - floor(a) <= ceil(d); a hundredth of a cell more for
+  // the rounding of x / h on a large canvas), so at most ceil(F / kCoarse) coarse cells.
+  const int fine = int(std::ceil(max_range / h_ + 0.01f));
+  const int reach = (fine + kCoarse - 1) / kCoarse;
   near(device_, box_.data(), occupied_.data(), reach, coarse_capacity_, near_.data());
   query(device_, view(), p, max_range);
 }

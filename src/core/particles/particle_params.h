@@ -29,9 +29,10 @@ struct ParticleParams {
   Vec3 gravity = Vec3(0.f, 0.f, -49050.f);
   /// Height of the canvas surface (solid floor), cells. Default 0. Eq. 8 (d_k).
   float floor_z = 0.f;
-  /// Cell size of the sample hash grid, cells. Default 2, range [0.5, D1]. Green 2010, §6. A
-  /// nearest query stops at the first ring of cells beyond its best distance, and most particles
-  /// lie within a cell or two of a sample: small cells check fewer samples (docs/PARTICLES.md).
+  /// Cell size of the sample grid, cells. Default 2, range [1, D1]. Green 2010, §6. A nearest
+  /// query stops at the first ring of cells beyond its best distance, and most particles lie
+  /// within a cell or two of a sample: small cells check fewer samples (docs/PARTICLES.md). Its
+  /// table has a cell per h^3 of the queries' region (the window's columns, the canvas's depth).
   float hash_cell = 2.f;
   /// Most particles the store may hold. Default 2M, range [1, 2^31). §7 ("as many as 2M particles").
   int64_t max_particles = 2000000;
