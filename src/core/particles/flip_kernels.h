@@ -28,7 +28,7 @@ struct ParticleRasterView {
 /// edges like sampling, so the weights always sum to one and nothing is lost. The splats of a
 /// run of consecutive particles whose stencils share their nodes (the same lower corner) are
 /// summed before they are added to the grid: a particle's eight atomic adds become one set a
-/// run. Particles sorted by cell (ParticleStore::sort_by_cell) come in such runs.
+/// run. Particles sorted by half cell (ParticleStore::sort_by_cell) come in such runs.
 struct SplatRun {
   int64_t base = -1;  ///< node of the run's lower corner, -1: no run open
   int64_t node[8];

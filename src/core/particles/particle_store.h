@@ -46,9 +46,10 @@ class ParticleStore {
   /// The scatter of compact() for a scan made elsewhere: pos = exclusive scan of the keep flags
   /// (particles_keep_flags) of the size() particles, kept = their total.
   void remove_dead(const uint32_t* pos, int64_t kept);
-  /// Puts the particles in the order of their cells in the window of `dims` cells at canvas cell
-  /// `origin` (x fastest; those outside it last), each cell's in their order before (a stable
-  /// radix sort, then a gather of every field): neighbours in space are neighbours in memory.
+  /// Puts the particles in the order of their half cells (a cell halved along each axis: every
+  /// raster stencil's corner is constant over one) in the window of `dims` cells at canvas cell
+  /// `origin` (x fastest; those outside it last), each half cell's in their order before (a
+  /// stable radix sort, then a gather of every field): neighbours in space are neighbours in memory.
   void sort_by_cell(Int3 origin, Int3 dims, Workspace& ws);
   void clear() { count_ = 0; }
 

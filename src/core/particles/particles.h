@@ -43,8 +43,9 @@ void particles_compact_field(const Device& d, const int32_t* src, int32_t* dst, 
                              const uint32_t* pos, int64_t n);
 void particles_compact_field(const Device& d, const uint32_t* src, uint32_t* dst, const uint32_t* dead,
                              const uint32_t* pos, int64_t n);
-/// Sort keys by window cell: keys[k] = the cell of particle k, numbered x fastest over the window
-/// of `dims` cells at canvas cell `origin` (the cell count for a particle outside it), index[k] = k.
+/// Sort keys by half cell: keys[k] = the half cell (a window cell halved along each axis) of
+/// particle k, numbered x fastest over the window of `dims` cells at canvas cell `origin` (the
+/// half cells' count for a particle outside it or not finite), index[k] = k.
 void particles_cell_keys(const Device& d, const ParticleView& p, Int3 origin, Int3 dims, uint32_t* keys,
                          uint32_t* index);
 /// dst[i] = src[from[i]] for i < n: a field in a new order (ParticleStore::sort_by_cell).

@@ -559,7 +559,7 @@ void Simulator::particle_stage(float dt) {
   WB_PROFILE_SCOPE("particles");
   const ParticleParams& prm = config_.params.particles;
   // Neighbours in space as neighbours in memory: the raster sums the splats of each run of
-  // particles in a cell before its atomic adds, and every pass over the particles reads the
+  // particles in a half cell before its atomic adds, and every pass over the particles reads the
   // grid, the samples and the paint in order (docs/PARTICLES.md "Order").
   particles_.sort_by_cell(grid_->window().origin(), grid_->window().dims(), ws_);
   // Samples are at t + dt, particles at t: hash the samples rewound to t (hash_grid.h). The
