@@ -127,8 +127,10 @@ void ParticleStore::sort_by_cell(Int3 origin, Int3 dims, Workspace& ws) {
   int bits = 1;
   while ((int64_t(1) << bits) <= cells) ++bits;
   sort_by_key(device_, scan_.data(), order_.data(), n, bits, ws);
+  // The state only: the sort comes before the step's queries, which write `nearest` and `d_B`
+  // again, and after the last compaction, which left every `dead` flag clear.
 #define WB_X(type, name, doc) gather_one(device_, name, scratch_, order_.data(), n);
-  WB_PARTICLE_FIELDS(WB_X)
+  WB_PARTICLE_STATE_FIELDS(WB_X)
 #undef WB_X
 }
 

@@ -49,7 +49,9 @@ class ParticleStore {
   /// Puts the particles in the order of their half cells (a cell halved along each axis: every
   /// raster stencil's corner is constant over one) in the window of `dims` cells at canvas cell
   /// `origin` (x fastest; those outside it last), each half cell's in their order before (a
-  /// stable radix sort, then a gather of every field): neighbours in space are neighbours in memory.
+  /// stable radix sort, then a gather of every state field): neighbours in space are neighbours
+  /// in memory. The per-step scratch is left as it is: call it where no `dead` flag is set and
+  /// before the queries that write `nearest` and `d_B`.
   void sort_by_cell(Int3 origin, Int3 dims, Workspace& ws);
   void clear() { count_ = 0; }
 

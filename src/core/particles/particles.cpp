@@ -99,12 +99,6 @@ void particles_gather_field(const Device& d, const float* src, float* dst, const
 void particles_gather_field(const Device& d, const Vec3* src, Vec3* dst, const uint32_t* from, int64_t n) {
   WB_DISPATCH(d, particles_gather_field(src, dst, from, n));
 }
-void particles_gather_field(const Device& d, const int32_t* src, int32_t* dst, const uint32_t* from, int64_t n) {
-  WB_DISPATCH(d, particles_gather_field(src, dst, from, n));
-}
-void particles_gather_field(const Device& d, const uint32_t* src, uint32_t* dst, const uint32_t* from, int64_t n) {
-  WB_DISPATCH(d, particles_gather_field(src, dst, from, n));
-}
 void particles_init_scratch(const Device& d, const ParticleView& p, int64_t first, int64_t n) {
   WB_DISPATCH(d, particles_init_scratch(p, first, n));
 }

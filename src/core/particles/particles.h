@@ -51,8 +51,6 @@ void particles_cell_keys(const Device& d, const ParticleView& p, Int3 origin, In
 /// dst[i] = src[from[i]] for i < n: a field in a new order (ParticleStore::sort_by_cell).
 void particles_gather_field(const Device& d, const float* src, float* dst, const uint32_t* from, int64_t n);
 void particles_gather_field(const Device& d, const Vec3* src, Vec3* dst, const uint32_t* from, int64_t n);
-void particles_gather_field(const Device& d, const int32_t* src, int32_t* dst, const uint32_t* from, int64_t n);
-void particles_gather_field(const Device& d, const uint32_t* src, uint32_t* dst, const uint32_t* from, int64_t n);
 /// Height fields of what the particles rest on over the window's columns (SolidView), absolute
 /// canvas z, nx * ny floats each: `height`, the top of the highest dried cell (dryness at or above
 /// dry_threshold, the grid's solid test) as a whole cell (the grid holds one state a cell, so
@@ -88,8 +86,6 @@ void particles_init_scratch(const Device& d, const ParticleView& p, int64_t firs
   void particles_cell_keys(ParticleView p, Int3 origin, Int3 dims, uint32_t* keys, uint32_t* index);             \
   void particles_gather_field(const float* src, float* dst, const uint32_t* from, int64_t n);                    \
   void particles_gather_field(const Vec3* src, Vec3* dst, const uint32_t* from, int64_t n);                      \
-  void particles_gather_field(const int32_t* src, int32_t* dst, const uint32_t* from, int64_t n);                \
-  void particles_gather_field(const uint32_t* src, uint32_t* dst, const uint32_t* from, int64_t n);              \
   void particles_ground_surface(PaintWindowView pw, const float* particle_density, float dry_threshold,          \
                                 float liquid_threshold, float floor_z, float* surface);                          \
   void particles_solid_height(PaintWindowView pw, const float* particle_density, float dry_threshold,            \

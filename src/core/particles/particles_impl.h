@@ -106,12 +106,6 @@ void particles_gather_field(const float* src, float* dst, const uint32_t* from, 
 void particles_gather_field(const Vec3* src, Vec3* dst, const uint32_t* from, int64_t n) {
   gather_field(src, dst, from, n);
 }
-void particles_gather_field(const int32_t* src, int32_t* dst, const uint32_t* from, int64_t n) {
-  gather_field(src, dst, from, n);
-}
-void particles_gather_field(const uint32_t* src, uint32_t* dst, const uint32_t* from, int64_t n) {
-  gather_field(src, dst, from, n);
-}
 
 void particles_init_scratch(ParticleView p, int64_t first, int64_t n) {
   parallel_for(n, [=] WB_HD(int64_t i) {
