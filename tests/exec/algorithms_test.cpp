@@ -9,6 +9,7 @@
 #include "backend_fixture.h"
 #include "core/exec/algorithms.h"
 #include "core/exec/buffer.h"
+#include "core/exec/graph.h"
 #include "core/exec/memory.h"
 #include "core/exec/selftest.h"
 
@@ -177,6 +178,79 @@ TEST_F(AlgorithmsTest, ParallelForVisitsEachIndexOnce) {
   selftest_count_visits(device_, hits.data(), n);
   auto h = hits.to_host();
   for (int64_t i = 0; i < n; ++i) ASSERT_EQ(h[i], 1) << i;
+}
+
+TEST_F(AlgorithmsTest, SumFormedInThePassIsTheSumAndRepeatsBitForBit) {
+  // parallel_sum_count: the pass writes the first *count entries and no more, its sum is the
+  // sum, and launches in a row (the ticket wrapping each time) give the same bits: the viscous
+  // CG relies on that to keep r.z unchanged past convergence.
+  DeviceBuffer<double> partial(device_, kSumBlocks);
+  DeviceBuffer<uint32_t> ticket(device_, 1);
+  ticket.fill_zero();
+  const SumScratch scratch{partial.data(), ticket.data()};
+  DeviceBuffer<int64_t> count(device_, 1);
+  for (int64_t capacity : {int64_t(1), int64_t(300), int64_t(100003), int64_t(700001)}) {
+    for (int64_t n : {int64_t(0), capacity / 2, capacity, capacity + 5}) {
+      const int64_t used = std::min(n, capacity);
+      std::vector<double> poison(size_t(capacity) + 1, -999.0);
+      DeviceBuffer<double> x(device_, size_t(capacity) + 1);
+      x.copy_from_host(poison);
+      count.copy_from_host(&n, 1);
+      constexpr int kRuns = 40;
+      DeviceBuffer<double> out(device_, kRuns);
+      out.fill_zero();
+      const int64_t reads = mem::host_reads();
+      for (int r = 0; r < kRuns; ++r) selftest_sum_squares(device_, count.data(), capacity, x.data(), out.data() + r, scratch);
+      EXPECT_EQ(mem::host_reads(), reads) << "the sum stays on the device";
+      const std::vector<double> got = out.to_host(), xs = x.to_host();
+      long double expect = 0.0L;
+      for (int64_t i = 0; i < used; ++i) {
+        const double v = double(i % 97) * 0.125 - 3.3;  // the product exact: no FMA's rounding
+        ASSERT_EQ(xs[size_t(i)], v) << "capacity " << capacity << " entry " << i;
+        expect += (long double)v * v;
+      }
+      for (int64_t i = used; i <= capacity; ++i) ASSERT_EQ(xs[size_t(i)], -999.0) << "written past the count: " << i;
+      // Sums of up to 7e5 terms in double, in the backend's order: within 1e-10 of the exact.
+      EXPECT_NEAR(got[0], double(expect), 1e-10 * std::max(double(expect), 1.0)) << "capacity " << capacity << " count " << n;
+      for (int r = 1; r < kRuns; ++r) ASSERT_EQ(got[size_t(r)], got[0]) << "run " << r << ", capacity " << capacity;
+    }
+  }
+  EXPECT_EQ(ticket.to_host()[0], 0u) << "the ticket is back to zero between launches";
+}
+
+TEST_F(AlgorithmsTest, LaunchGraphReplaysItsLaunchesAndRecordsAgainForANewKey) {
+  // The same launches run directly or through a LaunchGraph give the same results, counted as
+  // the same launches; a new key (other buffers) records again, and the old buffers are left.
+  const int64_t n = 50000;
+  DeviceBuffer<int32_t> hits_a(device_, n), hits_b(device_, n);
+  hits_a.fill_zero();
+  hits_b.fill_zero();
+  DeviceBuffer<double> partial(device_, kSumBlocks), x(device_, n), out(device_, 2);
+  DeviceBuffer<uint32_t> ticket(device_, 1);
+  DeviceBuffer<int64_t> count(device_, 1);
+  ticket.fill_zero();
+  out.fill_zero();
+  count.copy_from_host(&n, 1);
+  const SumScratch scratch{partial.data(), ticket.data()};
+  LaunchGraph graph;
+  const auto launches = [&](DeviceBuffer<int32_t>& hits, int slot) {
+    selftest_count_visits(device_, hits.data(), n);
+    selftest_sum_squares(device_, count.data(), n, x.data(), out.data() + slot, scratch);
+  };
+  const int64_t before = mem::launches();
+  for (int r = 0; r < 3; ++r) graph.run(device_, launch_key({launch_key_of(hits_a.data())}), [&] { launches(hits_a, 0); });
+  EXPECT_EQ(mem::launches() - before, 6) << "each replay counts the launches it holds";
+  graph.run(device_, launch_key({launch_key_of(hits_b.data())}), [&] { launches(hits_b, 1); });
+  const std::vector<int32_t> a = hits_a.to_host(), b = hits_b.to_host();
+  for (int64_t i = 0; i < n; ++i) {
+    ASSERT_EQ(a[size_t(i)], 3) << i;
+    ASSERT_EQ(b[size_t(i)], 1) << i;
+  }
+  double expect = 0.0;
+  for (int64_t i = 0; i < n; ++i) expect += (double(i % 97) * 0.125 - 3.3) * (double(i % 97) * 0.125 - 3.3);
+  const std::vector<double> sums = out.to_host();
+  EXPECT_NEAR(sums[0], expect, 1e-10 * expect);
+  EXPECT_EQ(sums[1], sums[0]);
 }
 
 TEST(DeviceTest, ParseAndPrint) {

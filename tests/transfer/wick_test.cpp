@@ -88,6 +88,57 @@ TEST_F(WickTest, KeepsEachBristlesPaintAndSaturationsInRange) {
   }
 }
 
+TEST_F(WickTest, SolvesTheBackwardEulerSystemOfEachBristle) {
+  // The parallel reduction against Thomas's algorithm in double on the host: the loads after the
+  // flow, m_i + F_{i-1} - F_i with F_i = g_i (s_i - s_{i+1}), for bristles of any length (not only
+  // powers of two), a slow and a fast flow, with a swept contact's sink on some samples.
+  std::mt19937 rng(5);
+  for (int per : {1, 2, 5, 37, 128}) {
+    for (float k_dt : {0.5f, 1e4f}) {
+      const int B = 7;
+      TransferParams prm;
+      prm.wick_rate = k_dt;
+      BristleLoadHost before = random_load(B * per, rng, prm);
+      std::uniform_real_distribution<float> U(0.f, 1.f);
+      for (float& sg : before.sweep) sg = U(rng) < 0.2f ? 2.f * U(rng) : 0.f;
+      BristleLoad load(device_, B * per, prm);
+      load.from_host(before);
+      Transfer t(device_, prm);
+      t.wick(layout(B, per), load, 1.f);  // at rest: g = k dt min(M_a, M_b)
+      const BristleLoadHost after = load.to_host();
+      for (int b = 0; b < B; ++b) {
+        const int o = b * per;
+        const size_t n = size_t(per);
+        std::vector<double> g(n, 0.0), cp(n), dp(n), s(n);
+        for (int i = 0; i + 1 < per; ++i)
+          g[i] = double(k_dt) * std::min(double(before.capacity[o + i]), double(before.capacity[o + i + 1]));
+        for (int i = 0; i < per; ++i) {  // Thomas, forward
+          const double gp = i > 0 ? g[i - 1] : 0.0;
+          const double diag = double(before.capacity[o + i]) * (1.0 + double(before.sweep[o + i])) + gp + g[i] -
+                              (i > 0 ? gp * cp[i - 1] : 0.0);
+          cp[i] = g[i] / diag;
+          dp[i] = (double(before.m[o + i]) + (i > 0 ? gp * dp[i - 1] : 0.0)) / diag;
+        }
+        for (int i = per - 1; i >= 0; --i) s[i] = dp[i] + (i + 1 < per ? cp[i] * s[i + 1] : 0.0);
+        double total = 0.0;
+        for (int i = 0; i < per; ++i) total += before.m[o + i];
+        // Single precision: F = g (s_i - s_{i+1}) loses k dt times float's epsilon of a load to
+        // the difference of two near-equal saturations, in any solver.
+        const double tol = (1e-6 * (1.0 + k_dt)) * total / per;
+        for (int i = 0; i < per; ++i) {
+          const double F_left = i > 0 ? g[i - 1] * (s[i - 1] - s[i]) : 0.0;
+          const double F = i + 1 < per ? g[i] * (s[i] - s[i + 1]) : 0.0;
+          const double m = double(before.m[o + i]) + F_left - F;
+          ASSERT_NEAR(after.m[o + i], m, tol + 1e-5 * m)
+              << "per " << per << ", k dt " << k_dt << ", bristle " << b << ", sample " << i;
+          const double sg = before.sweep[o + i];
+          ASSERT_NEAR(after.sweep[o + i], m * sg / (1.0 + sg), tol + 1e-5 * m) << "the sink's share";
+        }
+      }
+    }
+  }
+}
+
 TEST_F(WickTest, FeedsAnEmptiedTipWithTheBristlesColour) {
   // One bristle: the tip (sample 0) emptied, the rest full of blue paint. The tip fills from
   // its neighbours and turns blue; samples far up only give, so they keep their colour.

@@ -26,3 +26,13 @@
 #else
 #define WB_BACKEND_NS cpu
 #endif
+
+namespace wb {
+/// Blocks of a parallel_sum_count launch on CUDA, and its scratch: a partial sum a block, and a
+/// ticket that is zero between launches (the last block to finish takes it back to zero).
+inline constexpr int kSumBlocks = 1024;
+struct SumScratch {
+  double* partial = nullptr;       ///< kSumBlocks
+  unsigned int* ticket = nullptr;  ///< zero before the first launch
+};
+}  // namespace wb

@@ -8,6 +8,8 @@
 #include "core/exec/memory.h"
 
 #if defined(__CUDACC__)
+#include <cub/block/block_reduce.cuh>
+
 #include "core/exec/cuda_check.h"
 #include "core/exec/stream.h"
 #endif
@@ -18,6 +20,8 @@ namespace wb {
 inline constexpr int64_t kMinParallelSize = 2048;
 /// For loops whose elements are heavy (a whole bristle per element): thread from a few on.
 inline constexpr int64_t kMinParallelHeavy = 4;
+/// parallel_sum_count: the CPU sums serially up to this many elements (as reduce_sum does).
+inline constexpr int64_t kMinParallelSum = 65536;
 
 #if defined(__CUDACC__)
 namespace detail {
@@ -32,8 +36,35 @@ __global__ void parallel_for_count_kernel(const int64_t* count, int64_t capacity
   const int64_t stride = int64_t(blockDim.x) * gridDim.x;
   for (int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x; i < n; i += stride) fn(i);
 }
+template <typename F>
+__global__ void __launch_bounds__(256) parallel_sum_count_kernel(const int64_t* count, int64_t capacity, F fn,
+                                                                 double* out, SumScratch s) {
+  using Reduce = cub::BlockReduce<double, 256>;
+  __shared__ typename Reduce::TempStorage tmp;
+  __shared__ bool last;
+  const int64_t n = *count < capacity ? *count : capacity;
+  const int64_t stride = int64_t(blockDim.x) * gridDim.x;
+  double v = 0.0;
+  for (int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x; i < n; i += stride) v += fn(i);
+  const double block = Reduce(tmp).Sum(v);
+  if (threadIdx.x == 0) {
+    s.partial[blockIdx.x] = block;
+    __threadfence();  // the partial is seen by whichever block finishes last
+    last = atomicInc(s.ticket, gridDim.x - 1) == gridDim.x - 1;  // wraps the ticket to zero
+  }
+  __syncthreads();
+  if (!last) return;
+  // The last block sums the partials in block order: the same sum whatever order blocks ran in.
+  __threadfence();
+  double t = 0.0;
+  for (unsigned b = threadIdx.x; b < gridDim.x; b += blockDim.x) t += static_cast<volatile double*>(s.partial)[b];
+  __syncthreads();
+  t = Reduce(tmp).Sum(t);
+  if (threadIdx.x == 0) *out = t;
+}
 /// Blocks of kBlock threads for n elements, at most 2^20 (the kernels stride over the rest).
 constexpr int kBlock = 256;
+static_assert(kBlock == 256, "parallel_sum_count_kernel's block reduction is of 256 threads");
 inline unsigned blocks_for(int64_t n) {
   const int64_t blocks = (n + kBlock - 1) / kBlock;
   return unsigned(blocks > (int64_t(1) << 20) ? (int64_t(1) << 20) : blocks);
@@ -80,6 +111,35 @@ void parallel_for_count(const int64_t* count, int64_t capacity, F fn, int64_t se
   WB_CUDA_CHECK_LAUNCH();
 #else
   parallel_for(*count < capacity ? *count : capacity, fn, serial_below);
+#endif
+}
+
+/// *out = the sum of fn(i) over the first *count of `capacity` elements, fn returning a double
+/// (and free to write its element's results): a pass and its dot product in one launch, left on
+/// the device. The order of the sum is fixed for a given capacity (CUDA: kSumBlocks partials
+/// summed in block order; CPU: OpenMP's static reduction, as reduce_sum), so a run repeats.
+template <typename F>
+void parallel_sum_count(const int64_t* count, int64_t capacity, F fn, double* out, SumScratch scratch) {
+  mem::count_launch();
+#if defined(__CUDACC__)
+  if (capacity <= 0) {
+    WB_CUDA_CHECK(cudaMemsetAsync(out, 0, sizeof(double), ::wb::cuda_stream()));
+    return;
+  }
+  static_assert(__nv_is_extended_host_device_lambda_closure_type(F) || !__nv_is_extended_device_lambda_closure_type(F),
+                "parallel_sum_count takes __host__ __device__ (WB_HD) lambdas or functors");
+  const unsigned blocks = detail::blocks_for(capacity) < unsigned(kSumBlocks) ? detail::blocks_for(capacity)
+                                                                               : unsigned(kSumBlocks);
+  detail::parallel_sum_count_kernel<<<blocks, detail::kBlock, 0, ::wb::cuda_stream()>>>(count, capacity, fn, out,
+                                                                                         scratch);
+  WB_CUDA_CHECK_LAUNCH();
+#else
+  (void)scratch;
+  const int64_t n = capacity <= 0 ? 0 : (*count < capacity ? *count : capacity);
+  double s = 0.0;
+#pragma omp parallel for reduction(+ : s) schedule(static) if (n > kMinParallelSum)
+  for (int64_t i = 0; i < n; ++i) s += fn(i);
+  *out = s;
 #endif
 }
 

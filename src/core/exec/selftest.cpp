@@ -12,6 +12,10 @@ void selftest_atomic_contention(const Device& d, float* acc4, int32_t* iacc2, in
 }
 void selftest_count_visits(const Device& d, int32_t* hits, int64_t n) { WB_DISPATCH(d, selftest_count_visits(hits, n)); }
 
+void selftest_sum_squares(const Device& d, const int64_t* count, int64_t capacity, double* x, double* out,
+                          SumScratch s) {
+  WB_DISPATCH(d, selftest_sum_squares(count, capacity, x, out, s));
+}
 std::string selftest_run(const Device& d) {
   try {
     d.activate();

@@ -17,4 +17,14 @@ void selftest_count_visits(int32_t* hits, int64_t n) {
   parallel_for(n, [=] WB_HD(int64_t i) { hits[i] += 1; });
 }
 
+void selftest_sum_squares(const int64_t* count, int64_t capacity, double* x, double* out, SumScratch s) {
+  parallel_sum_count(
+      count, capacity,
+      [=] WB_HD(int64_t i) {
+        x[i] = double(i % 97) * 0.125 - 3.3;
+        return x[i] * x[i];
+      },
+      out, s);
+}
+
 }  // namespace wb::WB_BACKEND_NS

@@ -60,16 +60,16 @@ void visc_setup_d(const Device& d, GridView g, const uint32_t* list, ListCount n
   WB_DISPATCH(d, grid_viscous_setup(g, list, n, idx, mu, scale, nu, nb, diag, b, x));
 }
 void visc_apply_d(const Device& d, ListCount n, const float* nu, const int32_t* nb, const double* diag, const double* p,
-                  double* q, double* pq, CgGuard guard = {}) {
-  WB_DISPATCH(d, grid_viscous_apply(n, nu, nb, diag, p, q, pq, guard));
+                  double* q, double* pq, CgGuard guard, SumScratch s) {
+  WB_DISPATCH(d, grid_viscous_apply(n, nu, nb, diag, p, q, pq, guard, s));
 }
 void pcg_start_d(const Device& d, ListCount n, const double* b, const double* ax, const double* diag, double* r,
-                 double* z, double* p, double* rz, double* bz) {
-  WB_DISPATCH(d, grid_pcg_start(n, b, ax, diag, r, z, p, rz, bz));
+                 double* z, double* p, double* rz, double* bz, SumScratch s) {
+  WB_DISPATCH(d, grid_pcg_start(n, b, ax, diag, r, z, p, rz, bz, s));
 }
 void pcg_update_d(const Device& d, ListCount n, CgGuard guard, const double* pq, const double* p, const double* q,
-                  const double* diag, double* x, double* r, double* z, double* rz, double* iterations) {
-  WB_DISPATCH(d, grid_pcg_update(n, guard, pq, p, q, diag, x, r, z, rz, iterations));
+                  const double* diag, double* x, double* r, double* z, double* rz, double* iterations, SumScratch s) {
+  WB_DISPATCH(d, grid_pcg_update(n, guard, pq, p, q, diag, x, r, z, rz, iterations, s));
 }
 void pcg_direction_d(const Device& d, ListCount n, CgGuard guard, const double* rz_new, const double* z, double* p) {
   WB_DISPATCH(d, grid_pcg_direction(n, guard, rz_new, z, p));
@@ -274,12 +274,16 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   }
   cg_nb_.set_device(d);
   cg_nu_.set_device(d);
-  for (auto* b : {&cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_, &cg_dot_a_, &cg_dot_b_})
-    b->set_device(d);
+  for (auto* b : {&cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_}) b->set_device(d);
   cg_sums_.set_device(d);
   cg_sums_.resize(6);
   cg_count_.set_device(d);
   cg_count_.resize(1);
+  cg_partial_.set_device(d);
+  cg_partial_.resize(kSumBlocks);
+  cg_ticket_.set_device(d);
+  cg_ticket_.resize(1);
+  cg_ticket_.fill_zero();
   advect_max_.set_device(d);
   advect_max_.resize(kAdvectMaxSlots);
   const size_t tiles = size_t((g.nx + kPaintTile - 1) / kPaintTile) * size_t((g.ny + kPaintTile - 1) / kPaintTile);
@@ -519,7 +523,7 @@ void Grid::apply_viscosity(float dt) {
   // Jacobi-preconditioned conjugate gradients (Saad 2003, Alg. 9.1) from the current velocity.
   // alpha, beta and the test of convergence are formed on the device from sums kept there
   // (cg_sums_: r.z of the current and the next iteration, p.Ap, b.D^-1 b, the iterations made),
-  // so an iteration makes no host read and one launched past convergence does nothing
+  // so an iteration makes no host read and one launched past convergence moves nothing
   // (CgGuard). The host launches as many as the last solve made, and a few more, then reads
   // once; only a solve that needs more reads again, after kCgCheckEvery more iterations, then
   // twice as many each time (a solve far past its plan reads a few times, not every 8).
@@ -528,6 +532,7 @@ void Grid::apply_viscosity(float dt) {
   const double tol2 = double(params_.viscosity_tolerance) * double(params_.viscosity_tolerance);
   const int max_it = params_.viscosity_max_iterations;
   double* sums = cg_sums_.data();
+  const SumScratch sum{cg_partial_.data(), cg_ticket_.data()};
   double host[6] = {};
   int cur = 0;
   for (int64_t need = 0;;) {
@@ -535,33 +540,44 @@ void Grid::apply_viscosity(float dt) {
       const size_t cap = size_t(std::min(all, std::max<int64_t>(need + need / 2, kCgFirstCapacity)));
       cg_nb_.resize(6 * cap);
       cg_nu_.resize(cap);
-      for (auto* b : {&cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_, &cg_dot_a_, &cg_dot_b_})
-        b->resize(cap);
+      for (auto* b : {&cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_}) b->resize(cap);
     }
     const ListCount n{cg_count_.data(), int64_t(cg_x_.size())};
     cg_sums_.fill_zero();
     visc_count_d(d, v, idx, n.capacity, cg_count_.data(), sums + 5);
     visc_setup_d(d, v, list, n, idx, mu_.data(), nu_scale, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(),
                  cg_b_.data(), cg_x_.data());
-    visc_apply_d(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_x_.data(), cg_q_.data(), cg_dot_a_.data());
-    pcg_start_d(d, n, cg_b_.data(), cg_q_.data(), cg_diag_.data(), cg_r_.data(), cg_z_.data(), cg_p_.data(),
-                cg_dot_a_.data(), cg_dot_b_.data());
-    reduce_sum_count_into(d, cg_dot_a_.data(), n.n, n.capacity, sums + 0, ws_);
-    reduce_sum_count_into(d, cg_dot_b_.data(), n.n, n.capacity, sums + 3, ws_);
+    // A x into q (its p.Ap lands in slot 2, which the first iteration writes again), then r, z,
+    // p, r.z and b.D^-1 b.
+    visc_apply_d(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_x_.data(), cg_q_.data(), sums + 2, {}, sum);
+    pcg_start_d(d, n, cg_b_.data(), cg_q_.data(), cg_diag_.data(), cg_r_.data(), cg_z_.data(), cg_p_.data(), sums + 0,
+                sums + 3, sum);
+    // Three launches an iteration (each pass forms its dot product as it goes), queued two
+    // iterations at a time: the pair repeats with the same arguments (r.z's slots alternate), so
+    // on CUDA it is one graph's launch (recorded again when the vectors move).
+    const auto iterate = [&](int c) {
+      const CgGuard guard{sums + c, sums + 3, tol2};
+      visc_apply_d(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_p_.data(), cg_q_.data(), sums + 2, guard,
+                   sum);
+      pcg_update_d(d, n, guard, sums + 2, cg_p_.data(), cg_q_.data(), cg_diag_.data(), cg_x_.data(), cg_r_.data(),
+                   cg_z_.data(), sums + 1 - c, sums + 4, sum);
+      pcg_direction_d(d, n, guard, sums + 1 - c, cg_z_.data(), cg_p_.data());
+    };
+    const uint64_t key = launch_key({launch_key_of(cg_x_.data()), launch_key_of(cg_nb_.data()),
+                                     launch_key_of(cg_nu_.data()), launch_key_of(sums), uint64_t(n.capacity)});
     int launched = 0;
     cur = 0;
-    for (int planned = std::min(max_it, cg_last_iterations_ + kCgMargin), more = kCgCheckEvery;; more *= 2) {
-      for (; launched < planned; ++launched) {
-        const int next = 1 - cur;
-        const CgGuard guard{sums + cur, sums + 3, tol2};
-        visc_apply_d(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_p_.data(), cg_q_.data(),
-                     cg_dot_a_.data(), guard);
-        reduce_sum_count_into(d, cg_dot_a_.data(), n.n, n.capacity, sums + 2, ws_);
-        pcg_update_d(d, n, guard, sums + 2, cg_p_.data(), cg_q_.data(), cg_diag_.data(), cg_x_.data(), cg_r_.data(),
-                     cg_z_.data(), cg_dot_a_.data(), sums + 4);
-        reduce_sum_count_into(d, cg_dot_a_.data(), n.n, n.capacity, sums + next, ws_);
-        pcg_direction_d(d, n, guard, sums + next, cg_z_.data(), cg_p_.data());
-        cur = next;
+    // Plans are even (pairs) but for an odd max_it, whose last iteration runs alone.
+    const auto even = [](int k) { return k + (k & 1); };
+    for (int planned = std::min(max_it, even(cg_last_iterations_ + kCgMargin)), more = kCgCheckEvery;; more *= 2) {
+      for (; launched + 2 <= planned; launched += 2) cg_pair_.run(d, key, [&] {
+          iterate(0);
+          iterate(1);
+        });
+      if (launched < planned) {
+        iterate(0);
+        cur = 1;
+        ++launched;
       }
       cg_sums_.copy_to_host(host, 6);
       need = int64_t(host[5]);

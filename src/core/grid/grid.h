@@ -8,6 +8,7 @@
 #include <functional>
 
 #include "core/canvas/tile_store.h"
+#include "core/exec/graph.h"
 #include "core/grid/active_window.h"
 #include "core/grid/grid_fields.h"
 #include "core/grid/grid_params.h"
@@ -154,12 +155,16 @@ class Grid {
   DeviceBuffer<int32_t> cg_nb_;
   DeviceBuffer<float> cg_nu_;
   /// The viscous CG's vectors and matrix diagonal, in double (viscous_apply says why).
-  DeviceBuffer<double> cg_x_, cg_b_, cg_r_, cg_z_, cg_p_, cg_q_, cg_diag_, cg_dot_a_, cg_dot_b_;
+  DeviceBuffer<double> cg_x_, cg_b_, cg_r_, cg_z_, cg_p_, cg_q_, cg_diag_;
   /// The CG's scalars on the device: r.z of the two latest iterations, p.Ap, b.D^-1 b, the
   /// iterations made, the fluid faces counted (read together, once a solve).
   DeviceBuffer<double> cg_sums_;
   /// The fluid faces the solve's kernels run over (ListCount::n).
   DeviceBuffer<int64_t> cg_count_;
+  /// The scratch of the iterations' dot products (parallel_sum_count): a partial a block, a ticket.
+  DeviceBuffer<double> cg_partial_;
+  DeviceBuffer<uint32_t> cg_ticket_;
+  LaunchGraph cg_pair_;  ///< two CG iterations, recorded (CUDA)
   int cg_last_iterations_ = 0;  ///< the last viscous solve's CG iterations: the next one plans on them
   /// The advection's maxima, read in one copy: the outflow rate along each axis (slots 0-2), then
   /// column_maxima's six (the top layers holding paint and paint or particles, the latter's box);
@@ -225,11 +230,12 @@ class Grid {
   void grid_viscous_setup(GridView g, const uint32_t* list, ListCount n, const uint32_t* idx, const float* mu,     \
                           float nu_scale, float* nu, int32_t* nb, double* diag, double* b, double* x);               \
   void grid_viscous_apply(ListCount n, const float* nu, const int32_t* nb, const double* diag, const double* p,       \
-                          double* q, double* pq, CgGuard guard);                                                     \
+                          double* q, double* pq, CgGuard guard, SumScratch s);                                       \
   void grid_pcg_start(ListCount n, const double* b, const double* ax, const double* diag, double* r, double* z,      \
-                      double* p, double* rz, double* bz);                                                            \
+                      double* p, double* rz, double* bz, SumScratch s);                                              \
   void grid_pcg_update(ListCount n, CgGuard guard, const double* pq, const double* p, const double* q,               \
-                       const double* diag, double* x, double* r, double* z, double* rz, double* iterations);        \
+                       const double* diag, double* x, double* r, double* z, double* rz, double* iterations,         \
+                       SumScratch s);                                                                                \
   void grid_pcg_direction(ListCount n, CgGuard guard, const double* rz_new, const double* z, double* p);          \
   void grid_viscous_write(GridView g, const uint32_t* list, ListCount n, const double* x);                         \
   void grid_rhs(GridView g, const float* rho, float inv_dt, float* b);                                                                               \

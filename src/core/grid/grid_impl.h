@@ -432,38 +432,49 @@ void grid_viscous_setup(GridView g, const uint32_t* list, ListCount n, const uin
 }
 
 void grid_viscous_apply(ListCount n, const float* nu, const int32_t* nb, const double* diag, const double* p,
-                        double* q, double* pq, CgGuard guard) {
-  parallel_for_count(n.n, n.capacity, [=] WB_HD(int64_t e) {
-    if (!guard.active()) return;
-    q[e] = viscous_apply(nu, nb, p, diag[e], e);
-    pq[e] = p[e] * q[e];
-  });
+                        double* q, double* pq, CgGuard guard, SumScratch s) {
+  parallel_sum_count(
+      n.n, n.capacity,
+      [=] WB_HD(int64_t e) {
+        if (!guard.active()) return 0.0;
+        q[e] = viscous_apply(nu, nb, p, diag[e], e);
+        return p[e] * q[e];
+      },
+      pq, s);
 }
 
 void grid_pcg_start(ListCount n, const double* b, const double* ax, const double* diag, double* r, double* z,
-                    double* p, double* rz, double* bz) {
-  parallel_for_count(n.n, n.capacity, [=] WB_HD(int64_t e) {
-    r[e] = b[e] - ax[e];
-    z[e] = r[e] / diag[e];
-    p[e] = z[e];
-    rz[e] = r[e] * z[e];
-    bz[e] = b[e] * b[e] / diag[e];
-  });
+                    double* p, double* rz, double* bz, SumScratch s) {
+  parallel_sum_count(
+      n.n, n.capacity,
+      [=] WB_HD(int64_t e) {
+        r[e] = b[e] - ax[e];
+        z[e] = r[e] / diag[e];
+        p[e] = z[e];
+        return r[e] * z[e];
+      },
+      rz, s);
+  parallel_sum_count(n.n, n.capacity, [=] WB_HD(int64_t e) { return b[e] * b[e] / diag[e]; }, bz, s);
 }
 
 void grid_pcg_update(ListCount n, CgGuard guard, const double* pq, const double* p, const double* q,
-                     const double* diag, double* x, double* r, double* z, double* rz, double* iterations) {
-  parallel_for_count(n.n, n.capacity, [=] WB_HD(int64_t e) {
-    if (!guard.active()) return;
-    if (e == 0) *iterations += 1.0;
-    // alpha = (r.z) / (p.Ap) from the device sums; 0 (no step) where p.Ap is not positive,
-    // which an SPD system reaches only by round-off at convergence.
-    const double alpha = *pq > 0.0 ? *guard.rz / *pq : 0.0;
-    x[e] += alpha * p[e];
-    r[e] -= alpha * q[e];
-    z[e] = r[e] / diag[e];
-    rz[e] = r[e] * z[e];
-  });
+                     const double* diag, double* x, double* r, double* z, double* rz, double* iterations,
+                     SumScratch s) {
+  parallel_sum_count(
+      n.n, n.capacity,
+      [=] WB_HD(int64_t e) {
+        // Past convergence nothing moves, and the sum is the last r.z again (to rounding).
+        if (!guard.active()) return r[e] * z[e];
+        if (e == 0) *iterations += 1.0;
+        // alpha = (r.z) / (p.Ap) from the device sums; 0 (no step) where p.Ap is not positive,
+        // which an SPD system reaches only by round-off at convergence.
+        const double alpha = *pq > 0.0 ? *guard.rz / *pq : 0.0;
+        x[e] += alpha * p[e];
+        r[e] -= alpha * q[e];
+        z[e] = r[e] / diag[e];
+        return r[e] * z[e];
+      },
+      rz, s);
 }
 
 void grid_pcg_direction(ListCount n, CgGuard guard, const double* rz_new, const double* z, double* p) {

@@ -35,8 +35,8 @@ void d_absorb(const Device& d, ParticleView p, SampleView s, BristleLoadView l, 
   WB_DISPATCH(d, transfer_absorb(p, s, l, a, prm, dt, step_index));
 }
 void d_wick(const Device& d, SampleView s, BristleLoadView l, int bristles, int per, float k_dt, float k_slide,
-            float dt, float* a, float* b) {
-  WB_DISPATCH(d, transfer_wick(s, l, bristles, per, k_dt, k_slide, dt, a, b));
+            float dt, WickScratch w) {
+  WB_DISPATCH(d, transfer_wick(s, l, bristles, per, k_dt, k_slide, dt, w));
 }
 void d_contact_paths(const Device& d, SampleView s, BristleLoadView l, float dt, int ox, int oy, int nx, int ny,
                      uint32_t* passes) {
@@ -276,8 +276,16 @@ void Transfer::wick(const SampleView& samples, BristleLoad& load, float dt) {
   WB_REQUIRE(std::isfinite(dt) && dt >= 0.f, "Transfer::wick: dt must be finite and >= 0");
   if (ns == 0 || dt == 0.f) return;
   ensure_samples(ns);
+  WickScratch w{};
+  for (int k = 0; k < 2; ++k) {
+    w.a[k] = s_f32_[4 * k].data();
+    w.e[k] = s_f32_[4 * k + 1].data();
+    w.c[k] = s_f32_[4 * k + 2].data();
+    w.d[k] = s_f32_[4 * k + 3].data();
+  }
+  w.g = s_f32_[8].data();
   d_wick(device_, samples, load.view(), samples.bristles, samples.per_bristle, params_.wick_rate * dt,
-         params_.wick_slide, dt, s_f32_[0].data(), s_f32_[1].data());
+         params_.wick_slide, dt, w);
 }
 
 void Transfer::absorb(const SampleView& samples, BristleLoad& load, ParticleStore& particles, float dt) {

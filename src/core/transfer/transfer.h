@@ -92,6 +92,17 @@ struct TransferSums {
 };
 
 /// Scratch of the absorption pass, per sample (accumulators) and per particle (moved mass).
+/// The wick's per-sample scratch: each bristle's tridiagonal rows (a s_{i-1} + b s_i + c s_{i+1}
+/// = d, kept as a, c, d and the row sum e = a + b + c) in two copies for the cyclic reduction's
+/// passes, and each edge's conductance g.
+struct WickScratch {
+  float* a[2];
+  float* e[2];
+  float* c[2];
+  float* d[2];
+  float* g;
+};
+
 struct AbsorbScratch {
   uint32_t* ticket;  ///< particles that asked sample j this step
   float* claimed;    ///< mass claimed from sample j this step (capacity test)
@@ -266,7 +277,7 @@ void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadVi
                        float dt, int64_t step_index);                                                              \
   void transfer_absorb_apply(BristleLoadView load, AbsorbScratch a);                                               \
   void transfer_wick(SampleView s, BristleLoadView load, int bristles, int per, float k_dt, float k_slide, float dt, \
-                     float* a, float* d);                 \
+                     WickScratch w);                                                                                 \
   void transfer_distance_occupancy(SampleView s, DistanceBlocks db, int32_t* occ, int ox, int oy, int oz);         \
   void transfer_distance_init(const int32_t* occ, float* d2, int64_t n);                                           \
   void transfer_distance_pass(DistanceBlocks db, int axis, const float* src, float* dst, int32_t* v, float* z);    \

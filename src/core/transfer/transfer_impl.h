@@ -65,87 +65,120 @@ void transfer_contact_share(SampleView s, BristleLoadView load, float dt, int ox
 
 // --- wicking along each bristle (docs/TRANSFER.md "Wicking") -------------------------------
 
-// One thread per bristle: backward Euler for M'_i s_i - sum_e g_e (s_nb - s_i) = m_i (Thomas
-// algorithm; the matrix is an M-matrix, so s stays >= 0 and the bristle's mass is kept), then
-// the edge fluxes from the new saturations carry colour and oil upwind from the old values.
-// a, d are per-sample scratch (the eliminated diagonal and right-hand side).
+// Backward Euler for M'_i s_i - sum_e g_e (s_nb - s_i) = m_i on each bristle, a tridiagonal
+// M-matrix system, solved by parallel cyclic reduction (Hockney and Jesshope 1988): a thread a
+// sample, ceil(log2 per) passes, each eliminating the neighbours at twice the last distance.
+// The reduction keeps each row's sum e = b + a + c (= M_i (1 + sigma_i) at first) rather than
+// its diagonal b: under a fast flow (g >> M) b is the near-cancelling g_{i-1} + g_i + M, and the
+// new rows' margins would be differences of such; e's update is a sum of terms >= 0 (as in
+// Grassmann, Taksar and Heyman's elimination), so the solve stays accurate where Thomas's did.
+// The signs of an M-matrix hold (a, c <= 0, d >= 0), so s >= 0. Then the edge fluxes from the
+// new saturations carry colour and oil upwind from the old values, and the flux form keeps the
+// bristle's mass (to rounding).
 void transfer_wick(SampleView s, BristleLoadView load, int bristles, int per, float k_dt, float k_slide, float dt,
-                   float* a, float* d) {
-  parallel_for(
-      bristles,
-      [=] WB_HD(int64_t b) {
-        const int64_t o = b * per;
-        // Saturation against the capacity M_j of Eq. 13: a contact sample that emitted down to
-        // M_j is as full as its neighbours, so paint flows to it only as it loses paint by
-        // sliding (swept contact), not at a rate per second (a held brush does not leak).
-        const float* Mp = load.capacity + o;
-        float* m = load.m + o;
-        float* sc = a + o;  // c'_i of the Thomas sweep
-        float* sd = d + o;  // d'_i, then s_i
-        // Forward sweep: row i is (-g_{i-1}) s_{i-1} + (M_i (1 + sigma_i) + g_{i-1} + g_i) s_i
-        // + (-g_i) s_{i+1} = m_i, with the swept contact's sink sigma_i M_i s_i (backward Euler).
-        const float* sigma = load.sweep + o;
-        const Vec3* v = s.v + o;
-        // Conductance of edge i (samples i, i + 1); the drag term uses the edge's mean slide.
-        const auto edge = [&](int i) {
-          const float slid = 0.5f * (slid_distance(v[i], dt) + slid_distance(v[i + 1], dt));
-          return wick_conductance(k_dt, k_slide, slid, Mp[i], Mp[i + 1]);
-        };
-        float g_prev = 0.f;
-        for (int i = 0; i < per; ++i) {
-          const float g = i + 1 < per ? edge(i) : 0.f;
-          const float diag = maxf(Mp[i], 1e-30f) * (1.f + maxf(sigma[i], 0.f)) + g_prev + g -
-                             (i > 0 ? g_prev * sc[i - 1] : 0.f);
-          sc[i] = g / diag;  // minus the eliminated upper coefficient (-g_i / diag)
-          sd[i] = (m[i] + (i > 0 ? g_prev * sd[i - 1] : 0.f)) / diag;
-          g_prev = g;
-        }
-        for (int i = per - 2; i >= 0; --i) sd[i] += sc[i] * sd[i + 1];
-        // Fluxes F_i from sample i to i+1, then upwind colour: each sample mixes in what it
-        // received with the giver's old colour (Algorithm 2, batch form as in Eq. 14).
-        Vec3 c_left(0.f, 0.f, 0.f);
-        float oil_left = 0.f, F_left = 0.f;
-        for (int i = 0; i < per; ++i) {
-          const float F = i + 1 < per ? edge(i) * (sd[i] - sd[i + 1]) : 0.f;
-          const Vec3 ci(load.pigment_r[o + i], load.pigment_y[o + i], load.pigment_b[o + i]);
-          const float oil_i = load.oil[o + i];
-          const float mi = m[i];
-          float gain = 0.f, oil_in = 0.f, b_in = 0.f;
-          Vec3 wc(0.f, 0.f, 0.f);
-          if (F_left > 0.f) {  // from i - 1
-            gain += F_left;
-            wc = wc + c_left * F_left;
-            b_in += F_left * pigment_brightness(c_left);
-            oil_in += F_left * oil_left;
-          }
-          if (F < 0.f) {  // from i + 1 (old values: not yet written)
-            const Vec3 cr(load.pigment_r[o + i + 1], load.pigment_y[o + i + 1], load.pigment_b[o + i + 1]);
-            gain -= F;
-            wc = wc + cr * (-F);
-            b_in += -F * pigment_brightness(cr);
-            oil_in += -F * load.oil[o + i + 1];
-          }
-          const float lose = maxf(-F_left, 0.f) + maxf(F, 0.f);
-          const float keep = maxf(mi - lose, 0.f);
-          const float m_new = maxf(mi + F_left - F, 0.f);
-          // What the sink took: sigma M s = sigma / (1 + sigma) of the sample's paint after the
-          // flow; it stays on the sample until the emission pass lays it along the path.
-          const float sg = maxf(sigma[i], 0.f);
-          load.sweep[o + i] = m_new * sg / (1.f + sg);
-          c_left = ci;
-          oil_left = oil_i;
-          F_left = F;
-          if (gain > 0.f) {
-            const Vec3 cn = mix_batch(ci, keep, wc, b_in, gain);
-            load.pigment_r[o + i] = cn.x;
-            load.pigment_y[o + i] = cn.y;
-            load.pigment_b[o + i] = cn.z;
-            load.oil[o + i] = (keep * oil_i + oil_in) / maxf(keep + gain, 1e-30f);
-          }
-          m[i] = m_new;
-        }
-      },
-      kMinParallelHeavy);
+                   WickScratch w) {
+  const int64_t ns = int64_t(bristles) * per;
+  // Saturation against the capacity M_j of Eq. 13: a contact sample that emitted down to M_j is
+  // as full as its neighbours, so paint flows to it only as it loses paint by sliding (swept
+  // contact), not at a rate per second (a held brush does not leak).
+  const float* Mp = load.capacity;
+  const float* sigma = load.sweep;
+  const Vec3* v = s.v;
+  // Conductance of edge t (samples t, t + 1 of one bristle); the drag term uses its mean slide.
+  const auto edge = [=] WB_HD(int64_t t) {
+    const float slid = 0.5f * (slid_distance(v[t], dt) + slid_distance(v[t + 1], dt));
+    return wick_conductance(k_dt, k_slide, slid, Mp[t], Mp[t + 1]);
+  };
+  // Row i: (-g_{i-1}) s_{i-1} + (M_i (1 + sigma_i) + g_{i-1} + g_i) s_i + (-g_i) s_{i+1} = m_i,
+  // with the swept contact's sink sigma_i M_i s_i; its sum e_i = M_i (1 + sigma_i).
+  parallel_for(ns, [=] WB_HD(int64_t t) {
+    const int i = int(t % per);
+    const float g_prev = i > 0 ? edge(t - 1) : 0.f;
+    const float g = i + 1 < per ? edge(t) : 0.f;
+    w.g[t] = g;
+    w.a[0][t] = -g_prev;
+    w.c[0][t] = -g;
+    w.e[0][t] = maxf(Mp[t], 1e-30f) * (1.f + maxf(sigma[t], 0.f));
+    w.d[0][t] = load.m[t];
+  });
+  int cur = 0;
+  for (int stride = 1; stride < per; stride *= 2, cur = 1 - cur) {
+    const float *a = w.a[cur], *e = w.e[cur], *c = w.c[cur], *d = w.d[cur];
+    float *a2 = w.a[1 - cur], *e2 = w.e[1 - cur], *c2 = w.c[1 - cur], *d2 = w.d[1 - cur];
+    parallel_for(ns, [=] WB_HD(int64_t t) {
+      const int i = int(t % per);
+      const bool lo = i - stride >= 0, hi = i + stride < per;
+      // Row t minus al times row t - stride and ga times row t + stride, which removes its
+      // couplings to them (b = e - a - c, a sum of terms >= 0).
+      const float al = lo ? -a[t] / (e[t - stride] - a[t - stride] - c[t - stride]) : 0.f;
+      const float ga = hi ? -c[t] / (e[t + stride] - a[t + stride] - c[t + stride]) : 0.f;
+      a2[t] = lo ? al * a[t - stride] : 0.f;
+      c2[t] = hi ? ga * c[t + stride] : 0.f;
+      e2[t] = e[t] + (lo ? al * e[t - stride] : 0.f) + (hi ? ga * e[t + stride] : 0.f);
+      d2[t] = d[t] + (lo ? al * d[t - stride] : 0.f) + (hi ? ga * d[t + stride] : 0.f);
+    });
+  }
+  // The flux F_t from sample t to t + 1 and its giver's old colour and oil (upwind), into the
+  // other copy's rows, which the reduction no longer needs.
+  // Each row is s_t e_t = d_t now (its couplings are gone).
+  const float *e = w.e[cur], *d = w.d[cur];
+  float *F = w.a[1 - cur], *give_r = w.e[1 - cur], *give_y = w.c[1 - cur], *give_b = w.d[1 - cur],
+        *give_oil = w.a[cur];
+  parallel_for(ns, [=] WB_HD(int64_t t) {
+    const int i = int(t % per);
+    if (i + 1 >= per) {
+      F[t] = 0.f;
+      return;
+    }
+    const float f = w.g[t] * (d[t] / e[t] - d[t + 1] / e[t + 1]);
+    const int64_t giver = f > 0.f ? t : t + 1;
+    F[t] = f;
+    give_r[t] = load.pigment_r[giver];
+    give_y[t] = load.pigment_y[giver];
+    give_b[t] = load.pigment_b[giver];
+    give_oil[t] = load.oil[giver];
+  });
+  // Each sample mixes in what it received with the giver's old colour (Algorithm 2, batch form
+  // as in Eq. 14); a sample that only gives keeps its colour.
+  parallel_for(ns, [=] WB_HD(int64_t t) {
+    const int i = int(t % per);
+    const float F_left = i > 0 ? F[t - 1] : 0.f;
+    const float F_right = F[t];
+    const Vec3 ci(load.pigment_r[t], load.pigment_y[t], load.pigment_b[t]);
+    const float oil_i = load.oil[t];
+    const float mi = load.m[t];
+    float gain = 0.f, oil_in = 0.f, b_in = 0.f;
+    Vec3 wc(0.f, 0.f, 0.f);
+    if (F_left > 0.f) {  // from i - 1
+      const Vec3 cl(give_r[t - 1], give_y[t - 1], give_b[t - 1]);
+      gain += F_left;
+      wc = wc + cl * F_left;
+      b_in += F_left * pigment_brightness(cl);
+      oil_in += F_left * give_oil[t - 1];
+    }
+    if (F_right < 0.f) {  // from i + 1
+      const Vec3 cr(give_r[t], give_y[t], give_b[t]);
+      gain -= F_right;
+      wc = wc + cr * (-F_right);
+      b_in += -F_right * pigment_brightness(cr);
+      oil_in += -F_right * give_oil[t];
+    }
+    const float lose = maxf(-F_left, 0.f) + maxf(F_right, 0.f);
+    const float keep = maxf(mi - lose, 0.f);
+    const float m_new = maxf(mi + F_left - F_right, 0.f);
+    // What the sink took: sigma M s = sigma / (1 + sigma) of the sample's paint after the flow;
+    // it stays on the sample until the emission pass lays it along the path.
+    const float sg = maxf(sigma[t], 0.f);
+    load.sweep[t] = m_new * sg / (1.f + sg);
+    if (gain > 0.f) {
+      const Vec3 cn = mix_batch(ci, keep, wc, b_in, gain);
+      load.pigment_r[t] = cn.x;
+      load.pigment_y[t] = cn.y;
+      load.pigment_b[t] = cn.z;
+      load.oil[t] = (keep * oil_i + oil_in) / maxf(keep + gain, 1e-30f);
+    }
+    load.m[t] = m_new;
+  });
 }
 
 // --- Eq. 14: absorption and colour bleeding ----------------------------------------------

@@ -1,0 +1,65 @@
+// LaunchGraph: a run of launches that repeats with the same arguments, recorded once as a CUDA
+// graph and replayed whole, so the run costs one launch's latency instead of one a kernel.
+#pragma once
+#include <cstdint>
+#include <initializer_list>
+
+#include "core/exec/device.h"
+#include "core/exec/memory.h"
+
+namespace wb {
+
+/// A key for LaunchGraph::run from what its launches depend on: the buffers' addresses and the
+/// sizes they were launched over. A different key records the launches again.
+inline uint64_t launch_key(std::initializer_list<uint64_t> parts) {
+  uint64_t h = 1469598103934665603ull;  // FNV-1a over the parts' bytes
+  for (uint64_t p : parts)
+    for (int b = 0; b < 8; ++b) h = (h ^ ((p >> (8 * b)) & 0xffu)) * 1099511628211ull;
+  return h;
+}
+inline uint64_t launch_key_of(const void* p) { return uint64_t(reinterpret_cast<uintptr_t>(p)); }
+
+class LaunchGraph {
+ public:
+  LaunchGraph() = default;
+  ~LaunchGraph() { reset(); }
+  LaunchGraph(const LaunchGraph&) = delete;
+  LaunchGraph& operator=(const LaunchGraph&) = delete;
+
+  /// Runs `launches`, a function that only queues device work on the simulator's stream (no
+  /// host read, no allocation, the same arguments for the same key). On CUDA it is recorded the
+  /// first time and whenever `key` changes, and the recording is replayed; on the CPU, called.
+  template <typename F>
+  void run(const Device& d, uint64_t key, F&& launches) {
+    if (!d.is_cuda()) {
+      launches();
+      return;
+    }
+    const bool recorded = !(exec_ && key == key_);
+    if (recorded) {
+      const int64_t before = mem::launches();
+      begin();
+      try {
+        launches();
+      } catch (...) {
+        abandon();
+        throw;
+      }
+      end(key, mem::launches() - before);
+    }
+    replay(!recorded);
+  }
+  /// Drops the recording (the next run records again).
+  void reset();
+
+ private:
+  void begin();
+  void end(uint64_t key, int64_t launches);
+  void abandon();
+  void replay(bool count);
+  void* exec_ = nullptr;  // cudaGraphExec_t
+  uint64_t key_ = 0;
+  int64_t launches_ = 0;  // the kernels recorded: counted as launches on every replay
+};
+
+}  // namespace wb
