@@ -37,7 +37,7 @@ WB_BRUSH_CALL(brush_restore, (BristleState s, BrushFrame f, int64_t* c), (s, f, 
 WB_BRUSH_CALL(brush_place, (BristleState s, BristleRest r, BrushFrame f), (s, r, f))
 WB_BRUSH_CALL(brush_stretch_and_z, (BristleState s, BristleRest r, float* a, float* b), (s, r, a, b))
 WB_BRUSH_CALL(samples_spline, (BristleState s, SampleView sv, SamplePrev p, SolidField so), (s, sv, p, so))
-WB_BRUSH_CALL(samples_frames, (SampleView sv, BrushFrame f), (sv, f))
+WB_BRUSH_CALL(samples_frames, (SampleView sv, BrushFrame f, FrameScan q), (sv, f, q))
 WB_BRUSH_CALL(samples_motion, (SampleView sv, SamplePrev p, float dt, int h), (sv, p, dt, h))
 WB_BRUSH_CALL(samples_z, (SampleView sv, float* z), (sv, z))
 WB_BRUSH_CALL(samples_rasterize,
@@ -146,6 +146,12 @@ Brush::Brush(const Device& device, const BrushSpec& spec, const BrushPose& pose,
   lambda_.resize(size_t(N));
   contact_keys_.resize(size_t(S));
   contact_vals_.resize(size_t(S));
+  for (int k = 0; k < 2; ++k) {
+    scan_w_[k].set_device(device);
+    scan_w_[k].resize(size_t(S));
+    scan_v_[k].set_device(device);
+    scan_v_[k].resize(size_t(S));
+  }
   scratch_a_.set_device(device);
   scratch_b_.set_device(device);
   scratch_a_.resize(size_t(std::max(N, S)));
@@ -309,7 +315,8 @@ void Brush::update_samples(float dt, const BrushFrame& frame, const SolidField& 
   const SampleView sv = samples();
   const SamplePrev prev = prev_view();
   samples_spline_on(device_, state_view(), sv, prev, solid);
-  samples_frames_on(device_, sv, frame);
+  samples_frames_on(device_, sv, frame,
+                    FrameScan{{scan_w_[0].data(), scan_w_[1].data()}, {scan_v_[0].data(), scan_v_[1].data()}});
   samples_motion_on(device_, sv, prev, dt, sample_history_);
   sample_history_ = std::min(sample_history_ + 1, 2);
 }

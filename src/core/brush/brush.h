@@ -155,6 +155,8 @@ class Brush {
   // Scratch: contact keys, reductions.
   DeviceBuffer<uint32_t> contact_keys_, contact_vals_;
   DeviceBuffer<float> scratch_a_, scratch_b_;
+  DeviceBuffer<float> scan_w_[2];  ///< the frames' scan (FrameScan)
+  DeviceBuffer<Vec3> scan_v_[2];
   DeviceBuffer<int64_t> nonfinite_;  ///< the sub-step's non-finite positions, velocities; rollbacks
   DeviceBuffer<double> count_;       ///< mark_contacts' count
 };

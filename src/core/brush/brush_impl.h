@@ -273,26 +273,51 @@ void samples_spline(BristleState s, SampleView sv, SamplePrev prev, SolidField s
   });
 }
 
-void samples_frames(SampleView sv, BrushFrame f) {
+void samples_frames(SampleView sv, BrushFrame f, FrameScan scan) {
   const int S = sv.per_bristle;
-  parallel_for(sv.bristles, [=] WB_HD(int64_t k) {
-    const int64_t base = k * S;
-    // Root frame attached to the brush: the handle's x axis made normal to the tangent.
-    const Vec3 t0 = sv.t[base];
+  const int64_t n_all = sv.count();
+  // Root frame attached to the brush: the handle's x axis made normal to the tangent (its y
+  // axis where x is along it).
+  const auto normal_to = [=] WB_HD(Vec3 t) {
     const Vec3 ax = f.R.col(0), ay = f.R.col(1);
-    Vec3 n = ax - t0 * dot(t0, ax);
-    if (length2(n) < 1e-6f) n = ay - t0 * dot(t0, ay);
-    n = normalize(n);
-    sv.n[base] = n;
-    sv.b[base] = cross(t0, n);
-    for (int j = 1; j < S; ++j) {
-      const Vec3 t = sv.t[base + j];
-      n = brush::parallel_transport(n, sv.t[base + j - 1], t);
-      n = normalize_or(n - t * dot(t, n), sv.n[base + j - 1]);  // keep orthonormal against rounding
-      sv.n[base + j] = n;
-      sv.b[base + j] = cross(t, n);
-    }
-  }, kMinParallelHeavy);  // one bristle per element
+    const Vec3 n = ax - t * dot(t, ax);
+    return length2(n) < 1e-6f ? normalize(ay - t * dot(t, ay)) : normalize(n);
+  };
+  // n_j is n_0 carried by the transports of edges 1..j: their product, a prefix product over
+  // each bristle (Hillis and Steele 1986), ceil(log2 S) passes of a thread a sample instead of
+  // one thread walking each bristle.
+  parallel_for(n_all, [=] WB_HD(int64_t q) {
+    const int j = int(q % S);
+    const brush::Quat r = j > 0 ? brush::transport_quat(sv.t[q - 1], sv.t[q]) : brush::Quat{1.f, Vec3()};
+    scan.w[0][q] = r.w;
+    scan.v[0][q] = r.v;
+  });
+  int cur = 0;
+  for (int stride = 1; stride < S; stride *= 2, cur = 1 - cur) {
+    const float* w = scan.w[cur];
+    const Vec3* v = scan.v[cur];
+    float* w2 = scan.w[1 - cur];
+    Vec3* v2 = scan.v[1 - cur];
+    parallel_for(n_all, [=] WB_HD(int64_t q) {
+      const int j = int(q % S);
+      brush::Quat r{w[q], v[q]};
+      if (j >= stride) r = brush::quat_normalize(brush::quat_mul(r, brush::Quat{w[q - stride], v[q - stride]}));
+      w2[q] = r.w;
+      v2[q] = r.v;
+    });
+  }
+  const float* w = scan.w[cur];
+  const Vec3* v = scan.v[cur];
+  parallel_for(n_all, [=] WB_HD(int64_t q) {
+    const int64_t base = q - q % S;
+    const Vec3 t = sv.t[q];
+    const Vec3 n0 = normal_to(sv.t[base]);
+    const Vec3 c = brush::quat_rotate(brush::Quat{w[q], v[q]}, n0);
+    // Made normal to t again against rounding (the carried n is normal to it but for that).
+    const Vec3 n = normalize_or(c - t * dot(t, c), normal_to(t));
+    sv.n[q] = n;
+    sv.b[q] = cross(t, n);
+  });
 }
 
 void samples_motion(SampleView sv, SamplePrev prev, float dt, int history) {

@@ -30,6 +30,12 @@ struct SamplePrev {
   Vec3* omega;
 };
 
+/// The frames' prefix product of transports, a quaternion (w, v) a sample, in two copies.
+struct FrameScan {
+  float* w[2];
+  Vec3* v[2];
+};
+
 #define WB_BRUSH_STAGE_DECLS                                                                                      \
   void brush_integrate(BristleState s, BristleRest r, BrushFrame f, BrushForces e, float beta_B, float damping,    \
                        float dt);                                                                                  \
@@ -45,7 +51,7 @@ struct SamplePrev {
   void brush_place(BristleState s, BristleRest r, BrushFrame f);                                                   \
   void brush_stretch_and_z(BristleState s, BristleRest r, float* stretch, float* z);                              \
   void samples_spline(BristleState s, SampleView sv, SamplePrev prev, SolidField solid);                           \
-  void samples_frames(SampleView sv, BrushFrame f);                                                                \
+  void samples_frames(SampleView sv, BrushFrame f, FrameScan scan);                                                \
   void samples_motion(SampleView sv, SamplePrev prev, float dt, int history);                                     \
   void samples_z(SampleView sv, float* z);                                                                         \
   void samples_rasterize(SampleView sv, float radius, Int3 origin, Int3 dims, float* psi, float* vx, float* vy,    \

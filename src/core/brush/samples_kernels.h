@@ -37,6 +37,31 @@ WB_HD WB_INLINE Vec3 parallel_transport(Vec3 n, Vec3 t0, Vec3 t1) {
   return n * c + cross(k, n) * s + k * (dot(k, n) * (1.f - c));
 }
 
+/// A unit quaternion (w, v) as the frames' scan composes them.
+struct Quat {
+  float w;
+  Vec3 v;
+};
+/// a b: the rotation b, then a.
+WB_HD WB_INLINE Quat quat_mul(Quat a, Quat b) {
+  return {a.w * b.w - dot(a.v, b.v), b.v * a.w + a.v * b.w + cross(a.v, b.v)};
+}
+WB_HD WB_INLINE Quat quat_normalize(Quat q) {
+  const float l = sqrtf(q.w * q.w + dot(q.v, q.v));
+  return l > 0.f ? Quat{q.w / l, q.v / l} : Quat{1.f, Vec3()};
+}
+WB_HD WB_INLINE Vec3 quat_rotate(Quat q, Vec3 n) {
+  const Vec3 c = cross(q.v, n);
+  return n + c * (2.f * q.w) + cross(q.v, c) * 2.f;
+}
+/// The minimal rotation taking unit t0 to unit t1 (parallel_transport's), as a quaternion:
+/// (1 + t0.t1, t0 x t1) normalised; the identity where the two are parallel or opposite.
+WB_HD WB_INLINE Quat transport_quat(Vec3 t0, Vec3 t1) {
+  const Vec3 axis = cross(t0, t1);
+  if (length(axis) < 1e-8f) return {1.f, Vec3()};
+  return quat_normalize({1.f + dot(t0, t1), axis});
+}
+
 /// Rotation vector (axis * angle, angle in [0, pi]) of a rotation matrix; robust near 0
 /// (first order from the skew part) and near pi (axis from the diagonal).
 WB_HD WB_INLINE Vec3 rotation_vector(const Mat3& R) {
