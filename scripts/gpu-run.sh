@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Runs what scripts/bundle-gpu.sh built on a machine with a CUDA GPU: the test suite on the
 # CUDA backend, the benchmarks, the step bench of the examples and their replays, writing logs,
-# stats and pictures to DIR.
-#   scripts/gpu-run.sh DIR [tests|bench|steps|replay]...   (all four when none is named)
+# stats and pictures to DIR; on request compute-sanitizer over the kernels' own tests and a soak.
+#   scripts/gpu-run.sh DIR [tests|bench|steps|replay|sanitize|soak]...   (the first four when none
+#   is named; WB_SOAK_MINUTES sets the soak's length, default 4)
 set -uo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 out="${1:?output directory}"; shift
@@ -30,5 +31,22 @@ for w in $what; do
       done ;;
     replay)
       "$here/scripts/gallery.sh" "$out" cuda "$bin" ;;
+    sanitize)
+      # Out-of-bounds and uninitialised accesses, and shared-memory races, in the kernels whose
+      # tests build them whole: the scans, the block sums, the recorded graphs, the CG.
+      cs="$(command -v compute-sanitizer || echo /usr/local/cuda/bin/compute-sanitizer)"
+      filter='AlgorithmsTest.*:WickTest.*:BrushSamplesTest.*:GridStepTest.ViscousSolve*'
+      for tool in memcheck racecheck; do
+        WB_DEVICE=cuda timeout 120 "$cs" --tool "$tool" --error-exitcode 3 "$bin/wetbrush_tests" --gtest_brief=1 \
+          --gtest_filter="$filter" > "$out/sanitize-$tool.log" 2>&1
+        echo "compute-sanitizer $tool: exit $?"; grep -E "ERROR SUMMARY|RACECHECK SUMMARY|PASSED|FAILED" "$out/sanitize-$tool.log" | head -5
+      done ;;
+    soak)
+      # Device and host memory over many runs back to back (docs/PERFORMANCE.md "Soak").
+      m="${WB_SOAK_MINUTES:-4}"
+      timeout $(( m * 60 + 120 )) "$bin/wetbrush" soak "$here"/examples/press-and-drag.json \
+        "$here"/tests/data/strokes/good/minimal.json "$here"/tests/data/strokes/good/tablet.txt --minutes "$m" \
+        --device cuda --json "$out/soak.json" > "$out/soak.txt" 2>&1
+      echo "soak (cuda, $m min): exit $?"; tail -4 "$out/soak.txt" ;;
   esac
 done

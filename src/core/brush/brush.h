@@ -13,6 +13,7 @@
 #include "core/brush/brush_views.h"
 #include "core/canvas/window.h"
 #include "core/exec/buffer.h"
+#include "core/exec/graph.h"
 #include "core/exec/workspace.h"
 
 namespace wb {
@@ -145,6 +146,7 @@ class Brush {
   // Minimum-density hash grid.
   DeviceBuffer<uint32_t> grid_keys_, grid_ids_, cell_start_, cell_end_;
   DeviceBuffer<float> lambda_;
+  LaunchGraph density_graph_;  ///< the minimum-density iterations, recorded (CUDA)
   uint32_t grid_mask_ = 0;
   int grid_bits_ = 0;
   // Samples and their previous values.

@@ -14,11 +14,14 @@ void LaunchGraph::reset() {
   if (exec_) cudaGraphExecDestroy(static_cast<cudaGraphExec_t>(exec_));  // no throw from a destructor
   exec_ = nullptr;
   key_ = 0;
+  seen_ = 0;
   launches_ = 0;
 }
 
 void LaunchGraph::begin() {
+  const uint64_t seen = seen_;
   reset();
+  seen_ = seen;
   // Thread-local: another host thread's CUDA calls (the studio's UI) do not break the capture.
   WB_CUDA_CHECK(cudaStreamBeginCapture(cuda_stream(), cudaStreamCaptureModeThreadLocal));
 }
@@ -51,6 +54,7 @@ void LaunchGraph::replay(bool count) {
 void LaunchGraph::reset() {
   exec_ = nullptr;
   key_ = 0;
+  seen_ = 0;
   launches_ = 0;
 }
 void LaunchGraph::begin() { detail::throw_no_cuda(); }

@@ -27,11 +27,17 @@ class LaunchGraph {
   LaunchGraph& operator=(const LaunchGraph&) = delete;
 
   /// Runs `launches`, a function that only queues device work on the simulator's stream (no
-  /// host read, no allocation, the same arguments for the same key). On CUDA it is recorded the
-  /// first time and whenever `key` changes, and the recording is replayed; on the CPU, called.
+  /// host read; the same arguments for the same key). On CUDA a key's first run is made
+  /// directly (a workspace it grows grows then, outside a recording), its second is recorded,
+  /// and the recording is replayed from then on, until the key changes; on the CPU, called.
   template <typename F>
   void run(const Device& d, uint64_t key, F&& launches) {
     if (!d.is_cuda()) {
+      launches();
+      return;
+    }
+    if (!(exec_ && key == key_) && key != seen_) {
+      seen_ = key;
       launches();
       return;
     }
@@ -59,6 +65,7 @@ class LaunchGraph {
   void replay(bool count);
   void* exec_ = nullptr;  // cudaGraphExec_t
   uint64_t key_ = 0;
+  uint64_t seen_ = 0;     // the key of the last direct run
   int64_t launches_ = 0;  // the kernels recorded: counted as launches on every replay
 };
 

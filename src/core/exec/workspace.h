@@ -21,6 +21,7 @@ class Workspace {
     return buf_.data();
   }
   size_t bytes() const { return buf_.bytes(); }
+  const void* data() const { return buf_.data(); }
 
  private:
   DeviceBuffer<unsigned char> buf_;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include "core/exec/algorithms.h"
@@ -284,8 +285,19 @@ void Transfer::wick(const SampleView& samples, BristleLoad& load, float dt) {
     w.d[k] = s_f32_[4 * k + 3].data();
   }
   w.g = s_f32_[8].data();
-  d_wick(device_, samples, load.view(), samples.bristles, samples.per_bristle, params_.wick_rate * dt,
-         params_.wick_slide, dt, w);
+  const BristleLoadView lv = load.view();
+  const float k_dt = params_.wick_rate * dt, k_slide = params_.wick_slide;
+  // The same ten launches every step of a stroke: on CUDA one graph's replay.
+  const auto bits = [](float f) {
+    uint32_t b = 0;
+    std::memcpy(&b, &f, sizeof b);
+    return uint64_t(b);
+  };
+  const uint64_t key = launch_key({launch_key_of(samples.x), launch_key_of(samples.v), launch_key_of(lv.m),
+                                   launch_key_of(lv.capacity), launch_key_of(w.a[0]), uint64_t(samples.bristles),
+                                   uint64_t(samples.per_bristle), bits(k_dt), bits(k_slide), bits(dt)});
+  wick_graph_.run(device_, key,
+                  [&] { d_wick(device_, samples, lv, samples.bristles, samples.per_bristle, k_dt, k_slide, dt, w); });
 }
 
 void Transfer::absorb(const SampleView& samples, BristleLoad& load, ParticleStore& particles, float dt) {

@@ -12,6 +12,7 @@
 #include "core/canvas/window.h"
 #include "core/exec/buffer.h"
 #include "core/exec/device.h"
+#include "core/exec/graph.h"
 #include "core/exec/hd.h"
 #include "core/exec/workspace.h"
 #include "core/particles/mac_sample.h"
@@ -238,6 +239,7 @@ class Transfer {
   // Per sample.
   DeviceBuffer<uint32_t> s_u32_[2];
   DeviceBuffer<float> s_f32_[12];
+  LaunchGraph wick_graph_;  ///< the wick's passes, recorded (CUDA)
   // Per particle.
   DeviceBuffer<float> p_moved_;
   // make_particles: the counts, their scan, and its three prefix ends.
