@@ -37,4 +37,12 @@ struct ParticleView {
   int64_t count;
 };
 
+/// The state fields alone (a second set of arrays, into which a sort or a compaction moves
+/// every particle's state in one pass). Passed by value.
+struct ParticleStateView {
+#define WB_X(type, name, doc) type* name;
+  WB_PARTICLE_STATE_FIELDS(WB_X)
+#undef WB_X
+};
+
 }  // namespace wb

@@ -9,23 +9,6 @@
 #include "core/particles/particles.h"
 
 namespace wb {
-namespace {
-template <typename T>
-void compact_one(const Device& d, DeviceBuffer<T>& field, DeviceBuffer<Vec3>& scratch, const uint32_t* dead,
-                 const uint32_t* pos, int64_t n, int64_t kept) {
-  static_assert(sizeof(T) <= sizeof(Vec3), "the compaction scratch holds the widest field");
-  auto* tmp = reinterpret_cast<T*>(scratch.data());
-  particles_compact_field(d, field.data(), tmp, dead, pos, n);
-  mem::copy_on_device(d, field.data(), tmp, size_t(kept) * sizeof(T));
-}
-template <typename T>
-void gather_one(const Device& d, DeviceBuffer<T>& field, DeviceBuffer<Vec3>& scratch, const uint32_t* from, int64_t n) {
-  static_assert(sizeof(T) <= sizeof(Vec3), "the scratch holds the widest field");
-  auto* tmp = reinterpret_cast<T*>(scratch.data());
-  particles_gather_field(d, field.data(), tmp, from, n);
-  mem::copy_on_device(d, field.data(), tmp, size_t(n) * sizeof(T));
-}
-}  // namespace
 
 void ParticleHost::resize(size_t n) {
 #define WB_X(type, name, doc) name.resize(n);
@@ -37,9 +20,11 @@ ParticleStore::ParticleStore(const Device& device, int64_t limit) : device_(devi
 #define WB_X(type, name, doc) name.set_device(device);
   WB_PARTICLE_FIELDS(WB_X)
 #undef WB_X
+#define WB_X(type, name, doc) spare_##name##_.set_device(device);
+  WB_PARTICLE_STATE_FIELDS(WB_X)
+#undef WB_X
   scan_.set_device(device);
   order_.set_device(device);
-  scratch_.set_device(device);
   set_limit(limit);
 }
 
@@ -104,16 +89,30 @@ void ParticleStore::remove_dead(const uint32_t* pos, int64_t kept) {
   WB_REQUIRE(kept >= 0 && kept <= n, "ParticleStore::remove_dead: " + std::to_string(kept) + " kept of " +
                                          std::to_string(n));
   if (kept == n) return;
-  if (scratch_.size() < size_t(n)) scratch_.grow_keep(size_t(n));
-  // Every field goes through the one scratch buffer (sized for the widest field) and back,
-  // which needs a single spare array instead of a second copy of the whole store. The dead
-  // flags go last: the scatters read them.
-#define WB_X(type, name, doc) \
-  if (static_cast<const void*>(&name) != static_cast<const void*>(&dead)) compact_one(device_, name, scratch_, dead.data(), pos, n, kept);
-  WB_PARTICLE_FIELDS(WB_X)
-#undef WB_X
+  // The state alone, in one pass into the spare set: `nearest` and `d_B` are written again by
+  // the next query before anything reads them, and the dead flags are cleared.
+  particles_compact_state(device_, view(), spare_view(), pos, n);
+  swap_spare();
   dead.fill_zero();
   count_ = kept;
+}
+
+ParticleStateView ParticleStore::spare_view() {
+  // The spare set as large as the state arrays (their contents are not kept: a move rewrites
+  // every live entry), so that the two sets can swap.
+  ParticleStateView out;
+#define WB_X(type, name, doc)                                     \
+  if (spare_##name##_.size() != name.size()) spare_##name##_.resize(name.size()); \
+  out.name = spare_##name##_.data();
+  WB_PARTICLE_STATE_FIELDS(WB_X)
+#undef WB_X
+  return out;
+}
+
+void ParticleStore::swap_spare() {
+#define WB_X(type, name, doc) name.swap(spare_##name##_);
+  WB_PARTICLE_STATE_FIELDS(WB_X)
+#undef WB_X
 }
 
 void ParticleStore::sort_by_cell(Int3 origin, Int3 dims, Workspace& ws) {
@@ -121,17 +120,16 @@ void ParticleStore::sort_by_cell(Int3 origin, Int3 dims, Workspace& ws) {
   if (n <= 1) return;
   if (scan_.size() < size_t(n)) scan_.grow_keep(size_t(n));
   if (order_.size() < size_t(n)) order_.grow_keep(size_t(n));
-  if (scratch_.size() < size_t(n)) scratch_.grow_keep(size_t(n));
   particles_cell_keys(device_, view(), origin, dims, scan_.data(), order_.data());
   const int64_t cells = int64_t(8) * dims.x * dims.y * dims.z;  // half cells: the key of a particle outside
   int bits = 1;
   while ((int64_t(1) << bits) <= cells) ++bits;
   sort_by_key(device_, scan_.data(), order_.data(), n, bits, ws);
-  // The state only: the sort comes before the step's queries, which write `nearest` and `d_B`
-  // again, and after the last compaction, which left every `dead` flag clear.
-#define WB_X(type, name, doc) gather_one(device_, name, scratch_, order_.data(), n);
-  WB_PARTICLE_STATE_FIELDS(WB_X)
-#undef WB_X
+  // The state only, in one pass into the spare set: the sort comes before the step's queries,
+  // which write `nearest` and `d_B` again, and after the last compaction, which left every
+  // `dead` flag clear.
+  particles_gather_state(device_, view(), spare_view(), order_.data(), n);
+  swap_spare();
 }
 
 ParticleView ParticleStore::view() {

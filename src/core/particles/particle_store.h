@@ -71,7 +71,13 @@ class ParticleStore {
   int64_t limit_ = 2000000;
   DeviceBuffer<uint32_t> scan_;     ///< keep flags, then their exclusive scan; the sort's keys
   DeviceBuffer<uint32_t> order_;    ///< the sort's old index of each new place
-  DeviceBuffer<Vec3> scratch_;      ///< compaction target, reused by every field
+  /// A second set of the state arrays, as large as the store: a compaction or a sort writes
+  /// every particle's state there in one pass, and the two sets swap.
+#define WB_X(type, name, doc) DeviceBuffer<type> spare_##name##_;
+  WB_PARTICLE_STATE_FIELDS(WB_X)
+#undef WB_X
+  ParticleStateView spare_view();
+  void swap_spare();
 };
 
 }  // namespace wb

@@ -61,21 +61,9 @@ void particles_flip_pic(const Device& d, const ParticleView& p, const MacView& b
 void particles_keep_flags(const Device& d, const uint32_t* dead, uint32_t* keep, int64_t n) {
   WB_DISPATCH(d, particles_keep_flags(dead, keep, n));
 }
-void particles_compact_field(const Device& d, const float* src, float* dst, const uint32_t* dead, const uint32_t* pos,
+void particles_compact_state(const Device& d, const ParticleView& p, const ParticleStateView& to, const uint32_t* pos,
                              int64_t n) {
-  WB_DISPATCH(d, particles_compact_field(src, dst, dead, pos, n));
-}
-void particles_compact_field(const Device& d, const Vec3* src, Vec3* dst, const uint32_t* dead, const uint32_t* pos,
-                             int64_t n) {
-  WB_DISPATCH(d, particles_compact_field(src, dst, dead, pos, n));
-}
-void particles_compact_field(const Device& d, const int32_t* src, int32_t* dst, const uint32_t* dead,
-                             const uint32_t* pos, int64_t n) {
-  WB_DISPATCH(d, particles_compact_field(src, dst, dead, pos, n));
-}
-void particles_compact_field(const Device& d, const uint32_t* src, uint32_t* dst, const uint32_t* dead,
-                             const uint32_t* pos, int64_t n) {
-  WB_DISPATCH(d, particles_compact_field(src, dst, dead, pos, n));
+  WB_DISPATCH(d, particles_compact_state(p, to, pos, n));
 }
 void particles_solid_height(const Device& d, const PaintWindowView& pw, const float* particle_density,
                             float dry_threshold, float liquid_threshold, float floor_z, float* height,
@@ -93,11 +81,9 @@ void particles_cell_keys(const Device& d, const ParticleView& p, Int3 origin, In
              "particles_cell_keys: the window's cells do not fit a key");
   WB_DISPATCH(d, particles_cell_keys(p, origin, dims, keys, index));
 }
-void particles_gather_field(const Device& d, const float* src, float* dst, const uint32_t* from, int64_t n) {
-  WB_DISPATCH(d, particles_gather_field(src, dst, from, n));
-}
-void particles_gather_field(const Device& d, const Vec3* src, Vec3* dst, const uint32_t* from, int64_t n) {
-  WB_DISPATCH(d, particles_gather_field(src, dst, from, n));
+void particles_gather_state(const Device& d, const ParticleView& p, const ParticleStateView& to, const uint32_t* from,
+                            int64_t n) {
+  WB_DISPATCH(d, particles_gather_state(p, to, from, n));
 }
 void particles_init_scratch(const Device& d, const ParticleView& p, int64_t first, int64_t n) {
   WB_DISPATCH(d, particles_init_scratch(p, first, n));

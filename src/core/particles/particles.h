@@ -34,23 +34,19 @@ void particles_flip_pic(const Device& d, const ParticleView& p, const MacView& b
 
 /// Particles whose dead flag is clear; used by ParticleStore::compact.
 void particles_keep_flags(const Device& d, const uint32_t* dead, uint32_t* keep, int64_t n);
-/// dst[pos[i]] = src[i] for every i with !dead[i]; pos is the exclusive scan of the keep flags.
-void particles_compact_field(const Device& d, const float* src, float* dst, const uint32_t* dead, const uint32_t* pos,
+/// to[pos[i]] = the state of particle i for every i < n with !dead[i]; pos is the exclusive scan
+/// of the keep flags (ParticleStore::compact).
+void particles_compact_state(const Device& d, const ParticleView& p, const ParticleStateView& to, const uint32_t* pos,
                              int64_t n);
-void particles_compact_field(const Device& d, const Vec3* src, Vec3* dst, const uint32_t* dead, const uint32_t* pos,
-                             int64_t n);
-void particles_compact_field(const Device& d, const int32_t* src, int32_t* dst, const uint32_t* dead,
-                             const uint32_t* pos, int64_t n);
-void particles_compact_field(const Device& d, const uint32_t* src, uint32_t* dst, const uint32_t* dead,
-                             const uint32_t* pos, int64_t n);
 /// Sort keys by half cell: keys[k] = the half cell (a window cell halved along each axis) of
 /// particle k, numbered x fastest over the window of `dims` cells at canvas cell `origin` (the
 /// half cells' count for a particle outside it or not finite), index[k] = k.
 void particles_cell_keys(const Device& d, const ParticleView& p, Int3 origin, Int3 dims, uint32_t* keys,
                          uint32_t* index);
-/// dst[i] = src[from[i]] for i < n: a field in a new order (ParticleStore::sort_by_cell).
-void particles_gather_field(const Device& d, const float* src, float* dst, const uint32_t* from, int64_t n);
-void particles_gather_field(const Device& d, const Vec3* src, Vec3* dst, const uint32_t* from, int64_t n);
+/// to[i] = the state of particle from[i] for i < n: the particles in a new order
+/// (ParticleStore::sort_by_cell).
+void particles_gather_state(const Device& d, const ParticleView& p, const ParticleStateView& to, const uint32_t* from,
+                            int64_t n);
 /// Height fields of what the particles rest on over the window's columns (SolidView), absolute
 /// canvas z, nx * ny floats each: `height`, the top of the highest dried cell (dryness at or above
 /// dry_threshold, the grid's solid test) as a whole cell (the grid holds one state a cell, so
@@ -76,16 +72,10 @@ void particles_init_scratch(const Device& d, const ParticleView& p, int64_t firs
   void particles_face_velocity(ParticleRasterView g, float* u, float* v, float* w, float empty);                 \
   void particles_flip_pic(ParticleView p, MacView before, MacView after, float gamma);                           \
   void particles_keep_flags(const uint32_t* dead, uint32_t* keep, int64_t n);                                    \
-  void particles_compact_field(const float* src, float* dst, const uint32_t* dead, const uint32_t* pos, int64_t n); \
-  void particles_compact_field(const Vec3* src, Vec3* dst, const uint32_t* dead, const uint32_t* pos, int64_t n);   \
-  void particles_compact_field(const int32_t* src, int32_t* dst, const uint32_t* dead, const uint32_t* pos,         \
-                               int64_t n);                                                                         \
-  void particles_compact_field(const uint32_t* src, uint32_t* dst, const uint32_t* dead, const uint32_t* pos,       \
-                               int64_t n);                                                                         \
+  void particles_compact_state(ParticleView p, ParticleStateView to, const uint32_t* pos, int64_t n);               \
   void particles_init_scratch(ParticleView p, int64_t first, int64_t n);                                         \
   void particles_cell_keys(ParticleView p, Int3 origin, Int3 dims, uint32_t* keys, uint32_t* index);             \
-  void particles_gather_field(const float* src, float* dst, const uint32_t* from, int64_t n);                    \
-  void particles_gather_field(const Vec3* src, Vec3* dst, const uint32_t* from, int64_t n);                      \
+  void particles_gather_state(ParticleView p, ParticleStateView to, const uint32_t* from, int64_t n);               \
   void particles_ground_surface(PaintWindowView pw, const float* particle_density, float dry_threshold,          \
                                 float liquid_threshold, float floor_z, float* surface);                          \
   void particles_solid_height(PaintWindowView pw, const float* particle_density, float dry_threshold,            \

@@ -59,24 +59,14 @@ void particles_keep_flags(const uint32_t* dead, uint32_t* keep, int64_t n) {
   parallel_for(n, [=] WB_HD(int64_t i) { keep[i] = dead[i] ? 0u : 1u; });
 }
 
-template <typename T>
-void compact_field(const T* src, T* dst, const uint32_t* dead, const uint32_t* pos, int64_t n) {
+void particles_compact_state(ParticleView p, ParticleStateView to, const uint32_t* pos, int64_t n) {
   parallel_for(n, [=] WB_HD(int64_t i) {
-    if (!dead[i]) dst[pos[i]] = src[i];
+    if (p.dead[i]) return;
+    const int64_t k = pos[i];
+#define WB_X(type, name, doc) to.name[k] = p.name[i];
+    WB_PARTICLE_STATE_FIELDS(WB_X)
+#undef WB_X
   });
-}
-void particles_compact_field(const float* src, float* dst, const uint32_t* dead, const uint32_t* pos, int64_t n) {
-  compact_field(src, dst, dead, pos, n);
-}
-void particles_compact_field(const Vec3* src, Vec3* dst, const uint32_t* dead, const uint32_t* pos, int64_t n) {
-  compact_field(src, dst, dead, pos, n);
-}
-void particles_compact_field(const int32_t* src, int32_t* dst, const uint32_t* dead, const uint32_t* pos, int64_t n) {
-  compact_field(src, dst, dead, pos, n);
-}
-void particles_compact_field(const uint32_t* src, uint32_t* dst, const uint32_t* dead, const uint32_t* pos,
-                             int64_t n) {
-  compact_field(src, dst, dead, pos, n);
 }
 
 void particles_cell_keys(ParticleView p, Int3 origin, Int3 dims, uint32_t* keys, uint32_t* index) {
@@ -96,15 +86,13 @@ void particles_cell_keys(ParticleView p, Int3 origin, Int3 dims, uint32_t* keys,
   });
 }
 
-template <typename T>
-void gather_field(const T* src, T* dst, const uint32_t* from, int64_t n) {
-  parallel_for(n, [=] WB_HD(int64_t i) { dst[i] = src[from[i]]; });
-}
-void particles_gather_field(const float* src, float* dst, const uint32_t* from, int64_t n) {
-  gather_field(src, dst, from, n);
-}
-void particles_gather_field(const Vec3* src, Vec3* dst, const uint32_t* from, int64_t n) {
-  gather_field(src, dst, from, n);
+void particles_gather_state(ParticleView p, ParticleStateView to, const uint32_t* from, int64_t n) {
+  parallel_for(n, [=] WB_HD(int64_t i) {
+    const int64_t k = from[i];
+#define WB_X(type, name, doc) to.name[i] = p.name[k];
+    WB_PARTICLE_STATE_FIELDS(WB_X)
+#undef WB_X
+  });
 }
 
 void particles_init_scratch(ParticleView p, int64_t first, int64_t n) {
