@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <string>
 
 #include "core/brush/brush_kernels.h"
@@ -302,12 +301,10 @@ void Brush::apply_min_density(int iterations) {
   g.eps = 1e-3f * grad * grad;
   // The same launches every sub-step (about ten an iteration, the sort's among them): on CUDA
   // one graph's replay.
-  uint32_t h_bits = 0;
-  std::memcpy(&h_bits, &g.h, sizeof h_bits);
   const uint64_t key = launch_key({launch_key_of(xb_.data()), launch_key_of(grid_keys_.data()),
                                    launch_key_of(cell_start_.data()), launch_key_of(lambda_.data()),
                                    launch_key_of(ws_.data()), uint64_t(ws_.bytes()), uint64_t(N),
-                                   uint64_t(iterations), h_bits});
+                                   uint64_t(iterations), launch_key_of(g.h)});
   density_graph_.run(device_, key, [&] {
     for (int it = 0; it < iterations; ++it) {
       brush_grid_keys_on(device_, s, g.h, grid_mask_, grid_keys_.data(), grid_ids_.data());

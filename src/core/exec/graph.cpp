@@ -9,19 +9,21 @@
 
 namespace wb {
 
-#if defined(WB_WITH_CUDA)
 void LaunchGraph::reset() {
+  drop();
+  seen_ = 0;
+}
+
+#if defined(WB_WITH_CUDA)
+void LaunchGraph::drop() {
   if (exec_) cudaGraphExecDestroy(static_cast<cudaGraphExec_t>(exec_));  // no throw from a destructor
   exec_ = nullptr;
   key_ = 0;
-  seen_ = 0;
   launches_ = 0;
 }
 
 void LaunchGraph::begin() {
-  const uint64_t seen = seen_;
-  reset();
-  seen_ = seen;
+  drop();
   // Thread-local: another host thread's CUDA calls (the studio's UI) do not break the capture.
   WB_CUDA_CHECK(cudaStreamBeginCapture(cuda_stream(), cudaStreamCaptureModeThreadLocal));
 }
@@ -51,10 +53,9 @@ void LaunchGraph::replay(bool count) {
     for (int64_t i = 0; i < launches_; ++i) mem::count_launch();
 }
 #else
-void LaunchGraph::reset() {
+void LaunchGraph::drop() {
   exec_ = nullptr;
   key_ = 0;
-  seen_ = 0;
   launches_ = 0;
 }
 void LaunchGraph::begin() { detail::throw_no_cuda(); }

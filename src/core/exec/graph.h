@@ -2,6 +2,7 @@
 // graph and replayed whole, so the run costs one launch's latency instead of one a kernel.
 #pragma once
 #include <cstdint>
+#include <cstring>
 #include <initializer_list>
 
 #include "core/exec/device.h"
@@ -18,6 +19,12 @@ inline uint64_t launch_key(std::initializer_list<uint64_t> parts) {
   return h;
 }
 inline uint64_t launch_key_of(const void* p) { return uint64_t(reinterpret_cast<uintptr_t>(p)); }
+/// A float argument's bits, for a key.
+inline uint64_t launch_key_of(float f) {
+  uint32_t b = 0;
+  std::memcpy(&b, &f, sizeof b);
+  return b;
+}
 
 class LaunchGraph {
  public:
@@ -55,10 +62,11 @@ class LaunchGraph {
     }
     replay(!recorded);
   }
-  /// Drops the recording (the next run records again).
+  /// Drops the recording and the key seen (the next run starts over).
   void reset();
 
  private:
+  void drop();  // the recording alone
   void begin();
   void end(uint64_t key, int64_t launches);
   void abandon();

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <string>
 
 #include "core/exec/algorithms.h"
@@ -288,14 +287,10 @@ void Transfer::wick(const SampleView& samples, BristleLoad& load, float dt) {
   const BristleLoadView lv = load.view();
   const float k_dt = params_.wick_rate * dt, k_slide = params_.wick_slide;
   // The same ten launches every step of a stroke: on CUDA one graph's replay.
-  const auto bits = [](float f) {
-    uint32_t b = 0;
-    std::memcpy(&b, &f, sizeof b);
-    return uint64_t(b);
-  };
   const uint64_t key = launch_key({launch_key_of(samples.x), launch_key_of(samples.v), launch_key_of(lv.m),
                                    launch_key_of(lv.capacity), launch_key_of(w.a[0]), uint64_t(samples.bristles),
-                                   uint64_t(samples.per_bristle), bits(k_dt), bits(k_slide), bits(dt)});
+                                   uint64_t(samples.per_bristle), launch_key_of(k_dt), launch_key_of(k_slide),
+                                   launch_key_of(dt)});
   wick_graph_.run(device_, key,
                   [&] { d_wick(device_, samples, lv, samples.bristles, samples.per_bristle, k_dt, k_slide, dt, w); });
 }
