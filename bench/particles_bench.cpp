@@ -1,5 +1,5 @@
 // Particle stage (paper §4.3, §6) at the paper's Figure 12 load: 210K particles around a
-// brush of 200 bristles x 128 samples. Hash-grid build, nearest-sample query, adhesion step
+// brush of 200 bristles x 128 samples. Sample-grid build, nearest-sample query, adhesion step
 // and rasterisation, on the device named by WB_DEVICE.
 #include <benchmark/benchmark.h>
 
@@ -7,7 +7,7 @@
 
 #include "core/exec/device.h"
 #include "core/exec/workspace.h"
-#include "core/particles/hash_grid.h"
+#include "core/particles/sample_grid.h"
 #include "core/particles/particle_store.h"
 #include "core/particles/particles.h"
 #include "bench_scene.h"
@@ -22,7 +22,7 @@ struct Scene {
   test::HostSamples hs;
   test::DeviceSamples ds{d};
   ParticleStore store{d};
-  SampleHashGrid grid{d};
+  SampleGrid grid{d};
   ParticleParams prm;
   test::Region region;  ///< the particles' box grown by the longest range queried (D0)
   float dt = 1.f / 60.f;
@@ -72,7 +72,7 @@ Scene& scene() {
   return s;
 }
 
-void BM_SampleHashBuild(benchmark::State& state) {
+void BM_SampleGridBuild(benchmark::State& state) {
   Scene& s = scene();
   for (auto _ : state) {
     s.grid.build(s.ds.view(), float(state.range(0)), s.region.lo, s.region.hi, s.ws, s.dt);
@@ -80,7 +80,7 @@ void BM_SampleHashBuild(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * s.ds.view().count());
 }
-BENCHMARK(BM_SampleHashBuild)->Arg(4)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SampleGridBuild)->Arg(4)->Unit(benchmark::kMicrosecond);
 
 void BM_NearestSampleQuery(benchmark::State& state) {
   Scene& s = scene();
@@ -105,7 +105,7 @@ BENCHMARK(BM_NearestSampleQuery)
 
 void BM_AdhesionStep(benchmark::State& state) {
   Scene& s = scene();
-  s.grid.build(s.ds.view(), s.prm.hash_cell, s.region.lo, s.region.hi, s.ws, s.dt);
+  s.grid.build(s.ds.view(), s.prm.sample_cell, s.region.lo, s.region.hi, s.ws, s.dt);
   s.grid.query_nearest(s.store.view(), s.prm.D0);
   const ParticleHost start = s.store.to_host();
   SolidView solid;

@@ -9,7 +9,7 @@
 #include "core/canvas/window.h"
 #include "core/exec/device.h"
 #include "core/exec/workspace.h"
-#include "core/particles/hash_grid.h"
+#include "core/particles/sample_grid.h"
 #include "core/particles/particle_store.h"
 #include "core/transfer/bristle_load.h"
 #include "core/transfer/transfer.h"
@@ -26,7 +26,7 @@ struct TransferScene {
   test::DeviceSamples ds{d};
   ParticleStore store{d};
   ParticleHost particles0;
-  SampleHashGrid grid{d};
+  SampleGrid grid{d};
   PaintWindow window{d, Int3{128, 128, 32}};
   std::vector<std::vector<float>> paint0;
   BristleLoad load;

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "backend_fixture.h"
-#include "core/particles/hash_grid.h"
+#include "core/particles/sample_grid.h"
 #include "core/particles/particle_store.h"
 #include "core/particles/particles.h"
 #include "particles/sample_fixture.h"
@@ -90,7 +90,7 @@ TEST_F(AdhesionTest, BlendWeightsOfEq10) {
   const Vec3 v0 = V - A * kDt;  // moving with the sample's start-of-step velocity
   ParticleStore store(device_);
   store.append(particles_at({start[0], start[1]}, v0));
-  SampleHashGrid grid(device_);
+  SampleGrid grid(device_);
   const Region r = region_around({start[0], start[1]}, 50.f);
   grid.build(ds.view(), 4.f, r.lo, r.hi, ws_, kDt);
   grid.query_nearest(store.view(), 50.f);
@@ -256,7 +256,7 @@ float figure8_max_distance(const Device& device, Workspace& ws, Method method, V
   ParticleStore store(device);
   store.append(particles_at(x0, V));
   DeviceSamples ds(device);
-  SampleHashGrid grid(device);
+  SampleGrid grid(device);
   ParticleParams prm;
   prm.gravity = Vec3();
   const SolidView solid = floor_at(-1000.f);
@@ -273,7 +273,7 @@ float figure8_max_distance(const Device& device, Workspace& ws, Method method, V
     if (method == Method::TwoStep) {
       ds.upload(hs);
       const Region r = region_around(store.to_host().x, prm.D0);
-      grid.build(ds.view(), prm.hash_cell, r.lo, r.hi, ws, kDt);
+      grid.build(ds.view(), prm.sample_cell, r.lo, r.hi, ws, kDt);
       grid.query_nearest(store.view(), prm.D0);
       particles_adhesion_step(device, store.view(), ds.view(), solid, prm, kDt);
       h = store.to_host();

@@ -11,7 +11,7 @@
 namespace wb::test {
 
 /// The box of `points` grown by `range`: the region a sample grid is built for when its queries
-/// of that range start from those points (SampleHashGrid::build).
+/// of that range start from those points (SampleGrid::build).
 struct Region {
   Vec3 lo, hi;
 };

@@ -407,7 +407,7 @@ struct BooksScene {
     return s;
   }
   TransferRecord step(Workspace& ws) {
-    SampleHashGrid grid(device);
+    SampleGrid grid(device);
     const Region r = region_around(p.to_host().x, 12.f);
     grid.build(s.view(), 2.f, r.lo, r.hi, ws);
     grid.query_nearest(p.view(), 12.f);

@@ -9,7 +9,7 @@
 
 #include "backend_fixture.h"
 #include "core/canvas/window.h"
-#include "core/particles/hash_grid.h"
+#include "core/particles/sample_grid.h"
 #include "core/particles/particle_store.h"
 #include "core/transfer/bristle_load.h"
 #include "core/transfer/paint_books.h"
@@ -65,9 +65,9 @@ class TransferTest : public BackendTest {
     return w;
   }
 
-  /// Sets every particle's nearest sample (range `range`) with the sample hash grid.
+  /// Sets every particle's nearest sample (range `range`) with the sample grid.
   void query_nearest(DeviceSamples& s, ParticleStore& p, float range) {
-    SampleHashGrid grid(device_);
+    SampleGrid grid(device_);
     const Region r = region_around(p.to_host().x, range);
     grid.build(s.view(), 2.f, r.lo, r.hi, ws_);
     grid.query_nearest(p.view(), range);

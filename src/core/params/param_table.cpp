@@ -107,7 +107,7 @@ std::vector<ParamInfo> build_table() {
                "How fast paint touching the canvas stops: its velocity decays as exp(-k w t)"),
       WB_PARAM(particles.gamma, "PIC weight gamma", "", "Eq. 11", 0, 1,
                "Weight of the projected grid velocity in the particle velocity update"),
-      WB_PARAM(particles.hash_cell, "Sample grid cell", "cells", "§6", 1, 100, "Cell size of the sample grid"),
+      WB_PARAM(particles.sample_cell, "Sample grid cell", "cells", "§6", 1, 100, "Cell size of the sample grid"),
       WB_PARAM(particles.max_particles, "Particle limit", "", "§7", 1, 2147483647.0, "Most particles at once"),
       // Rendering (§6).
       // Liquid transfer (§5) and wicking.

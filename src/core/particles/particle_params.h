@@ -33,7 +33,7 @@ struct ParticleParams {
   /// query stops at the first ring of cells beyond its best distance, and most particles lie
   /// within a cell or two of a sample: small cells check fewer samples (docs/PARTICLES.md). Its
   /// table has a cell per h^3 of the queries' region (the window's columns, the canvas's depth).
-  float hash_cell = 2.f;
+  float sample_cell = 2.f;
   /// Most particles the store may hold. Default 2M, range [1, 2^31). §7 ("as many as 2M particles").
   int64_t max_particles = 2000000;
 };

@@ -1,6 +1,6 @@
 // Particle stage (paper §4.3, Eq. 8-11; DESIGN steps 4, 5 and 7): the per-step drivers a
 // simulator step calls, in order:
-//   SampleHashGrid::build -> query_nearest -> particles_adhesion_step -> particles_rasterise
+//   SampleGrid::build -> query_nearest -> particles_adhesion_step -> particles_rasterise
 //   -> (grid projection) -> particles_flip_pic.
 // Each validates its input and dispatches to wb::cpu or wb::cuda (particles_impl.h).
 #pragma once
@@ -18,7 +18,7 @@
 namespace wb {
 
 /// Two-step adhesion update of every particle (Eq. 8-10) over dt seconds. Needs the
-/// particles' nearest / d_B from SampleHashGrid::query_nearest with a range >= prm.D1 on
+/// particles' nearest / d_B from SampleGrid::query_nearest with a range >= prm.D1 on
 /// the same samples. Positions and velocities are updated in place.
 void particles_adhesion_step(const Device& d, const ParticleView& p, const SampleView& s, const SolidView& solid,
                              const ParticleParams& prm, float dt);

@@ -43,7 +43,7 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
   brush_ = std::make_unique<Brush>(d, config_.brush, initial_pose, config_.params.brush_solver);
   grid_ = std::make_unique<Grid>(*canvas_, config_.params.grid, config_.window, Int3{});
   particles_ = ParticleStore(d, config_.params.particles.max_particles);
-  hash_ = SampleHashGrid(d);
+  sample_grid_ = SampleGrid(d);
   // This brush's bristles hold in proportion to their volume (Eq. 12's M_max).
   const TransferParams tp = config_.params.transfer.for_bristle_radius(config_.brush.bristle_radius);
   load_ = std::make_unique<BristleLoad>(d, brush_->sample_count(), tp);
@@ -493,7 +493,7 @@ void Simulator::step(const BrushPose* pen_poses, int substeps, float dt) {
       // largest load sphere reaches (Eq. 14 takes a particle only inside R_j).
       const float range = transfer_->params().absorb_range();
       build_sample_grid(range, 0.f);
-      hash_.query_nearest(particles_.view(), range);
+      sample_grid_.query_nearest(particles_.view(), range);
     }
     TransferEnv env = transfer_env();
     env.dt = dt;  // wicking along the bristles over this step
@@ -562,10 +562,10 @@ void Simulator::particle_stage(float dt) {
   // particles in a half cell before its atomic adds, and every pass over the particles reads the
   // grid, the samples and the paint in order (docs/PARTICLES.md "Order").
   particles_.sort_by_cell(grid_->window().origin(), grid_->window().dims(), ws_);
-  // Samples are at t + dt, particles at t: hash the samples rewound to t (hash_grid.h). The
+  // Samples are at t + dt, particles at t: file the samples rewound to t (sample_grid.h). The
   // query reaches D1, the range of Eq. 10: beyond it no sample moves a particle.
   build_sample_grid(prm.D1, dt);
-  hash_.query_nearest(particles_.view(), prm.D1);
+  sample_grid_.query_nearest(particles_.view(), prm.D1);
   // The particles rest on the canvas and on dried paint (d_k of Eq. 8 is measured to both), and
   // free ones land on the wet paint's surface. The wet paint is the joint paint, grid and
   // particles, as the grid's liquid test counts it: near the bristles most of a layer is
@@ -600,7 +600,7 @@ void Simulator::build_sample_grid(float range, float rewind_dt) {
   const Int3 o = win.origin(), n = win.dims();
   const Vec3 lo(float(o.x) - range, float(o.y) - range, -range);
   const Vec3 hi(float(o.x + n.x) + range, float(o.y + n.y) + range, float(config_.canvas.depth) + range);
-  hash_.build(brush_->samples(), config_.params.particles.hash_cell, lo, hi, ws_, rewind_dt);
+  sample_grid_.build(brush_->samples(), config_.params.particles.sample_cell, lo, hi, ws_, rewind_dt);
 }
 
 void Simulator::clamp_particles_to_canvas() {

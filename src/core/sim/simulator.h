@@ -17,7 +17,7 @@
 #include "core/grid/grid.h"
 #include "core/io/stroke.h"
 #include "core/params/sim_params.h"
-#include "core/particles/hash_grid.h"
+#include "core/particles/sample_grid.h"
 #include "core/particles/particle_store.h"
 #include "core/render/renderer.h"
 #include "core/transfer/paint_books.h"
@@ -166,7 +166,7 @@ class Simulator {
   static constexpr size_t kCheckedArrays = kPaintFieldCount + 3 + 5 + kNonfiniteParticleArrays;
   std::array<std::pair<float*, int64_t>, kCheckedArrays> checked_arrays();
   void clamp_particles_to_canvas();
-  /// Files the brush's samples (at x - v rewind_dt) in hash_ for queries of `range` from the
+  /// Files the brush's samples (at x - v rewind_dt) in sample_grid_ for queries of `range` from the
   /// particles: the window's columns and the canvas's depth.
   void build_sample_grid(float range, float rewind_dt);
   TransferEnv transfer_env();
@@ -191,7 +191,7 @@ class Simulator {
   std::unique_ptr<Brush> brush_;
   std::unique_ptr<Grid> grid_;
   ParticleStore particles_;
-  SampleHashGrid hash_;
+  SampleGrid sample_grid_;
   std::unique_ptr<BristleLoad> load_;
   std::unique_ptr<Transfer> transfer_;
   PaintBooks books_;

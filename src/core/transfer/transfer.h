@@ -159,7 +159,7 @@ class Transfer {
   int64_t steps() const { return step_index_; }
 
   /// One transfer step (§5): every stage below in order; the compaction of the particle store
-  /// and the room of the emission and of Eq. 15 come from one scan and one host read. The particles' `nearest` must come from SampleHashGrid::query_nearest on these
+  /// and the room of the emission and of Eq. 15 come from one scan and one host read. The particles' `nearest` must come from SampleGrid::query_nearest on these
   /// samples this step (the absorption candidate; the distance is re-measured here). The
   /// record holds what the host knows (new particles, drops); the device's sums and counts
   /// join it in collect().

@@ -1,5 +1,5 @@
 // Sample grid: validation and the one runtime dispatch.
-#include "core/particles/hash_grid.h"
+#include "core/particles/sample_grid.h"
 
 #include <cmath>
 #include <cstdint>
@@ -11,23 +11,23 @@
 namespace wb {
 namespace {
 void box(const Device& d, const Vec3* x, const Vec3* v, float rw, int64_t n, float inv_h, CellBox r, int32_t* b) {
-  WB_DISPATCH(d, hash_grid_box(x, v, rw, n, inv_h, r, b));
+  WB_DISPATCH(d, sample_grid_box(x, v, rw, n, inv_h, r, b));
 }
 void keys(const Device& d, const Vec3* x, const Vec3* v, float rw, int64_t n, float inv_h, CellBox r,
           const int32_t* b, uint32_t* k, uint32_t* idx) {
-  WB_DISPATCH(d, hash_grid_keys(x, v, rw, n, inv_h, r, b, k, idx));
+  WB_DISPATCH(d, sample_grid_keys(x, v, rw, n, inv_h, r, b, k, idx));
 }
 void first(const Device& d, const uint32_t* k, const uint32_t* idx, const Vec3* x, const Vec3* v, float rw, int64_t n,
            const int32_t* b, uint32_t* f, Vec3* sx) {
-  WB_DISPATCH(d, hash_grid_first(k, idx, x, v, rw, n, b, f, sx));
+  WB_DISPATCH(d, sample_grid_first(k, idx, x, v, rw, n, b, f, sx));
 }
 void coarse(const Device& d, const int32_t* b, const uint32_t* f, int64_t cap, uint8_t* occ) {
-  WB_DISPATCH(d, hash_grid_coarse(b, f, cap, occ));
+  WB_DISPATCH(d, sample_grid_coarse(b, f, cap, occ));
 }
 void near(const Device& d, const int32_t* b, const uint8_t* occ, int reach, int64_t cap, uint8_t* out) {
-  WB_DISPATCH(d, hash_grid_near(b, occ, reach, cap, out));
+  WB_DISPATCH(d, sample_grid_near(b, occ, reach, cap, out));
 }
-void query(const Device& d, HashGridView g, ParticleView p, float r) { WB_DISPATCH(d, hash_grid_query(g, p, r)); }
+void query(const Device& d, SampleGridView g, ParticleView p, float r) { WB_DISPATCH(d, sample_grid_query(g, p, r)); }
 
 /// The grid's cell table holds at most this many cells (128 M, 512 MiB). The simulator's region
 /// (its window's columns over the canvas's depth, up to 1024 cells) stays below it at the default
@@ -36,7 +36,7 @@ void query(const Device& d, HashGridView g, ParticleView p, float r) { WB_DISPAT
 constexpr int64_t kMaxCells = int64_t(1) << 27;
 }  // namespace
 
-SampleHashGrid::SampleHashGrid(const Device& device) : device_(device) {
+SampleGrid::SampleGrid(const Device& device) : device_(device) {
   keys_.set_device(device);
   index_.set_device(device);
   first_.set_device(device);
@@ -47,35 +47,35 @@ SampleHashGrid::SampleHashGrid(const Device& device) : device_(device) {
   box_.resize(6);
 }
 
-void SampleHashGrid::build(const SampleView& s, float cell_size, Vec3 region_lo, Vec3 region_hi, Workspace& ws,
+void SampleGrid::build(const SampleView& s, float cell_size, Vec3 region_lo, Vec3 region_hi, Workspace& ws,
                            float rewind_dt) {
   WB_REQUIRE(std::isfinite(cell_size) && cell_size > 0.f,
-             "SampleHashGrid::build: cell size must be positive, got " + std::to_string(cell_size));
-  WB_REQUIRE(s.bristles >= 0 && s.per_bristle >= 0, "SampleHashGrid::build: negative sample counts");
+             "SampleGrid::build: cell size must be positive, got " + std::to_string(cell_size));
+  WB_REQUIRE(s.bristles >= 0 && s.per_bristle >= 0, "SampleGrid::build: negative sample counts");
   const int64_t n = s.count();
-  WB_REQUIRE(n < (int64_t(1) << 31), "SampleHashGrid::build: too many samples (" + std::to_string(n) + ")");
-  WB_REQUIRE(n == 0 || s.x != nullptr, "SampleHashGrid::build: sample positions are null");
-  WB_REQUIRE(std::isfinite(rewind_dt) && rewind_dt >= 0.f, "SampleHashGrid::build: rewind time must be >= 0");
-  WB_REQUIRE(rewind_dt == 0.f || n == 0 || s.v != nullptr, "SampleHashGrid::build: rewinding needs sample velocities");
-  WB_REQUIRE(isfinite3(region_lo) && isfinite3(region_hi), "SampleHashGrid::build: the region is not finite");
+  WB_REQUIRE(n < (int64_t(1) << 31), "SampleGrid::build: too many samples (" + std::to_string(n) + ")");
+  WB_REQUIRE(n == 0 || s.x != nullptr, "SampleGrid::build: sample positions are null");
+  WB_REQUIRE(std::isfinite(rewind_dt) && rewind_dt >= 0.f, "SampleGrid::build: rewind time must be >= 0");
+  WB_REQUIRE(rewind_dt == 0.f || n == 0 || s.v != nullptr, "SampleGrid::build: rewinding needs sample velocities");
+  WB_REQUIRE(isfinite3(region_lo) && isfinite3(region_hi), "SampleGrid::build: the region is not finite");
   count_ = n;
   h_ = cell_size;
   const float inv_h = 1.f / h_;
   CellBox region;
   int lo[3], hi[3];
-  hash_cell_of(region_lo, inv_h, lo[0], lo[1], lo[2]);
-  hash_cell_of(region_hi, inv_h, hi[0], hi[1], hi[2]);
+  sample_cell_of(region_lo, inv_h, lo[0], lo[1], lo[2]);
+  sample_cell_of(region_hi, inv_h, hi[0], hi[1], hi[2]);
   int64_t n_axis[3];
   double volume = 1.0;
   for (int a = 0; a < 3; ++a) {
-    WB_REQUIRE(lo[a] <= hi[a], "SampleHashGrid::build: the region is empty");
+    WB_REQUIRE(lo[a] <= hi[a], "SampleGrid::build: the region is empty");
     region.lo[a] = lo[a];
     region.hi[a] = hi[a];
     n_axis[a] = int64_t(hi[a]) - lo[a] + 1;
     volume *= double(n_axis[a]);
   }
   WB_REQUIRE(volume <= double(kMaxCells),
-             "SampleHashGrid::build: the region is " + std::to_string(n_axis[0]) + " x " + std::to_string(n_axis[1]) +
+             "SampleGrid::build: the region is " + std::to_string(n_axis[0]) + " x " + std::to_string(n_axis[1]) +
                  " x " + std::to_string(n_axis[2]) + " cells of " + std::to_string(cell_size) + ", more than " +
                  std::to_string(kMaxCells));
   const int64_t cells = n_axis[0] * n_axis[1] * n_axis[2];
@@ -101,15 +101,15 @@ void SampleHashGrid::build(const SampleView& s, float cell_size, Vec3 region_lo,
   coarse(device_, box_.data(), first_.data(), coarse_capacity_, occupied_.data());
 }
 
-HashGridView SampleHashGrid::view() const {
-  return HashGridView{first_.data(), index_.data(), sorted_x_.data(), count_, h_, box_.data(), near_.data()};
+SampleGridView SampleGrid::view() const {
+  return SampleGridView{first_.data(), index_.data(), sorted_x_.data(), count_, h_, box_.data(), near_.data()};
 }
 
-void SampleHashGrid::query_nearest(const ParticleView& p, float max_range) {
+void SampleGrid::query_nearest(const ParticleView& p, float max_range) {
   WB_REQUIRE(std::isfinite(max_range) && max_range > 0.f,
-             "SampleHashGrid::query_nearest: range must be positive, got " + std::to_string(max_range));
-  WB_REQUIRE(first_.size() > 0, "SampleHashGrid::query_nearest: build() was not called");
-  WB_REQUIRE(p.count >= 0, "SampleHashGrid::query_nearest: negative particle count");
+             "SampleGrid::query_nearest: range must be positive, got " + std::to_string(max_range));
+  WB_REQUIRE(first_.size() > 0, "SampleGrid::query_nearest: build() was not called");
+  WB_REQUIRE(p.count >= 0, "SampleGrid::query_nearest: negative particle count");
   // A sample within max_range of a point lies at most F = ceil(max_range / h) cells from the
   // point's along each axis (floor(a + d) - floor(a) <= ceil(d); a hundredth of a cell more for
   // the rounding of x / h on a large canvas), so at most ceil(F / kCoarse) coarse cells.

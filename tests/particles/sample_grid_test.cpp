@@ -2,13 +2,13 @@
 #include <random>
 
 #include "backend_fixture.h"
-#include "core/particles/hash_grid.h"
+#include "core/particles/sample_grid.h"
 #include "core/particles/particle_store.h"
 #include "particles/sample_fixture.h"
 
 namespace wb::test {
 
-class HashGridTest : public BackendTest {};
+class SampleGridTest : public BackendTest {};
 
 namespace {
 ParticleHost particles_at(const std::vector<Vec3>& x) {
@@ -19,7 +19,7 @@ ParticleHost particles_at(const std::vector<Vec3>& x) {
 }
 }  // namespace
 
-TEST_F(HashGridTest, NearestSampleEqualsBruteForce) {
+TEST_F(SampleGridTest, NearestSampleEqualsBruteForce) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> U(0.f, 1.f);
   // 40 curved bristles of 64 samples in an 80-cell box, plus particles spread around it
@@ -44,7 +44,7 @@ TEST_F(HashGridTest, NearestSampleEqualsBruteForce) {
   ds.upload(hs);
   ParticleStore store(device_);
   store.append(particles_at(px));
-  SampleHashGrid grid(device_);
+  SampleGrid grid(device_);
   // Ranges within a cell and over many cells, as the absorption's load sphere, Eq. 10's D1
   // and D0 use them.
   for (float h : {2.f, 4.f, 15.f}) {
@@ -88,7 +88,7 @@ TEST_F(HashGridTest, NearestSampleEqualsBruteForce) {
   EXPECT_GT(hits, 100);
 }
 
-TEST_F(HashGridTest, RewindHashesStartOfStepPositions) {
+TEST_F(SampleGridTest, RewindFilesStartOfStepPositions) {
   // A bristle that moved by v dt: with rewind the particle at the old place is on it.
   HostSamples hs;
   hs.resize(1, 32);
@@ -97,7 +97,7 @@ TEST_F(HashGridTest, RewindHashesStartOfStepPositions) {
   ds.upload(hs);
   ParticleStore store(device_);
   store.append(particles_at({Vec3(100.f, 108.f, 40.f)}));
-  SampleHashGrid grid(device_);
+  SampleGrid grid(device_);
   const Region r = region_around({Vec3(100.f, 108.f, 40.f)}, 50.f);
   grid.build(ds.view(), 4.f, r.lo, r.hi, ws_);
   grid.query_nearest(store.view(), 50.f);
@@ -108,14 +108,14 @@ TEST_F(HashGridTest, RewindHashesStartOfStepPositions) {
   EXPECT_EQ(store.nearest.to_host()[0], 10);
 }
 
-TEST_F(HashGridTest, EmptySamplesAndBadInput) {
+TEST_F(SampleGridTest, EmptySamplesAndBadInput) {
   HostSamples hs;
   hs.resize(0, 128);
   DeviceSamples ds(device_);
   ds.upload(hs);
   ParticleStore store(device_);
   store.append(particles_at({Vec3(1, 2, 3), Vec3(4, 5, 6)}));
-  SampleHashGrid grid(device_);
+  SampleGrid grid(device_);
   EXPECT_THROW(grid.query_nearest(store.view(), 15.f), Error);  // not built
   const Region r = region_around({Vec3(1, 2, 3), Vec3(4, 5, 6)}, 15.f);
   grid.build(ds.view(), 4.f, r.lo, r.hi, ws_);

@@ -1,13 +1,13 @@
-// Sample hash grid drivers (paper §6, Green 2010), compiled once per backend.
+// Sample grid drivers (paper §6, Green 2010), compiled once per backend.
 #pragma once
 #include "core/exec/atomics.h"
 #include "core/exec/parallel_for.h"
-#include "core/particles/hash_grid.h"
+#include "core/particles/sample_grid.h"
 
 namespace wb::WB_BACKEND_NS {
 
-// Position hashed for sample i: x - v rewind_dt (v may be null when rewind_dt is 0).
-WB_HD WB_INLINE Vec3 hashed_position(const Vec3* x, const Vec3* v, float rewind_dt, int64_t i) {
+// Position filed for sample i: x - v rewind_dt (v may be null when rewind_dt is 0).
+WB_HD WB_INLINE Vec3 filed_position(const Vec3* x, const Vec3* v, float rewind_dt, int64_t i) {
   return rewind_dt != 0.f ? x[i] - v[i] * rewind_dt : x[i];
 }
 
@@ -22,7 +22,7 @@ WB_HD WB_INLINE bool in_region(const CellBox& r, int cx, int cy, int cz) {
   return cx >= r.lo[0] && cx <= r.hi[0] && cy >= r.lo[1] && cy <= r.hi[1] && cz >= r.lo[2] && cz <= r.hi[2];
 }
 
-void hash_grid_box(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, CellBox region,
+void sample_grid_box(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, CellBox region,
                    int32_t* box) {
   // Empty box (lo > hi) until the samples in the region widen it with integer atomics; set on
   // the device, so that the host never waits for an upload.
@@ -34,7 +34,7 @@ void hash_grid_box(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, flo
   });
   parallel_for(n, [=] WB_HD(int64_t i) {
     int cx, cy, cz;
-    hash_cell_of(hashed_position(x, v, rewind_dt, i), inv_h, cx, cy, cz);
+    sample_cell_of(filed_position(x, v, rewind_dt, i), inv_h, cx, cy, cz);
     if (!in_region(region, cx, cy, cz)) return;
     atomic_min(&box[0], int32_t(cx));
     atomic_min(&box[1], int32_t(cy));
@@ -45,11 +45,11 @@ void hash_grid_box(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, flo
   });
 }
 
-void hash_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, CellBox region,
+void sample_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, CellBox region,
                     const int32_t* box, uint32_t* keys, uint32_t* index) {
   parallel_for(n, [=] WB_HD(int64_t i) {
     int cx, cy, cz;
-    hash_cell_of(hashed_position(x, v, rewind_dt, i), inv_h, cx, cy, cz);
+    sample_cell_of(filed_position(x, v, rewind_dt, i), inv_h, cx, cy, cz);
     // A sample outside the region takes the key one past the box's cells: it sorts last and
     // no cell's range holds it.
     const int64_t nx = int64_t(box[3]) - box[0] + 1, ny = int64_t(box[4]) - box[1] + 1;
@@ -62,19 +62,19 @@ void hash_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, fl
 
 // After the sort: slot i is the first of every cell after slot i - 1's and up to its own (the
 // box's end for i = n), so each cell's entry is written once, with no clearing beforehand.
-void hash_grid_first(const uint32_t* sorted_keys, const uint32_t* index, const Vec3* x, const Vec3* v,
+void sample_grid_first(const uint32_t* sorted_keys, const uint32_t* index, const Vec3* x, const Vec3* v,
                      float rewind_dt, int64_t n, const int32_t* box, uint32_t* first, Vec3* sorted_x) {
   parallel_for(n + 1, [=] WB_HD(int64_t i) {
     const int64_t volume = box_volume(box);
     const int64_t prev = i == 0 ? -1 : int64_t(sorted_keys[i - 1]);
     const int64_t cur = i == n ? volume : int64_t(sorted_keys[i]);
     for (int64_t c = prev + 1; c <= cur; ++c) first[c] = uint32_t(i);
-    if (i < n) sorted_x[i] = hashed_position(x, v, rewind_dt, int64_t(index[i]));
+    if (i < n) sorted_x[i] = filed_position(x, v, rewind_dt, int64_t(index[i]));
   });
 }
 
 // Coarse cell cc of the box holds a sample: any of its rows has a non-empty range.
-void hash_grid_coarse(const int32_t* box, const uint32_t* first, int64_t capacity, uint8_t* occupied) {
+void sample_grid_coarse(const int32_t* box, const uint32_t* first, int64_t capacity, uint8_t* occupied) {
   parallel_for(capacity, [=] WB_HD(int64_t cc) {
     if (box_volume(box) == 0) return;
     const int64_t nx = int64_t(box[3]) - box[0] + 1, ny = int64_t(box[4]) - box[1] + 1, nz = int64_t(box[5]) - box[2] + 1;
@@ -93,7 +93,7 @@ void hash_grid_coarse(const int32_t* box, const uint32_t* first, int64_t capacit
 }
 
 // Coarse cell cc is near when a coarse cell within `reach` of it (Chebyshev) holds a sample.
-void hash_grid_near(const int32_t* box, const uint8_t* occupied, int reach, int64_t capacity, uint8_t* near) {
+void sample_grid_near(const int32_t* box, const uint8_t* occupied, int reach, int64_t capacity, uint8_t* near) {
   parallel_for(capacity, [=] WB_HD(int64_t cc) {
     if (box_volume(box) == 0) return;
     const int cnx = coarse_count(int64_t(box[3]) - box[0] + 1), cny = coarse_count(int64_t(box[4]) - box[1] + 1);
@@ -109,7 +109,7 @@ void hash_grid_near(const int32_t* box, const uint8_t* occupied, int reach, int6
   });
 }
 
-void hash_grid_query(HashGridView g, ParticleView p, float max_range) {
+void sample_grid_query(SampleGridView g, ParticleView p, float max_range) {
   parallel_for(p.count, [=] WB_HD(int64_t k) {
     const NearestSample s = nearest_sample(g, p.x[k], max_range);
     p.nearest[k] = s.index;

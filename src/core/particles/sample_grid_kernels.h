@@ -12,14 +12,14 @@
 namespace wb {
 
 /// The built grid, by value. The box holds the cells [lo, hi] (inclusive, per axis) of the
-/// samples hashed; cell (x, y, z) of the box is number ((z - lo.z) ny + y - lo.y) nx + x - lo.x,
+/// samples filed; cell (x, y, z) of the box is number ((z - lo.z) ny + y - lo.y) nx + x - lo.x,
 /// and first[c] is the first sorted slot whose cell is c or later (first[volume] = the samples
-/// hashed). The samples of cells [c0, c1] are the slots [first[c0], first[c1 + 1]).
-struct HashGridView {
+/// filed). The samples of cells [c0, c1] are the slots [first[c0], first[c1 + 1]).
+struct SampleGridView {
   const uint32_t* first;         ///< per cell of the box, and one past the last
   const uint32_t* sorted_index;  ///< sample index of each sorted slot
   const Vec3* sorted_x;          ///< sample position of each sorted slot (coherent reads)
-  int64_t count;                 ///< number of samples hashed
+  int64_t count;                 ///< number of samples filed
   float h;                       ///< cell size, canvas cells
   const int32_t* box;            ///< lo x, y, z, hi x, y, z (cells); lo > hi: no sample
   /// Per coarse cell of the box (kCoarse cells a side, from its lo corner): 1 when a sample may
@@ -37,16 +37,16 @@ WB_HD WB_INLINE int coarse_count(int64_t n) { return int((n + kCoarse - 1) >> kC
 /// A cell coordinate defined for every float: beyond +-1e9 cells (no canvas is that large) and
 /// for a non-finite value (a point the step's containment is about to remove) it is clamped, as
 /// converting such a float to int is undefined.
-WB_HD WB_INLINE int hash_coord(float v) {
+WB_HD WB_INLINE int cell_coord(float v) {
   if (v > -1e9f && v < 1e9f) return int(floorf(v));
   return v > 0.f ? 1000000000 : -1000000000;
 }
 
 /// Integer cell of p for cell size h.
-WB_HD WB_INLINE void hash_cell_of(Vec3 p, float inv_h, int& ix, int& iy, int& iz) {
-  ix = hash_coord(p.x * inv_h);
-  iy = hash_coord(p.y * inv_h);
-  iz = hash_coord(p.z * inv_h);
+WB_HD WB_INLINE void sample_cell_of(Vec3 p, float inv_h, int& ix, int& iy, int& iz) {
+  ix = cell_coord(p.x * inv_h);
+  iy = cell_coord(p.y * inv_h);
+  iz = cell_coord(p.z * inv_h);
 }
 
 /// Result of a nearest-sample query.
@@ -61,7 +61,7 @@ WB_HD WB_INLINE int ring_near(int lo, int hi, int c) { return c < lo ? lo - c : 
 WB_HD WB_INLINE int ring_far(int lo, int hi, int c) { return c - lo > hi - c ? c - lo : hi - c; }
 
 /// Checks the sorted slots [s, end) against the best so far (ties to the lower sample index).
-WB_HD WB_INLINE void nearest_in(const HashGridView& g, Vec3 p, uint32_t s, uint32_t end, float& best_d2,
+WB_HD WB_INLINE void nearest_in(const SampleGridView& g, Vec3 p, uint32_t s, uint32_t end, float& best_d2,
                                 int32_t& best) {
   for (; s < end; ++s) {
     const float d2 = length2(g.sorted_x[s] - p);
@@ -84,8 +84,8 @@ WB_HD WB_INLINE void nearest_in(const HashGridView& g, Vec3 p, uint32_t s, uint3
 /// so the answer does not depend on the order of the visits.
 ///
 /// Most particles of a stroke lie beyond the range of every sample: the coarse cell's flag
-/// (HashGridView::near) tells them with one load.
-WB_HD WB_INLINE NearestSample nearest_sample(const HashGridView& g, Vec3 p, float max_range) {
+/// (SampleGridView::near) tells them with one load.
+WB_HD WB_INLINE NearestSample nearest_sample(const SampleGridView& g, Vec3 p, float max_range) {
   NearestSample out{-1, max_range};
   if (g.count == 0 || !isfinite3(p)) return out;  // a non-finite point has no neighbour
   const float inv_h = 1.f / g.h;
@@ -96,10 +96,10 @@ WB_HD WB_INLINE NearestSample nearest_sample(const HashGridView& g, Vec3 p, floa
   // ring 1, not the whole ring.
   int lo[3], hi[3], c[3];
   for (int a = 0; a < 3; ++a) {
-    lo[a] = imax(blo[a], hash_coord((pc[a] - max_range) * inv_h));
-    hi[a] = imin(bhi[a], hash_coord((pc[a] + max_range) * inv_h));
+    lo[a] = imax(blo[a], cell_coord((pc[a] - max_range) * inv_h));
+    hi[a] = imin(bhi[a], cell_coord((pc[a] + max_range) * inv_h));
     if (lo[a] > hi[a]) return out;  // no sample's cell within reach
-    c[a] = hash_coord(pc[a] * inv_h);
+    c[a] = cell_coord(pc[a] * inv_h);
   }
   const int64_t nx = int64_t(bhi[0]) - blo[0] + 1, ny = int64_t(bhi[1]) - blo[1] + 1;
   if (c[0] >= blo[0] && c[0] <= bhi[0] && c[1] >= blo[1] && c[1] <= bhi[1] && c[2] >= blo[2] && c[2] <= bhi[2]) {

@@ -13,7 +13,7 @@
 #include "core/exec/buffer.h"
 #include "core/exec/device.h"
 #include "core/exec/workspace.h"
-#include "core/particles/hash_grid_kernels.h"
+#include "core/particles/sample_grid_kernels.h"
 #include "core/particles/particle_fields.h"
 
 namespace wb {
@@ -23,10 +23,10 @@ struct CellBox {
   int32_t lo[3], hi[3];
 };
 
-class SampleHashGrid {
+class SampleGrid {
  public:
-  SampleHashGrid() = default;
-  explicit SampleHashGrid(const Device& device);
+  SampleGrid() = default;
+  explicit SampleGrid(const Device& device);
 
   /// Files the samples that lie in `region` (canvas cells, lo to hi) into cells of size
   /// cell_size (canvas cells), at x - v rewind_dt. The region is where the queries' points lie,
@@ -43,7 +43,7 @@ class SampleHashGrid {
   /// beyond sees only the region's samples.
   void query_nearest(const ParticleView& particles, float max_range);
 
-  HashGridView view() const;
+  SampleGridView view() const;
   const Device& device() const { return device_; }
   int64_t sample_count() const { return count_; }
   /// Cells the last build could use (the region's), the size of its cell table less one.
@@ -63,22 +63,22 @@ class SampleHashGrid {
 /// Reference for tests: the nearest sample to p among all n (host arrays), within max_range.
 NearestSample nearest_sample_brute_force(const Vec3* samples, int64_t n, Vec3 p, float max_range);
 
-#define WB_HASH_GRID_BACKEND_DECLS                                                                               \
-  void hash_grid_box(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, CellBox region,      \
+#define WB_SAMPLE_GRID_BACKEND_DECLS                                                                               \
+  void sample_grid_box(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, CellBox region,      \
                      int32_t* box);                                                                              \
-  void hash_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, CellBox region,     \
+  void sample_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, CellBox region,     \
                       const int32_t* box, uint32_t* keys, uint32_t* index);                                      \
-  void hash_grid_first(const uint32_t* sorted_keys, const uint32_t* index, const Vec3* x, const Vec3* v,         \
+  void sample_grid_first(const uint32_t* sorted_keys, const uint32_t* index, const Vec3* x, const Vec3* v,         \
                        float rewind_dt, int64_t n, const int32_t* box, uint32_t* first, Vec3* sorted_x);         \
-  void hash_grid_coarse(const int32_t* box, const uint32_t* first, int64_t capacity, uint8_t* occupied);           \
-  void hash_grid_near(const int32_t* box, const uint8_t* occupied, int reach, int64_t capacity, uint8_t* near);      \
-  void hash_grid_query(HashGridView g, ParticleView p, float max_range);
+  void sample_grid_coarse(const int32_t* box, const uint32_t* first, int64_t capacity, uint8_t* occupied);           \
+  void sample_grid_near(const int32_t* box, const uint8_t* occupied, int reach, int64_t capacity, uint8_t* near);      \
+  void sample_grid_query(SampleGridView g, ParticleView p, float max_range);
 
 namespace cpu {
-WB_HASH_GRID_BACKEND_DECLS
+WB_SAMPLE_GRID_BACKEND_DECLS
 }  // namespace cpu
 namespace cuda {
-WB_HASH_GRID_BACKEND_DECLS
+WB_SAMPLE_GRID_BACKEND_DECLS
 }  // namespace cuda
 
 }  // namespace wb

@@ -1,1 +1,0 @@
-#include "core/particles/hash_grid_impl.h"

@@ -1,0 +1,1 @@
+#include "core/particles/sample_grid_impl.h"
