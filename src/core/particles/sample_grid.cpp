@@ -48,7 +48,7 @@ SampleGrid::SampleGrid(const Device& device) : device_(device) {
 }
 
 void SampleGrid::build(const SampleView& s, float cell_size, Vec3 region_lo, Vec3 region_hi, Workspace& ws,
-                           float rewind_dt) {
+                       float rewind_dt) {
   WB_REQUIRE(std::isfinite(cell_size) && cell_size > 0.f,
              "SampleGrid::build: cell size must be positive, got " + std::to_string(cell_size));
   WB_REQUIRE(s.bristles >= 0 && s.per_bristle >= 0, "SampleGrid::build: negative sample counts");

@@ -63,15 +63,15 @@ class SampleGrid {
 /// Reference for tests: the nearest sample to p among all n (host arrays), within max_range.
 NearestSample nearest_sample_brute_force(const Vec3* samples, int64_t n, Vec3 p, float max_range);
 
-#define WB_SAMPLE_GRID_BACKEND_DECLS                                                                               \
-  void sample_grid_box(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, CellBox region,      \
-                     int32_t* box);                                                                              \
-  void sample_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, CellBox region,     \
-                      const int32_t* box, uint32_t* keys, uint32_t* index);                                      \
-  void sample_grid_first(const uint32_t* sorted_keys, const uint32_t* index, const Vec3* x, const Vec3* v,         \
-                       float rewind_dt, int64_t n, const int32_t* box, uint32_t* first, Vec3* sorted_x);         \
-  void sample_grid_coarse(const int32_t* box, const uint32_t* first, int64_t capacity, uint8_t* occupied);           \
-  void sample_grid_near(const int32_t* box, const uint8_t* occupied, int reach, int64_t capacity, uint8_t* near);      \
+#define WB_SAMPLE_GRID_BACKEND_DECLS                                                                              \
+  void sample_grid_box(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, CellBox region,     \
+                       int32_t* box);                                                                             \
+  void sample_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, CellBox region,    \
+                        const int32_t* box, uint32_t* keys, uint32_t* index);                                     \
+  void sample_grid_first(const uint32_t* sorted_keys, const uint32_t* index, const Vec3* x, const Vec3* v,        \
+                         float rewind_dt, int64_t n, const int32_t* box, uint32_t* first, Vec3* sorted_x);        \
+  void sample_grid_coarse(const int32_t* box, const uint32_t* first, int64_t capacity, uint8_t* occupied);        \
+  void sample_grid_near(const int32_t* box, const uint8_t* occupied, int reach, int64_t capacity, uint8_t* near); \
   void sample_grid_query(SampleGridView g, ParticleView p, float max_range);
 
 namespace cpu {

@@ -23,7 +23,7 @@ WB_HD WB_INLINE bool in_region(const CellBox& r, int cx, int cy, int cz) {
 }
 
 void sample_grid_box(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, CellBox region,
-                   int32_t* box) {
+                     int32_t* box) {
   // Empty box (lo > hi) until the samples in the region widen it with integer atomics; set on
   // the device, so that the host never waits for an upload.
   parallel_for(1, [=] WB_HD(int64_t) {
@@ -46,7 +46,7 @@ void sample_grid_box(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, f
 }
 
 void sample_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, CellBox region,
-                    const int32_t* box, uint32_t* keys, uint32_t* index) {
+                      const int32_t* box, uint32_t* keys, uint32_t* index) {
   parallel_for(n, [=] WB_HD(int64_t i) {
     int cx, cy, cz;
     sample_cell_of(filed_position(x, v, rewind_dt, i), inv_h, cx, cy, cz);
@@ -63,7 +63,7 @@ void sample_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, 
 // After the sort: slot i is the first of every cell after slot i - 1's and up to its own (the
 // box's end for i = n), so each cell's entry is written once, with no clearing beforehand.
 void sample_grid_first(const uint32_t* sorted_keys, const uint32_t* index, const Vec3* x, const Vec3* v,
-                     float rewind_dt, int64_t n, const int32_t* box, uint32_t* first, Vec3* sorted_x) {
+                       float rewind_dt, int64_t n, const int32_t* box, uint32_t* first, Vec3* sorted_x) {
   parallel_for(n + 1, [=] WB_HD(int64_t i) {
     const int64_t volume = box_volume(box);
     const int64_t prev = i == 0 ? -1 : int64_t(sorted_keys[i - 1]);
