@@ -1,8 +1,8 @@
 // LaunchGraph: a run of launches that repeats with the same arguments, recorded once as a CUDA
 // graph and replayed whole, so the run costs one launch's latency instead of one a kernel.
 #pragma once
+#include <bit>
 #include <cstdint>
-#include <cstring>
 #include <initializer_list>
 
 #include "core/exec/device.h"
@@ -20,11 +20,7 @@ inline uint64_t launch_key(std::initializer_list<uint64_t> parts) {
 }
 inline uint64_t launch_key_of(const void* p) { return uint64_t(reinterpret_cast<uintptr_t>(p)); }
 /// A float argument's bits, for a key.
-inline uint64_t launch_key_of(float f) {
-  uint32_t b = 0;
-  std::memcpy(&b, &f, sizeof b);
-  return b;
-}
+inline uint64_t launch_key_of(float f) { return std::bit_cast<uint32_t>(f); }
 
 class LaunchGraph {
  public:
