@@ -2,55 +2,94 @@
 
 #include <QKeyEvent>
 #include <QMouseEvent>
+#include <QOffscreenSurface>
+#include <QOpenGLContext>
 #include <QPainter>
 #include <QTabletEvent>
-#include <QTransform>
 #include <QWheelEvent>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
+#include "studio/canvas_surface.h"
+
 namespace wb::studio {
-namespace {
 
-const char* kVertexShader = R"(
-attribute vec2 pos;
-uniform vec3 row0;
-uniform vec3 row1;
-uniform vec2 size;
-varying vec2 uv;
-void main() {
-  vec3 p = vec3(pos * size, 1.0);
-  gl_Position = vec4(dot(row0, p), dot(row1, p), 0.0, 1.0);
-  uv = pos;
-})";
+std::optional<ViewKind> parse_view_kind(const QString& name) {
+  if (name == "auto") return ViewKind::Auto;
+  if (name == "gl") return ViewKind::Gl;
+  if (name == "raster") return ViewKind::Raster;
+  return std::nullopt;
+}
 
-const char* kFragmentShader = R"(
-uniform sampler2D tex;
-varying vec2 uv;
-void main() { gl_FragColor = texture2D(tex, uv); })";
+const char* view_kind_name(ViewKind k) {
+  switch (k) {
+    case ViewKind::Gl: return "gl";
+    case ViewKind::Raster: return "raster";
+    default: return "auto";
+  }
+}
 
-}  // namespace
+bool opengl_available() {
+  static const bool ok = [] {
+    QOpenGLContext context;
+    if (!context.create()) return false;
+    QOffscreenSurface surface;
+    surface.setFormat(context.format());
+    surface.create();
+    if (!surface.isValid() || !context.makeCurrent(&surface)) return false;
+    context.doneCurrent();
+    return true;
+  }();
+  return ok;
+}
 
-CanvasView::CanvasView(QWidget* parent) : QOpenGLWidget(parent) {
+CanvasView::CanvasView(ViewKind kind, QWidget* parent) : QWidget(parent) {
+  kind_ = kind != ViewKind::Auto ? kind : opengl_available() ? ViewKind::Gl : ViewKind::Raster;
   setMouseTracking(true);
   setFocusPolicy(Qt::StrongFocus);
   setAttribute(Qt::WA_TabletTracking);
   setMinimumSize(320, 240);
+  if (kind_ == ViewKind::Gl)
+    surface_ = new GlSurface(*this);
+  else
+    surface_ = new RasterSurface(*this);
 }
 
-CanvasView::~CanvasView() {
-  makeCurrent();
-  if (texture_) glDeleteTextures(1, &texture_);
-  quad_.destroy();
-  doneCurrent();
+CanvasView::~CanvasView() = default;  // the surface is a child widget
+
+QOpenGLWidget* CanvasView::gl_widget() const { return dynamic_cast<GlSurface*>(surface_); }
+
+void CanvasView::frame_ready() { pull(); }
+
+void CanvasView::pull() {
+  if (!source_) return;
+  FrameUpdate u = source_(image_);
+  if (u.dirty.isEmpty()) return;
+  awaiting_.insert(awaiting_.end(), u.input_times.begin(), u.input_times.end());
+  const QRect shown =
+      canvas_transform().mapRect(QRectF(u.dirty)).toAlignedRect().adjusted(-1, -1, 1, 1).intersected(rect());
+  // Pixels out of sight are never drawn: their pen events are as much on screen as they will be.
+  if (shown.isEmpty() || !isVisible()) time_inputs();
+  surface_->image_changed(u.dirty, isVisible() ? shown : QRect());
+}
+
+void CanvasView::presented(int64_t pixels) {
+  ++frames_;
+  pixels_ += pixels;
+  time_inputs();
+}
+
+void CanvasView::time_inputs() {
+  if (awaiting_.empty()) return;
+  const double now = wall_now();
+  for (double t : awaiting_) latency_.add(now - t, now);
+  awaiting_.clear();
 }
 
 void CanvasView::set_canvas_size(int w, int h) {
   canvas_w_ = std::max(1, w);
   canvas_h_ = std::max(1, h);
-  texture_stale_ = true;
   fitted_ = false;
   fit();
 }
@@ -59,7 +98,7 @@ void CanvasView::set_view(QPointF center, float zoom, float rotation_deg) {
   center_ = center;
   zoom_ = std::clamp(zoom, 1.f / 64.f, 64.f);
   rotation_deg_ = std::fmod(rotation_deg, 360.f);
-  update();
+  surface_->widget()->update();
   Q_EMIT viewChanged();
 }
 
@@ -77,107 +116,49 @@ void CanvasView::zoom_by(float factor, QPointF anchor) {
   set_view(center_ + (c - moved), z, rotation_deg_);
 }
 
-QPointF CanvasView::to_widget(QPointF c) const {
+QTransform CanvasView::canvas_transform() const {
   QTransform t;
   t.translate(width() * 0.5, height() * 0.5);
   t.rotate(rotation_deg_);
   t.scale(zoom_, zoom_);
   t.translate(-center_.x(), -center_.y());
-  return t.map(c);
+  return t;
 }
 
-QPointF CanvasView::to_canvas(QPointF w) const {
-  QTransform t;
-  t.translate(width() * 0.5, height() * 0.5);
-  t.rotate(rotation_deg_);
-  t.scale(zoom_, zoom_);
-  t.translate(-center_.x(), -center_.y());
-  return t.inverted().map(w);
-}
+QPointF CanvasView::to_widget(QPointF c) const { return canvas_transform().map(c); }
 
-void CanvasView::initializeGL() {
-  initializeOpenGLFunctions();
-  program_.addShaderFromSourceCode(QOpenGLShader::Vertex, kVertexShader);
-  program_.addShaderFromSourceCode(QOpenGLShader::Fragment, kFragmentShader);
-  program_.bindAttributeLocation("pos", 0);
-  program_.link();
-  const GLfloat quad[] = {0.f, 0.f, 1.f, 0.f, 0.f, 1.f, 1.f, 1.f};
-  quad_.create();
-  quad_.bind();
-  quad_.allocate(quad, sizeof quad);
-  quad_.release();
-  glGenTextures(1, &texture_);
-  texture_stale_ = true;
-}
+QPointF CanvasView::to_canvas(QPointF w) const { return canvas_transform().inverted().map(w); }
 
-void CanvasView::resizeGL(int, int) {
-  if (!fitted_) {
+void CanvasView::resizeEvent(QResizeEvent*) {
+  surface_->widget()->setGeometry(rect());
+  if (!fitted_ && width() > 0 && height() > 0) {
     fitted_ = true;
     fit();
   }
 }
 
-void CanvasView::paintGL() {
-  // Upload what changed since the last frame: the whole image once, then only the dirty rectangle.
-  QRect dirty;
-  if (source_) dirty = source_(image_);
-  glBindTexture(GL_TEXTURE_2D, texture_);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-  if (!image_.isNull() && (texture_stale_ || dirty == image_.rect())) {
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA, image_.width(), image_.height(), 0, GL_RGBA, GL_UNSIGNED_BYTE,
-                 image_.constBits());
-    texture_stale_ = false;
-  } else if (!image_.isNull() && !dirty.isEmpty()) {
-    glPixelStorei(GL_UNPACK_ROW_LENGTH, image_.width());
-    glTexSubImage2D(GL_TEXTURE_2D, 0, dirty.x(), dirty.y(), dirty.width(), dirty.height(), GL_RGBA, GL_UNSIGNED_BYTE,
-                    image_.constScanLine(dirty.y()) + dirty.x() * 4);
-    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-  }
-  // Cells stay crisp from 1:1 up; smaller zooms are filtered.
-  const GLint filter = zoom_ >= 1.f ? GL_NEAREST : GL_LINEAR;
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+QRect CanvasView::cursor_rect(QPointF pos) const {
+  if (pos.x() < 0) return {};
+  const double r = cursor_radius_ * zoom_ + 3.0;
+  return QRectF(pos.x() - r, pos.y() - r, 2 * r, 2 * r).toAlignedRect();
+}
 
-  glClearColor(0.16f, 0.16f, 0.17f, 1.f);
-  glClear(GL_COLOR_BUFFER_BIT);
-  if (!image_.isNull()) {
-    // canvas cells -> widget pixels -> normalised device coordinates
-    QTransform t;
-    t.translate(width() * 0.5, height() * 0.5);
-    t.rotate(rotation_deg_);
-    t.scale(zoom_, zoom_);
-    t.translate(-center_.x(), -center_.y());
-    const QTransform ndc(2.0 / width(), 0, 0, -2.0 / height(), -1.0, 1.0);
-    const QTransform m = t * ndc;
-    program_.bind();
-    program_.setUniformValue("row0", QVector3D(m.m11(), m.m21(), m.m31()));
-    program_.setUniformValue("row1", QVector3D(m.m12(), m.m22(), m.m32()));
-    program_.setUniformValue("size", QVector2D(image_.width(), image_.height()));
-    program_.setUniformValue("tex", 0);
-    glActiveTexture(GL_TEXTURE0);
-    quad_.bind();
-    program_.enableAttributeArray(0);
-    program_.setAttributeBuffer(0, GL_FLOAT, 0, 2);
-    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
-    program_.disableAttributeArray(0);
-    quad_.release();
-    program_.release();
-  }
-  glBindTexture(GL_TEXTURE_2D, 0);
+void CanvasView::move_cursor(QPointF pos) {
+  const QRect before = cursor_rect(cursor_);
+  cursor_ = pos;
+  surface_->widget()->update(before);
+  surface_->widget()->update(cursor_rect(cursor_));
+}
 
-  // Overlay: the brush footprint under the cursor.
-  if (cursor_.x() >= 0) {
-    QPainter p(this);
-    p.setRenderHint(QPainter::Antialiasing);
-    p.setPen(QPen(QColor(255, 255, 255, 160), 1.0));
-    const double r = cursor_radius_ * zoom_;
-    p.drawEllipse(cursor_, r, r);
-    p.setPen(QPen(QColor(0, 0, 0, 160), 1.0));
-    p.drawEllipse(cursor_, r + 1, r + 1);
-  }
-  ++frames_;
+void CanvasView::paint_overlay(QPainter& p) const {
+  // The brush footprint under the cursor.
+  if (cursor_.x() < 0) return;
+  p.setRenderHint(QPainter::Antialiasing);
+  p.setPen(QPen(QColor(255, 255, 255, 160), 1.0));
+  const double r = cursor_radius_ * zoom_;
+  p.drawEllipse(cursor_, r, r);
+  p.setPen(QPen(QColor(0, 0, 0, 160), 1.0));
+  p.drawEllipse(cursor_, r + 1, r + 1);
 }
 
 PenInput CanvasView::input_at(QPointF pos, float pressure, float tilt_x, float tilt_y, float twist) const {
@@ -212,7 +193,6 @@ double CanvasView::event_time(const QInputEvent* e, bool press) {
 }
 
 void CanvasView::tabletEvent(QTabletEvent* e) {
-  cursor_ = e->position();
   const PenInput in = input_at(e->position(), float(e->pressure()), float(e->xTilt()), float(e->yTilt()),
                                float(e->rotation()));
   switch (e->type()) {
@@ -245,12 +225,11 @@ void CanvasView::tabletEvent(QTabletEvent* e) {
     default: break;
   }
   e->accept();
-  update();
+  move_cursor(e->position());
 }
 
 void CanvasView::mousePressEvent(QMouseEvent* e) {
   setFocus();
-  cursor_ = e->position();
   if (e->button() == Qt::RightButton && !pen_down_) {
     light_drag_ = true;
     light_anchor_ = e->position();
@@ -267,11 +246,10 @@ void CanvasView::mousePressEvent(QMouseEvent* e) {
     last_input_ = in;
     Q_EMIT penPress(in, event_time(e, true));
   }
-  update();
+  move_cursor(e->position());
 }
 
 void CanvasView::mouseMoveEvent(QMouseEvent* e) {
-  cursor_ = e->position();
   if (light_drag_) {
     Q_EMIT lightDrag(e->position() - light_anchor_, false);
   } else if (panning_) {
@@ -283,7 +261,7 @@ void CanvasView::mouseMoveEvent(QMouseEvent* e) {
     last_input_ = in;
     Q_EMIT penMove(in, event_time(e, false));
   }
-  update();
+  move_cursor(e->position());
 }
 
 void CanvasView::mouseReleaseEvent(QMouseEvent* e) {
@@ -296,7 +274,7 @@ void CanvasView::mouseReleaseEvent(QMouseEvent* e) {
     pen_down_ = false;
     Q_EMIT penRelease(input_at(e->position(), mouse_pressure_, 0.f, 0.f, 0.f), event_time(e, false));
   }
-  update();
+  move_cursor(e->position());
 }
 
 void CanvasView::wheelEvent(QWheelEvent* e) {
@@ -316,7 +294,7 @@ void CanvasView::keyPressEvent(QKeyEvent* e) {
     case Qt::Key_Equal: zoom_by(1.25f, QPointF(width() * 0.5, height() * 0.5)); break;
     case Qt::Key_Minus: zoom_by(0.8f, QPointF(width() * 0.5, height() * 0.5)); break;
     case Qt::Key_R: set_view(center_, zoom_, rotation_deg_ + ((e->modifiers() & Qt::ShiftModifier) ? -15.f : 15.f)); break;
-    default: QOpenGLWidget::keyPressEvent(e);
+    default: QWidget::keyPressEvent(e);
   }
 }
 

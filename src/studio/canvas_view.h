@@ -1,29 +1,56 @@
-// The canvas view: an OpenGL widget that shows the renderer's image of the canvas as one
-// texture (only the changed rectangle is uploaded per frame), with pan, zoom and rotation,
-// and turns tablet and mouse input into pen inputs in canvas cells.
+// The canvas view: shows the renderer's image of the canvas with pan, zoom and rotation, turns
+// tablet and mouse input into pen inputs in canvas cells, and measures the pen-to-paint latency.
+// What draws the picture is its surface (canvas_surface.h): an OpenGL texture (only the changed
+// rectangle is uploaded per frame) or QPainter (only the changed rectangle is repainted), one
+// view either way; OpenGL where a context can be made, QPainter where not (docs/STUDIO.md "View").
 #pragma once
 #include <QImage>
 #include <QInputEvent>
-#include <QOpenGLBuffer>
-#include <QOpenGLFunctions>
-#include <QOpenGLShaderProgram>
-#include <QOpenGLWidget>
 #include <QPointF>
+#include <QTransform>
+#include <QWidget>
 
 #include <functional>
+#include <optional>
+#include <vector>
 
+#include "studio/frame_cache.h"
+#include "studio/latency.h"
 #include "studio/pen_clock.h"
+
+class QOpenGLWidget;
 
 namespace wb::studio {
 
-class CanvasView : public QOpenGLWidget, protected QOpenGLFunctions {
+class CanvasSurface;
+
+/// How the canvas is drawn: `Auto` is OpenGL when a context can be made, QPainter otherwise.
+enum class ViewKind { Auto, Gl, Raster };
+
+/// "auto", "gl" or "raster"; nothing for another name.
+std::optional<ViewKind> parse_view_kind(const QString& name);
+const char* view_kind_name(ViewKind k);
+/// Whether an OpenGL context can be made current here (on an offscreen surface), checked once:
+/// QOpenGLWidget crashes on a platform without one (the `offscreen` platform without GLX).
+bool opengl_available();
+
+class CanvasView : public QWidget {
   Q_OBJECT
  public:
-  explicit CanvasView(QWidget* parent = nullptr);
+  /// `kind` Auto is resolved here (opengl_available).
+  explicit CanvasView(ViewKind kind = ViewKind::Auto, QWidget* parent = nullptr);
   ~CanvasView() override;
 
-  /// Where new pixels come from: fills `canvas` and returns the changed rectangle.
-  void set_frame_source(std::function<QRect(QImage&)> source) { source_ = std::move(source); }
+  /// Gl or Raster.
+  ViewKind kind() const { return kind_; }
+  /// The OpenGL widget that draws the canvas (null for the raster view).
+  QOpenGLWidget* gl_widget() const;
+
+  /// Where new pixels come from: fills `canvas` where it changed and says where, with the pen
+  /// events that these pixels show first.
+  void set_frame_source(std::function<FrameUpdate(QImage&)> source) { source_ = std::move(source); }
+  /// The source has a new frame: takes it and redraws what changed.
+  void frame_ready();
   void set_canvas_size(int w, int h);
   QSize canvas_size() const { return {canvas_w_, canvas_h_}; }
 
@@ -36,6 +63,8 @@ class CanvasView : public QOpenGLWidget, protected QOpenGLFunctions {
   void zoom_by(float factor, QPointF widget_anchor);
   QPointF to_canvas(QPointF widget) const;
   QPointF to_widget(QPointF canvas) const;
+  /// Canvas cells -> widget pixels.
+  QTransform canvas_transform() const;
 
   // Input mapping.
   /// Pressure curve exponent: pressure_out = pressure_in ^ gamma.
@@ -49,6 +78,12 @@ class CanvasView : public QOpenGLWidget, protected QOpenGLFunctions {
   void set_cursor_radius(float r) { cursor_radius_ = r; }
   /// Frames drawn so far (for frame-rate measurement).
   int64_t frames_drawn() const { return frames_; }
+  /// Widget pixels repainted so far (the raster view repaints the changed rectangles only; the
+  /// OpenGL view draws the whole widget every frame).
+  int64_t pixels_drawn() const { return pixels_; }
+  /// Pen-to-paint latencies measured by this view.
+  LatencyLog& latency() { return latency_; }
+  const LatencyLog& latency() const { return latency_; }
 
  Q_SIGNALS:
   /// Pen input at time t, when it happened on the wall clock (event_time).
@@ -65,9 +100,7 @@ class CanvasView : public QOpenGLWidget, protected QOpenGLFunctions {
   void viewChanged();
 
  protected:
-  void initializeGL() override;
-  void paintGL() override;
-  void resizeGL(int w, int h) override;
+  void resizeEvent(QResizeEvent* e) override;
   void tabletEvent(QTabletEvent* e) override;
   void mousePressEvent(QMouseEvent* e) override;
   void mouseMoveEvent(QMouseEvent* e) override;
@@ -76,16 +109,34 @@ class CanvasView : public QOpenGLWidget, protected QOpenGLFunctions {
   void keyPressEvent(QKeyEvent* e) override;
 
  private:
-  PenInput input_at(QPointF widget_pos, float pressure, float tilt_x, float tilt_y, float twist) const;
+  friend class GlSurface;
+  friend class RasterSurface;
 
-  std::function<QRect(QImage&)> source_;
+  // --- for the surfaces ---
+  /// Takes what the source has (the image's changed rectangle and its pen events) and asks the
+  /// surface to draw it.
+  void pull();
+  const QImage& image() const { return image_; }
+  /// Draws the brush footprint under the cursor.
+  void paint_overlay(QPainter& p) const;
+  /// A frame of `pixels` widget pixels reached the window: the pen events it shows are timed.
+  void presented(int64_t pixels);
+  /// The pen events taken so far are on screen now.
+  void time_inputs();
+
+  PenInput input_at(QPointF widget_pos, float pressure, float tilt_x, float tilt_y, float twist) const;
+  /// The cursor moved to `pos` (widget pixels; (-1, -1): gone): redraws its old and new footprint.
+  void move_cursor(QPointF pos);
+  QRect cursor_rect(QPointF pos) const;
+
+  ViewKind kind_;
+  CanvasSurface* surface_ = nullptr;  ///< a child filling the view, transparent to input
+  std::function<FrameUpdate(QImage&)> source_;
   QImage image_;
+  std::vector<double> awaiting_;  ///< pen events taken with pixels not presented yet (wall_now)
+  LatencyLog latency_;
   int canvas_w_ = 1, canvas_h_ = 1;
   bool place_paint_ = false;
-  bool texture_stale_ = true;
-  GLuint texture_ = 0;
-  QOpenGLShaderProgram program_;
-  QOpenGLBuffer quad_{QOpenGLBuffer::VertexBuffer};
 
   QPointF center_{0.5, 0.5};
   float zoom_ = 1.f;
@@ -112,6 +163,7 @@ class CanvasView : public QOpenGLWidget, protected QOpenGLFunctions {
   QPointF pan_anchor_;
   QPointF cursor_{-1, -1};
   int64_t frames_ = 0;
+  int64_t pixels_ = 0;
 };
 
 }  // namespace wb::studio

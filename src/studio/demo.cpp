@@ -88,7 +88,7 @@ std::vector<ScriptPoint> line_points(QPointF a, QPointF b, int n, float pressure
 
 namespace wb::studio {
 
-DemoTimes run_demo_painting(MainWindow& w) {
+DemoTimes run_demo_painting(MainWindow& w, bool short_demo) {
   // A small painting on linen, 8 x 6 cm: two colours put out on the palette and mixed there, a
   // stroke of the mix, one of a well's paint across it while it is wet, and a light pass of a
   // lightly loaded brush that catches the weave.
@@ -107,8 +107,10 @@ DemoTimes run_demo_painting(MainWindow& w) {
     paint.load = load;
     return paint;
   };
-  pal->put_paint(QPointF(0.35 * pw, 0.5 * ph), well(0, 1.f));
-  pal->put_paint(QPointF(0.65 * pw, 0.5 * ph), well(2, 1.f));
+  if (!short_demo) {
+    pal->put_paint(QPointF(0.35 * pw, 0.5 * ph), well(0, 1.f));
+    pal->put_paint(QPointF(0.65 * pw, 0.5 * ph), well(2, 1.f));
+  }
   w.clean_brush();
   w.settle();
   QElapsedTimer pen;
@@ -117,11 +119,11 @@ DemoTimes run_demo_painting(MainWindow& w) {
     pen.start();
     tablet_stroke(view, pts, 16);
     t.pen_s += pen.elapsed() / 1000.0;
-    w.settle();
+    w.settle(true);  // the frames of the catching up reach the screen as they come
     (view == v ? t.canvas_s : t.palette_s) += pen.elapsed() / 1000.0;
   };
   // Scrubbed together on the palette: the brush comes away with the mix.
-  for (int k = 0; k < 3; ++k) {
+  for (int k = 0; k < (short_demo ? 0 : 3); ++k) {
     const double y = ph * (0.5 + 0.04 * (k - 1));
     timed(pal->view(), line_points(QPointF(pw * (k % 2 ? 0.8 : 0.2), y), QPointF(pw * (k % 2 ? 0.2 : 0.8), y), 40,
                                    0.6f, k % 2 ? -15.f : 15.f));
@@ -134,6 +136,7 @@ DemoTimes run_demo_painting(MainWindow& w) {
   };
   const Pass passes[] = {{-1, 0.f, 0.38, 0.06, 0.6f, 20.f}, {2, 1.f, 0.52, 0.08, 0.75f, -15.f}, {0, 0.3f, 0.68, 0.04, 0.2f, 25.f}};
   for (const Pass& p : passes) {
+    if (short_demo && p.well != 2) continue;
     if (p.well >= 0) {
       w.clean_brush();
       w.dip(well(p.well, p.load));

@@ -35,8 +35,9 @@ struct DemoTimes {
 };
 /// A small scripted painting on linen: two wells' paint put out on the palette and mixed there,
 /// three curved strokes (the mix, a well's paint, a dry-brush pass) with varying pressure and tilt
-/// (the README screenshot and the frame-rate measurement).
-DemoTimes run_demo_painting(MainWindow& w);
+/// (the README screenshot and the frame-rate measurement). `short_demo`: the well's stroke alone,
+/// nothing on the palette (a test that the demo runs).
+DemoTimes run_demo_painting(MainWindow& w, bool short_demo = false);
 /// Stroke k of an endless scripted session (`--paint-loop`, the autosave and recovery test): a
 /// dip, then a straight stroke of about a second across row k mod 5 of the canvas, alternating in
 /// direction. Returns once the simulation has caught up with it.

@@ -59,6 +59,8 @@ bool FrameCache::render(Simulator& sim, bool force) {
   for (int y = r.top(); y <= r.bottom(); ++y)
     std::memcpy(front_.scanLine(y) + r.left() * 4, img.at(r.left(), y), size_t(r.width()) * 4);
   front_dirty_ |= r;
+  front_inputs_.insert(front_inputs_.end(), inputs_.begin(), inputs_.end());
+  inputs_.clear();
   return true;
 }
 
@@ -69,7 +71,7 @@ Image FrameCache::canvas_image(Simulator& sim) {
   return cache_->update(sim.canvas(), sim.live_window(), &overlay);
 }
 
-QRect FrameCache::take(QImage& canvas) {
+FrameUpdate FrameCache::take(QImage& canvas) {
   std::lock_guard lk(mu_);
   if (front_.isNull() || front_dirty_.isEmpty()) return {};
   QRect r = front_dirty_;
@@ -82,7 +84,9 @@ QRect FrameCache::take(QImage& canvas) {
       std::memcpy(canvas.scanLine(y) + r.left() * bpp, front_.constScanLine(y) + r.left() * bpp, size_t(r.width()) * bpp);
   }
   front_dirty_ = QRect();
-  return r;
+  FrameUpdate u{r, std::move(front_inputs_)};
+  front_inputs_.clear();
+  return u;
 }
 
 BrushPicture FrameCache::brush_picture() const {

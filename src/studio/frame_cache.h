@@ -9,11 +9,18 @@
 
 #include <memory>
 #include <mutex>
+#include <vector>
 
 #include "core/render/renderer.h"
 #include "core/sim/simulator.h"
 
 namespace wb::studio {
+
+/// What the view takes from the simulation for its next frame.
+struct FrameUpdate {
+  QRect dirty;                      ///< pixels changed since the last take (empty: none)
+  std::vector<double> input_times;  ///< pen events (wall_now) first consumed by these pixels' steps
+};
 
 class FrameCache {
  public:
@@ -27,15 +34,20 @@ class FrameCache {
   void invalidate_all();
   /// Cells [x0, x1) x [y0, y1) changed.
   void invalidate_rect(int x0, int y0, int x1, int y1);
+  /// A step consumed the pen event that happened at `wall_t` (wall_now): it goes to the view with
+  /// the next front image.
+  void input_consumed(double wall_t) { inputs_.push_back(wall_t); }
   /// Re-renders what changed and copies it to the front image, at most 30 times a second unless
-  /// `force`; the brush picture is taken with it. True when the front image changed.
+  /// `force`; the brush picture and the consumed pen events are taken with it. True when the
+  /// front image changed.
   bool render(Simulator& sim, bool force);
   /// The whole canvas rendered now (one pixel per cell).
   Image canvas_image(Simulator& sim);
 
   // --- UI thread (locked) ---
-  /// Copies the pixels changed since the last call into `canvas`; returns their rectangle.
-  QRect take(QImage& canvas);
+  /// Copies the pixels changed since the last call into `canvas`; returns their rectangle and
+  /// the pen events they show for the first time.
+  FrameUpdate take(QImage& canvas);
   BrushPicture brush_picture() const;
 
  private:
@@ -44,9 +56,11 @@ class FrameCache {
   CanvasDims dims_{};
   double last_render_ = 0.0;
   int dirty_x0_ = 1 << 30, dirty_y0_ = 1 << 30, dirty_x1_ = -1, dirty_y1_ = -1;
-  mutable std::mutex mu_;  ///< guards what the UI takes: front_, front_dirty_, picture_
+  std::vector<double> inputs_;  ///< pen events consumed since the last front image
+  mutable std::mutex mu_;  ///< guards what the UI takes: front_, front_dirty_, front_inputs_, picture_
   QImage front_;
   QRect front_dirty_;
+  std::vector<double> front_inputs_;
   BrushPicture picture_;
 };
 

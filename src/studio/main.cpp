@@ -1,4 +1,5 @@
-// wetbrush studio: the desktop painting application (Qt 6 Widgets, OpenGL canvas view).
+// wetbrush studio: the desktop painting application (Qt 6 Widgets; an OpenGL canvas view, or a
+// QPainter one where no OpenGL context can be made).
 #include <QApplication>
 #include <QThread>
 #include <QBuffer>
@@ -30,6 +31,10 @@ int main(int argc, char** argv) {
   cli.addHelpOption();
   QCommandLineOption device_opt("device", "Simulation device: auto, cpu, cuda or cuda:N.", "device", "auto");
   QCommandLineOption preset_opt("preset", "Quality preset: auto (from the device), cpu, gpu or tiny (small canvas and brush, fast).", "preset", "auto");
+  QCommandLineOption view_opt("view",
+                              "Canvas view: auto (OpenGL when a context can be made, else raster), gl (OpenGL) or "
+                              "raster (QPainter, no OpenGL).",
+                              "view", "auto");
   QCommandLineOption data_opt("data-dir", "Folder for presets, settings and the recovery file.", "dir");
   QCommandLineOption norecover_opt("no-recovery", "Do not offer to recover an autosaved painting.");
   QCommandLineOption demo_opt("demo-screenshot",
@@ -37,16 +42,20 @@ int main(int argc, char** argv) {
                               "the window to FILE and quit.",
                               "file");
   QCommandLineOption stats_opt("demo-stats",
-                               "With --demo-screenshot: write the view frame rate and the simulation rate of the "
-                               "scripted painting to FILE (JSON).",
+                               "With --demo-screenshot: write the view frame rate, the simulation rate and the "
+                               "pen-to-paint latency of the scripted painting to FILE (JSON).",
                                "file");
+  QCommandLineOption short_opt("demo-short",
+                               "With --demo-screenshot: a short scripted painting, one stroke on the canvas and "
+                               "none on the palette (a test that the demo runs).");
   QCommandLineOption autosave_opt("autosave-interval", "Seconds between autosaves of a changed painting (default 180).",
                                   "seconds", "180");
   QCommandLineOption loop_opt("paint-loop",
                               "Paint scripted tablet strokes without end, announcing each on standard output when the "
                               "pen goes down and when it lifts (the autosave and recovery test kills the studio "
                               "mid-stroke).");
-  cli.addOptions({device_opt, preset_opt, data_opt, norecover_opt, autosave_opt, demo_opt, stats_opt, loop_opt});
+  cli.addOptions(
+      {device_opt, preset_opt, view_opt, data_opt, norecover_opt, autosave_opt, demo_opt, stats_opt, short_opt, loop_opt});
   cli.addPositionalArgument("painting", "OpenRaster painting to open (.ora).", "[painting]");
   cli.process(app);
 
@@ -56,6 +65,17 @@ int main(int argc, char** argv) {
     opt.preset = QualityPreset::from_name(cli.value(preset_opt).toStdString(), opt.device);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "wetbrush-studio: %s\n", e.what());
+    return 2;
+  }
+  const std::optional<ViewKind> view = parse_view_kind(cli.value(view_opt));
+  if (!view) {
+    std::fprintf(stderr, "wetbrush-studio: --view: expected auto, gl or raster, got '%s'\n", qPrintable(cli.value(view_opt)));
+    return 2;
+  }
+  opt.view = *view;
+  if (opt.view == ViewKind::Gl && !opengl_available()) {
+    std::fprintf(stderr, "wetbrush-studio: --view gl: no OpenGL context can be made on the '%s' platform; use --view "
+                 "raster or auto\n", qPrintable(QGuiApplication::platformName()));
     return 2;
   }
   bool interval_ok = false;
@@ -73,14 +93,16 @@ int main(int argc, char** argv) {
   w.show();
   if (cli.isSet(demo_opt)) {
     const QString out = cli.value(demo_opt), stats = cli.value(stats_opt);
-    QTimer::singleShot(500, &w, [&w, out, stats, &opt] {
+    const bool short_demo = cli.isSet(short_opt);
+    QTimer::singleShot(500, &w, [&w, out, stats, short_demo, &opt] {
       // Also the frame-rate and simulation-rate measurement of docs/perf/studio.md.
       w.settle();
       QElapsedTimer timer;
       timer.start();
-      const int64_t frames0 = w.view()->frames_drawn();
+      const int64_t frames0 = w.view()->frames_drawn(), latency0 = w.view()->latency().count(),
+                    pal_latency0 = w.palette()->view()->latency().count();
       const SimStatus st0 = w.sim()->status(), pal0 = w.palette()->sim()->status();
-      const DemoTimes t = run_demo_painting(w);
+      const DemoTimes t = run_demo_painting(w, short_demo);
       w.settle();
       QApplication::processEvents();
       const double secs = timer.elapsed() / 1000.0;
@@ -97,9 +119,17 @@ int main(int argc, char** argv) {
       const double pal_mean_ms = pal_steps > 0 ? 1e3 * (pal.times.step - pal0.times.step) / double(pal_steps) : 0.0;
       // The canvas's view draws when the canvas's simulation publishes: its rate is over those strokes.
       const double fps = t.canvas_s > 0 ? double(frames) / t.canvas_s : 0.0;
+      // Pen-to-paint latency of each surface's pen events (docs/STUDIO.md "Pen-to-paint latency").
+      const LatencySummary lat = w.view()->latency().summary(latency0),
+                           pal_lat = w.palette()->view()->latency().summary(pal_latency0);
+      const char* view_name = view_kind_name(w.view()->kind());
       std::printf("demo: %.1f s wall (pen on the canvas or palette %.1f s), %lld view frames (%.1f fps over the "
-                  "canvas's strokes), device %s, preset %s\n",
-                  secs, t.pen_s, (long long)frames, fps, st.device.c_str(), opt.preset.name.c_str());
+                  "canvas's strokes, %s view), device %s, preset %s\n",
+                  secs, t.pen_s, (long long)frames, fps, view_name, st.device.c_str(), opt.preset.name.c_str());
+      std::printf("demo: pen-to-paint latency: canvas median %.1f ms, p95 %.1f ms (%lld pen events); palette median "
+                  "%.1f ms, p95 %.1f ms (%lld)\n",
+                  lat.median_ms, lat.p95_ms, (long long)lat.count, pal_lat.median_ms, pal_lat.p95_ms,
+                  (long long)pal_lat.count);
       std::printf("demo: canvas: %lld simulation steps in %.1f s of its strokes (real-time factor %.3f, %.1f ms "
                   "a step on average, %.1f the median of the last half second), %lld particles at the end\n",
                   (long long)steps, t.canvas_s, rtf, mean_ms, st.step_ms, (long long)st.particles);
@@ -120,8 +150,11 @@ int main(int argc, char** argv) {
       try {
         if (!stats.isEmpty()) {
           const nlohmann::json j = {{"preset", opt.preset.name}, {"device", st.device},
+                                    {"view", view_name},
                                     {"wall_s", secs},         {"pen_s", t.pen_s},
                                     {"view_frames", frames},  {"view_fps", fps},
+                                    {"latency_median_ms", lat.median_ms}, {"latency_p95_ms", lat.p95_ms},
+                                    {"latency_events", lat.count},
                                     {"canvas_s", t.canvas_s}, {"steps", steps},
                                     {"simulated_s", sim_s},   {"real_time_factor", rtf},
                                     {"mean_step_ms", mean_ms}, {"last_median_step_ms", st.step_ms},
@@ -130,6 +163,9 @@ int main(int argc, char** argv) {
                                     {"palette", {{"strokes_s", t.palette_s}, {"steps", pal_steps},
                                                  {"simulated_s", pal_sim_s}, {"real_time_factor", pal_rtf},
                                                  {"mean_step_ms", pal_mean_ms}, {"last_median_step_ms", pal.step_ms},
+                                                 {"latency_median_ms", pal_lat.median_ms},
+                                                 {"latency_p95_ms", pal_lat.p95_ms},
+                                                 {"latency_events", pal_lat.count},
                                                  {"worker_s", pal_worker}}}};
           wb::write_file_atomic(stats.toStdString(), j.dump(2) + "\n");
         }

@@ -20,6 +20,7 @@
 #include <QDoubleSpinBox>
 #include <QStandardPaths>
 #include <QStatusBar>
+#include <QThread>
 #include <QThreadPool>
 #include <QUndoCommand>
 
@@ -98,18 +99,18 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   cfg.canvas = CanvasDims{q.canvas_width, q.canvas_height, q.canvas_depth};
   cfg.brush = q.start_brush();
   if (options_.brush) cfg.brush = *options_.brush;
-  cfg.window = Int3{q.window_xy, q.window_xy, std::min(q.window_z, q.canvas_depth)};
+  cfg.window = q.window();
   cfg.params.transfer.candidate_split = q.candidate_split;
   RenderParams rp;
   rp.ao_rays = q.ao_rays;
   sim_ = std::make_unique<SimThread>(cfg, rp);
 
-  view_ = new CanvasView;
+  view_ = new CanvasView(options_.view);
   view_->set_frame_source([s = sim_.get()](QImage& img) { return s->take_frame(img); });
   view_->set_canvas_size(cfg.canvas.width, cfg.canvas.height);
   view_->set_cursor_radius(cfg.brush.width * 0.5f);
   setCentralWidget(view_);
-  connect(sim_.get(), &SimThread::frameReady, view_, qOverload<>(&QWidget::update));
+  connect(sim_.get(), &SimThread::frameReady, view_, &CanvasView::frame_ready);
   connect(sim_.get(), &SimThread::failed, this, [this](const QString& m) {
     std::fprintf(stderr, "wetbrush-studio: %s\n", qPrintable(m));
     statusBar()->showMessage("Error: " + m, 10000);
@@ -125,7 +126,7 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   });
 
   // The palette: its own small canvas and simulation, the same brush.
-  palette_ = new PalettePanel(cfg, rp, q.palette_width, q.palette_height);
+  palette_ = new PalettePanel(cfg, rp, q.palette_width, q.palette_height, view_->kind());
   connect(palette_, &PalettePanel::aboutToPaint, this, [this] { carry_brush(true); });
   connect(palette_, &PalettePanel::placePaint, this,
           [this](QPointF c) { palette_->put_paint(c, paint_panel_->current_paint()); });
@@ -257,6 +258,10 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   status_sim_ = new QLabel;
   status_device_ = new QLabel;
   status_view_ = new QLabel;
+  status_behind_ = new QLabel;
+  status_behind_->setStyleSheet("color: #c0392b");
+  status_behind_->hide();
+  statusBar()->addPermanentWidget(status_behind_);
   statusBar()->addPermanentWidget(status_sim_);
   statusBar()->addPermanentWidget(status_view_);
   statusBar()->addPermanentWidget(status_device_);
@@ -577,7 +582,11 @@ void MainWindow::new_canvas(int width, int height, QColor paper, const CanvasGro
   update_title();
 }
 
-void MainWindow::settle() {
+void MainWindow::settle(bool present) {
+  while (present && !(sim_->is_idle() && palette_->sim()->is_idle())) {
+    QCoreApplication::processEvents(QEventLoop::AllEvents, 5);
+    QThread::usleep(500);
+  }
   for (int pass = 0; pass < 2; ++pass) {
     sim_->wait_idle();
     palette_->sim()->wait_idle();
@@ -822,10 +831,28 @@ void MainWindow::update_status() {
   sim += st.particles >= 0 ? QString(" \u00b7 %1 particles").arg(st.particles) : QString(" \u00b7 particles: n/a");
   if (!st.error.empty()) sim += " \u00b7 STOPPED: " + QString::fromStdString(st.error);
   status_sim_->setText(sim);
-  status_view_->setText(QString("View %1 fps \u00b7 %2% \u00b7 %3\u00b0")
+  // The surface the brush is on: its pen-to-paint latency, and whether its simulation keeps up.
+  CanvasView* painted = brush_on_palette_ ? palette_->view() : view_;
+  const SimStatus ps = brush_on_palette_ ? palette_->sim()->status() : st;
+  const double latency = painted->latency().current_ms(now);
+  status_view_->setText(QString("View %1 fps \u00b7 %2 \u00b7 latency %3 \u00b7 %4% \u00b7 %5\u00b0")
                             .arg(view_fps_, 0, 'f', 0)
+                            .arg(view_kind_name(view_->kind()))
+                            .arg(latency >= 0 ? QString("%1 ms").arg(latency, 0, 'f', 0) : QString("\u2013"))
                             .arg(view_->zoom() * 100.f, 0, 'f', 0)
                             .arg(view_->rotation_deg(), 0, 'f', 0));
+  if (ps.realtime_factor >= 0.0 && ps.realtime_factor < 1.0) {
+    QString behind = QString("Behind real time: %1\u00d7 over the last second").arg(ps.realtime_factor, 0, 'f', 2);
+    if (const auto lighter = lighter_preset_that_keeps_up(ps.brush_samples, ps.window, ps.realtime_factor))
+      behind += QString("; the %1 preset keeps up (--preset %2)")
+                    .arg(QString::fromStdString(lighter->name), QString::fromStdString(lighter->id));
+    else
+      behind += "; no lighter preset keeps up";
+    status_behind_->setText(behind);
+    status_behind_->show();
+  } else {
+    status_behind_->hide();
+  }
   status_device_->setText(QString("Device %1 \u00b7 Preset %2")
                               .arg(QString::fromStdString(st.device), QString::fromStdString(options_.preset.name)));
   SimThread* holder = brush_on_palette_ ? palette_->sim() : sim_.get();

@@ -30,6 +30,7 @@ struct StudioOptions {
   QString data_dir;             ///< presets, recovery file (default: the platform's app data folder)
   bool offer_recovery = true;
   int autosave_interval_s = 180;
+  ViewKind view = ViewKind::Auto;  ///< how the canvas and the palette are drawn (--view)
 };
 
 /// Undo limit: whole strokes kept (each holds only the tiles it changed, zstd-compressed).
@@ -83,8 +84,9 @@ class MainWindow : public QMainWindow {
   /// How many oblique views have arrived (tests wait on it).
   int oblique_renders() const { return oblique_renders_; }
   /// Blocks until the simulation has consumed every input so far and the last stroke's undo
-  /// record has arrived (tests).
-  void settle();
+  /// record has arrived (tests). With `present`, the window goes on drawing the frames that come
+  /// meanwhile, as it does for a painter who waits (the demo's latency and frame rate).
+  void settle(bool present = false);
 
  protected:
   void closeEvent(QCloseEvent* e) override;
@@ -121,6 +123,7 @@ class MainWindow : public QMainWindow {
   QLabel* status_sim_ = nullptr;
   QLabel* status_device_ = nullptr;
   QLabel* status_view_ = nullptr;
+  QLabel* status_behind_ = nullptr;
   QTimer status_timer_, hold_timer_, autosave_timer_, idle_save_timer_;
   std::vector<StrokeEvent> pending_events_;  ///< palette actions while the pen is down
   QString path_;

@@ -47,7 +47,8 @@ void put_paint_dab(TileStore& canvas, float cx, float cy, float radius, float he
     }
 }
 
-PalettePanel::PalettePanel(const SimConfig& config, const RenderParams& render, int width, int height, QWidget* parent)
+PalettePanel::PalettePanel(const SimConfig& config, const RenderParams& render, int width, int height, ViewKind view,
+                           QWidget* parent)
     : QWidget(parent), clock_(width, height) {
   SimConfig c = config;
   c.canvas.width = width;
@@ -56,7 +57,7 @@ PalettePanel::PalettePanel(const SimConfig& config, const RenderParams& render, 
   RenderParams rp = render;
   rp.paper_rgb = Vec3(0.86f, 0.85f, 0.82f);  // a pale grey glass palette
   sim_ = std::make_unique<SimThread>(c, rp);
-  view_ = new CanvasView;
+  view_ = new CanvasView(view);
   view_->set_frame_source([s = sim_.get()](QImage& img) { return s->take_frame(img); });
   view_->set_canvas_size(width, height);
   view_->set_cursor_radius(c.brush.width * 0.5f);
@@ -64,7 +65,7 @@ PalettePanel::PalettePanel(const SimConfig& config, const RenderParams& render, 
   view_->setMinimumSize(320, 200);
   view_->setToolTip("Ctrl + click: put out the selected well's paint. Paint here to mix; the brush carries its "
                     "paint between palette and canvas. Alt + click: eyedropper.");
-  connect(sim_.get(), &SimThread::frameReady, view_, qOverload<>(&QWidget::update));
+  connect(sim_.get(), &SimThread::frameReady, view_, &CanvasView::frame_ready);
   auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(2, 2, 2, 2);
   layout->addWidget(view_, 1);

@@ -25,8 +25,9 @@ class PalettePanel : public QWidget {
   Q_OBJECT
  public:
   /// `config`: the painting's (device, brush, window, depth); the palette's canvas is
-  /// `width` x `height` cells of it.
-  PalettePanel(const SimConfig& config, const RenderParams& render, int width, int height, QWidget* parent = nullptr);
+  /// `width` x `height` cells of it, drawn by a view of `view` kind (the canvas's).
+  PalettePanel(const SimConfig& config, const RenderParams& render, int width, int height, ViewKind view,
+               QWidget* parent = nullptr);
   ~PalettePanel() override;
 
   SimThread* sim() const { return sim_.get(); }

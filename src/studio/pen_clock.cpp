@@ -49,6 +49,7 @@ ClockOutput PenClock::press(const PenInput& p, double t, double arrival) {
   const double s = any_ ? last_t_ + kStrokeGap : kLeadIn;
   push(out, sample(p, s - kLiftGap, false));
   push(out, sample(p, s, true));
+  out.input = PenEventTime{s, t};
   down_ = true;
   press_session_t_ = s;
   press_t_ = last_event_t_ = t;
@@ -62,6 +63,7 @@ ClockOutput PenClock::move(const PenInput& p, double t, double arrival) {
   last_event_t_ = t;
   last_arrival_ = last_input_ = arrival;
   push(out, sample(p, stamp(t), true));
+  out.input = PenEventTime{last_t_, t};
   return out;
 }
 
@@ -82,6 +84,7 @@ ClockOutput PenClock::release(const PenInput& p, double t) {
   ClockOutput out;
   if (!down_) return out;
   push(out, sample(p, stamp(t), true));
+  out.input = PenEventTime{last_t_, t};
   // Lifted kLiftGap later, then held still up to a step boundary: the simulation may run
   // every step up to that sample without knowing what comes next.
   const double up = last_t_ + kLiftGap;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/io/stroke.h"
+#include "studio/latency.h"
 
 namespace wb::studio {
 
@@ -31,6 +32,9 @@ struct PenInput {
 struct ClockOutput {
   std::vector<PenSample> samples;
   std::vector<StrokeEvent> events;
+  /// The pen event (press, move or release; not a held pen's repeat) whose sample this is, for
+  /// the pen-to-paint latency: the simulation consumes it with the step that reaches its time.
+  std::optional<PenEventTime> input;
 };
 
 class PenClock {

@@ -1,5 +1,7 @@
 #include "studio/preset.h"
 
+#include <algorithm>
+
 #include "core/exec/error.h"
 
 namespace wb::studio {
@@ -7,6 +9,7 @@ namespace wb::studio {
 QualityPreset QualityPreset::cpu() {
   QualityPreset p;
   p.name = "CPU (light)";
+  p.id = "cpu";
   p.bristles = 80;
   p.samples_per_bristle = 128;
   p.canvas_width = 1200;
@@ -26,6 +29,7 @@ QualityPreset QualityPreset::cpu() {
 QualityPreset QualityPreset::gpu() {
   QualityPreset p;
   p.name = "GPU (paper)";
+  p.id = "gpu";
   p.bristles = 400;
   p.samples_per_bristle = 128;
   p.canvas_width = 4096;
@@ -40,6 +44,7 @@ QualityPreset QualityPreset::gpu() {
 QualityPreset QualityPreset::tiny() {
   QualityPreset p;
   p.name = "tiny";
+  p.id = "tiny";
   p.bristles = 40;  // the fewest a brush file accepts
   p.brush_length = 16.f;
   p.brush_width = 8.f;
@@ -61,6 +66,30 @@ QualityPreset QualityPreset::from_name(const std::string& name, const Device& d)
   if (name == "gpu") return gpu();
   if (name == "tiny") return tiny();
   WB_THROW("unknown quality preset '" + name + "' (valid: auto, cpu, gpu, tiny)");
+}
+
+Int3 QualityPreset::window() const { return Int3{window_xy, window_xy, std::min(window_z, canvas_depth)}; }
+
+double estimated_step_ms(int64_t brush_samples, Int3 window) {
+  // Two measured points (docs/perf/studio.md, CPU backend, passive waits): the CPU preset's step
+  // (80 x 128 samples, window 64 x 64 x 16) about 38 ms, the tiny preset's (40 x 24, 48 x 48 x 8)
+  // about 5.5 ms; the brush's and the window's stages grow with their sizes.
+  constexpr double ms_per_sample = 2.70e-3, ms_per_cell = 1.58e-4;
+  const double cells = double(window.x) * double(window.y) * double(window.z);
+  return ms_per_sample * double(brush_samples) + ms_per_cell * cells;
+}
+
+std::optional<QualityPreset> lighter_preset_that_keeps_up(int64_t brush_samples, Int3 window, double realtime_factor) {
+  if (realtime_factor <= 0.0) return std::nullopt;
+  const double now_ms = estimated_step_ms(brush_samples, window);
+  std::optional<QualityPreset> best;
+  double best_ms = 0.0;
+  for (const QualityPreset& p : {QualityPreset::gpu(), QualityPreset::cpu(), QualityPreset::tiny()}) {
+    const double ms = estimated_step_ms(int64_t(p.bristles) * p.samples_per_bristle, p.window());
+    if (ms >= now_ms || realtime_factor * now_ms / ms < 1.0) continue;
+    if (!best || ms > best_ms) best = p, best_ms = ms;
+  }
+  return best;
 }
 
 BrushSpec QualityPreset::start_brush() const {

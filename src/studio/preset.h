@@ -1,16 +1,19 @@
 // The studio's quality presets: brush resolution, canvas, palette, window and render settings
 // sized for the device (docs/STUDIO.md "Quality presets").
 #pragma once
+#include <optional>
 #include <string>
 
 #include "core/brush/brush_spec.h"
 #include "core/exec/device.h"
+#include "core/canvas/window.h"
 
 namespace wb::studio {
 
 /// A quality preset: brush resolution, canvas and render settings sized for the device.
 struct QualityPreset {
   std::string name;
+  std::string id;  ///< its --preset name: cpu, gpu, tiny
   int bristles = 80;
   int samples_per_bristle = 32;
   int canvas_width = 1200, canvas_height = 900, canvas_depth = 32;
@@ -30,6 +33,19 @@ struct QualityPreset {
   /// "cpu", "gpu", "tiny"; "auto" picks from the device. Throws wb::Error for other names.
   static QualityPreset from_name(const std::string& name, const Device& d);
   static QualityPreset for_device(const Device& d) { return d.is_cuda() ? gpu() : cpu(); }
+  /// The simulated window of this preset, cells.
+  Int3 window() const;
 };
+
+/// A step's wall time estimated from what it simulates: `brush_samples` (bristles x samples a
+/// bristle) and the window's cells, ms on the CPU backend of the 2-core VM. Fitted to the CPU
+/// preset's and the tiny preset's measured steps (docs/STUDIO.md "Falling behind"); what it is
+/// for is the ratio of two configurations' costs.
+double estimated_step_ms(int64_t brush_samples, Int3 window);
+
+/// The preset of the most detail, lighter than what is simulated now (`brush_samples`, `window`),
+/// whose estimated real-time factor reaches 1, given the factor `realtime_factor` measured now;
+/// nothing when no lighter preset would keep up.
+std::optional<QualityPreset> lighter_preset_that_keeps_up(int64_t brush_samples, Int3 window, double realtime_factor);
 
 }  // namespace wb::studio

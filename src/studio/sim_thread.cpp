@@ -42,7 +42,10 @@ SimThread::~SimThread() {
 
 void SimThread::push(const ClockOutput& out) {
   if (out.samples.empty() && out.events.empty()) return;
-  post([out](SimThread& self) { self.session_.append(out); });
+  post([out](SimThread& self) {
+    self.session_.append(out);
+    if (out.input) self.pending_inputs_.push_back(*out.input);
+  });
 }
 
 void SimThread::post(std::function<void(SimThread&)> fn) {
@@ -58,6 +61,11 @@ void SimThread::wait_idle() {
   idle_cv_.wait(lk, [&] { return quit_ || (in_cmds_.empty() && !busy_); });
 }
 
+bool SimThread::is_idle() const {
+  std::lock_guard lk(in_mu_);
+  return quit_ || (in_cmds_.empty() && !busy_);
+}
+
 Stroke SimThread::recording() const { return session_.recording(); }
 
 SimStatus SimThread::status() const {
@@ -65,7 +73,7 @@ SimStatus SimThread::status() const {
   return status_;
 }
 
-QRect SimThread::take_frame(QImage& canvas) { return frames_.take(canvas); }
+FrameUpdate SimThread::take_frame(QImage& canvas) { return frames_.take(canvas); }
 
 // --- simulation thread ------------------------------------------------------------------
 
@@ -125,6 +133,7 @@ void SimThread::restart_recording(bool from_blank) {
   header.lead_out = 0.0;
   header.source = "studio session";
   session_.restart(std::move(header), from_blank);
+  pending_inputs_.clear();  // inputs past the old time line's last step: never simulated
 }
 
 BristleLoadHost SimThread::give_brush_paint() {
@@ -205,8 +214,14 @@ void SimThread::run_step(const SessionStep& s) {
   const Int3 o = sim.live_window()->origin(), n = sim.live_window()->dims();
   invalidate_rect(std::min(o.x, o0.x), std::min(o.y, o0.y), std::max(o.x, o0.x) + n.x, std::max(o.y, o0.y) + n.y);
   session_.step_done(s);
+  // The pen events up to the step's end are in the paint now: they go with its next frame.
+  while (!pending_inputs_.empty() && pending_inputs_.front().session_t <= s.step.t) {
+    frames_.input_consumed(pending_inputs_.front().wall_t);
+    pending_inputs_.pop_front();
+  }
   ++steps_;
   ++rate_steps_;
+  step_ends_.push_back(wall_now());
 }
 
 void SimThread::finish_stroke() {
@@ -234,6 +249,13 @@ void SimThread::publish_status(bool force) {
     sim_->profiler().clear();  // bounded memory over a long session
     status_.particles = sim_->particle_count();
   }
+  // The real-time factor of the last second, while the simulation was behind all of it: a
+  // simulation that caught up within it kept up, whatever its rate while it ran.
+  while (!step_ends_.empty() && step_ends_.front() < now - 1.0) step_ends_.pop_front();
+  status_.realtime_factor =
+      !status_.idle && busy_since_ > 0.0 && now - busy_since_ >= 1.0 ? double(step_ends_.size()) * kStepDt : -1.0;
+  status_.brush_samples = int64_t(config_.brush.bristles) * config_.brush.samples_per_bristle;
+  status_.window = config_.window;
   status_.steps = steps_;
   status_.times = times_;
   const BrushPicture picture = frames_.brush_picture();
@@ -243,7 +265,6 @@ void SimThread::publish_status(bool force) {
 }
 
 void SimThread::run() {
-  double busy_since = 0.0;
   for (;;) {
     std::deque<std::function<void(SimThread&)>> cmds;
     bool more = false;
@@ -267,7 +288,7 @@ void SimThread::run() {
     t = lap(times_.commands, t);
     // A few steps, then look at the inputs again: commands (undo, save) never wait long.
     const double t_start = wall_now();
-    if (busy_since == 0.0) busy_since = t_start, rate_t0_ = t_start;
+    if (busy_since_ == 0.0) busy_since_ = t_start, rate_t0_ = t_start;
     int n = 0;
     try {
       SessionStep step;
@@ -315,7 +336,7 @@ void SimThread::run() {
     {
       std::lock_guard lk(in_mu_);
       busy_ = pending;
-      if (!pending) busy_since = 0.0;
+      if (!pending) busy_since_ = 0.0;
     }
     idle_cv_.notify_all();
   }

@@ -48,6 +48,12 @@ struct SimStatus {
   int64_t steps = 0;            ///< steps done in this session
   int64_t particles = -1;       ///< liquid particles (-1: the simulator has none)
   double lag_s = 0.0;           ///< session time not simulated yet
+  /// Session seconds simulated per wall second over the last second, measured only while the
+  /// simulation had steps waiting throughout it (-1: it caught up within the last second, so it
+  /// keeps up). Below 1: the simulation falls behind real time.
+  double realtime_factor = -1.0;
+  int64_t brush_samples = 0;    ///< the simulated brush's bristles x samples (cost estimates)
+  Int3 window{};                ///< the simulated window, cells (cost estimates)
   bool idle = true;
   std::string device;
   std::array<float, 3> brush_ryb{};  ///< mean colour of the paint on the brush (RYB), from the device
@@ -68,8 +74,9 @@ class SimThread : public QObject {
   /// Runs `fn` on the simulation thread between steps (with exclusive access).
   void post(std::function<void(SimThread&)> fn);
   /// Copies the pixels that changed since the last call into `canvas` (the full canvas
-  /// image, one pixel per cell); returns the changed rectangle (empty when nothing changed).
-  QRect take_frame(QImage& canvas);
+  /// image, one pixel per cell); returns the changed rectangle (empty when nothing changed) and
+  /// the pen events whose steps these pixels show first.
+  FrameUpdate take_frame(QImage& canvas);
   SimStatus status() const;
   /// The recording so far (a copy).
   Stroke recording() const;
@@ -77,6 +84,8 @@ class SimThread : public QObject {
   bool recording_from_blank() const { return session_.from_blank(); }
   /// Blocks until every input pushed so far has been simulated (tests and shutdown only).
   void wait_idle();
+  /// Every input pushed so far has been simulated (what wait_idle waits for).
+  bool is_idle() const;
 
   // --- on the simulation thread (inside post()) -----------------------------------------
   Simulator& sim() { return *sim_; }
@@ -148,6 +157,8 @@ class SimThread : public QObject {
   std::deque<PenSample> in_samples_;
   std::deque<StrokeEvent> in_events_;
   std::deque<std::function<void(SimThread&)>> in_cmds_;
+  /// Pen events appended to the time line and not simulated yet (worker only), in session order.
+  std::deque<PenEventTime> pending_inputs_;
   bool quit_ = false;
   bool busy_ = false;
 
@@ -163,6 +174,8 @@ class SimThread : public QObject {
   int64_t steps_ = 0;
   int64_t rate_steps_ = 0;
   double rate_t0_ = 0.0;
+  double busy_since_ = 0.0;        ///< since when steps have been waiting without a break (0: idle)
+  std::deque<double> step_ends_;  ///< wall times the steps of the last second ended
   double last_status_ = 0.0;
   bool failed_ = false;
   WorkerTimes times_;  ///< worker only; copied into status_ with it

@@ -1,5 +1,6 @@
 // Studio tests (Qt Test, run under xvfb-run for Mesa OpenGL): the window opens with an OpenGL
-// canvas; synthesised tablet strokes paint under their path only; pressure widens the stroke;
+// canvas, and with the raster one on request or where there is no OpenGL (the offscreen demo,
+// with its pen-to-paint latency); synthesised tablet strokes paint under their path only; pressure widens the stroke;
 // undo / redo restore the exact canvas; save then open gives the same volume; a recorded
 // session replays to the same canvas; closing with unsaved changes asks; the real studio killed
 // mid-stroke recovers its last autosave; a save that fails (read-only folder, file size limit)
@@ -13,6 +14,7 @@
 #include <QFile>
 #include <QMessageBox>
 #include <QOpenGLContext>
+#include <QOpenGLWidget>
 #include <QProcess>
 #include <QPushButton>
 #include <QTemporaryDir>
@@ -305,12 +307,127 @@ class StudioTest : public QObject {
   }
 
   void windowOpensWithOpenGL() {
-    QVERIFY(w_->view()->context() != nullptr);
-    QVERIFY(w_->view()->context()->isValid());
-    const QImage img = w_->view()->grabFramebuffer();
+    QCOMPARE(w_->view()->kind(), ViewKind::Gl);  // auto: Xvfb's Mesa makes a context
+    QOpenGLWidget* gl = w_->view()->gl_widget();
+    QVERIFY(gl != nullptr);
+    QVERIFY(gl->context() != nullptr);
+    QVERIFY(gl->context()->isValid());
+    const QImage img = gl->grabFramebuffer();
     QVERIFY(!img.isNull());
     QCOMPARE(w_->view()->canvas_size(), QSize(kW, kH));
     QCOMPARE(w_->sim()->status().device, std::string("cpu"));
+  }
+
+  /// `--view raster`: the window has no OpenGL widget at all; a scripted stroke changes the
+  /// canvas's pixels on screen, each frame repainting the changed rectangle rather than the view,
+  /// and its pen events are timed from the tablet to the screen.
+  void rasterViewPaintsAScriptedStroke() {
+    StudioOptions o = options();
+    o.view = ViewKind::Raster;
+    o.data_dir = dir_->path() + "/raster";
+    auto w = std::make_unique<MainWindow>(o);
+    w->show();
+    QVERIFY(QTest::qWaitForWindowExposed(w.get()));
+    QCOMPARE(w->view()->kind(), ViewKind::Raster);
+    QCOMPARE(w->palette()->view()->kind(), ViewKind::Raster);
+    QVERIFY(w->view()->gl_widget() == nullptr);
+    QVERIFY(w->findChildren<QOpenGLWidget*>().isEmpty());
+    // A canvas larger than the changed rectangle of a step (the window and the renderer's reach).
+    w->new_canvas(400, 300, QColor(240, 235, 225));
+    w->settle();
+    w->view()->fit();
+    QTest::qWait(100);
+    const QImage before = w->view()->grab().toImage();
+    const int64_t frames0 = w->view()->frames_drawn(), pixels0 = w->view()->pixels_drawn();
+    const int64_t latency0 = w->view()->latency().count();
+    const QPointF a(100, 150), b(300, 150);
+    tablet_stroke(w->view(), line_points(a, b, 48, 0.7f), 20);
+    w->settle(true);
+    QTest::qWait(200);  // the last frame's repaint
+    const int64_t frames = w->view()->frames_drawn() - frames0, pixels = w->view()->pixels_drawn() - pixels0;
+    const LatencySummary lat = w->view()->latency().summary(latency0);
+    const QImage after = w->view()->grab().toImage();
+    QCOMPARE(after.size(), before.size());
+    // Pixels along the stroke's path changed, and not on the far side of the canvas.
+    const auto changed = [&](QPointF from, QPointF to) {
+      int n = 0, all = 0;
+      for (int i = 0; i <= 100; ++i) {
+        const QPoint p = w->view()->to_widget(from + (to - from) * (i / 100.0)).toPoint();
+        ++all;
+        n += before.pixel(p) != after.pixel(p);
+      }
+      return double(n) / all;
+    };
+    const double on_path = changed(a + QPointF(10, 0), b - QPointF(10, 0));
+    const double far_row = changed(QPointF(20, 280), QPointF(380, 280));
+    const double area = double(w->view()->width()) * w->view()->height();
+    qInfo("raster view: %lld frames, %.0f %% of the view a frame on average; path pixels changed %.2f, far row %.2f; "
+          "latency median %.1f ms, p95 %.1f ms over %lld pen events",
+          (long long)frames, frames > 0 ? 100.0 * double(pixels) / double(frames) / area : 0.0, on_path, far_row,
+          lat.median_ms, lat.p95_ms, (long long)lat.count);
+    QVERIFY2(on_path > 0.9, "the stroke's pixels changed on screen");
+    QCOMPARE(far_row, 0.0);
+    QVERIFY(frames > 0);
+    QVERIFY2(double(pixels) / double(frames) < 0.5 * area, "a frame repaints what changed, not the whole view");
+    QVERIFY(lat.count > 0);
+    QVERIFY(std::isfinite(lat.median_ms) && lat.median_ms > 0.0 && lat.p95_ms >= lat.median_ms);
+    w->undo_stack()->setClean();
+  }
+
+  /// Under the offscreen platform and no display there is no OpenGL: the real studio picks the
+  /// raster view itself, runs its scripted demo (the short one) to the end and writes the demo's
+  /// statistics with the pen-to-paint latency; `--view gl` says why it cannot run there instead of
+  /// crashing.
+  void offscreenDemoChoosesRasterAndReportsLatency() {
+    const QString data = dir_->path() + "/offscreen";
+    QVERIFY(QDir().mkpath(data));
+    QProcessEnvironment env = QProcessEnvironment::systemEnvironment();
+    env.insert("QT_QPA_PLATFORM", "offscreen");
+    env.remove("DISPLAY");
+    env.remove("WAYLAND_DISPLAY");
+    QProcess studio;
+    studio.setProcessEnvironment(env);
+    studio.start(WB_STUDIO_PATH, {"--device", "cpu", "--preset", "tiny", "--data-dir", data, "--demo-screenshot",
+                                  data + "/demo.png", "--demo-stats", data + "/stats.json", "--demo-short"});
+    QVERIFY2(studio.waitForFinished(120000), "the demo finished within two minutes");
+    const QString out = QString::fromUtf8(studio.readAllStandardOutput()),
+                  err = QString::fromUtf8(studio.readAllStandardError());
+    qInfo("studio stdout:\n%s", qPrintable(out));
+    QVERIFY2(studio.exitStatus() == QProcess::NormalExit && studio.exitCode() == 0,
+             qPrintable(QString("exit %1, stderr:\n%2").arg(studio.exitCode()).arg(err)));
+    QVERIFY2(!err.contains("QOpenGLWidget"), qPrintable(err));
+    QVERIFY(QFile::exists(data + "/demo.png"));
+    const nlohmann::json j = nlohmann::json::parse(read_bytes(data + "/stats.json").toStdString());
+    QCOMPARE(j.at("view").get<std::string>(), std::string("raster"));
+    for (const char* key : {"latency_median_ms", "latency_p95_ms"}) {
+      const double v = j.at(key).get<double>();
+      QVERIFY2(std::isfinite(v) && v > 0.0, key);
+    }
+    QVERIFY(j.at("latency_p95_ms").get<double>() >= j.at("latency_median_ms").get<double>());
+    QVERIFY(j.at("latency_events").get<int64_t>() > 0);
+
+    QProcess gl;
+    gl.setProcessEnvironment(env);
+    gl.start(WB_STUDIO_PATH, {"--device", "cpu", "--preset", "tiny", "--data-dir", data, "--view", "gl"});
+    QVERIFY(gl.waitForFinished(30000));
+    QCOMPARE(gl.exitStatus(), QProcess::NormalExit);
+    QCOMPARE(gl.exitCode(), 2);
+    QVERIFY2(gl.readAllStandardError().contains("--view gl: no OpenGL context"), "it says why");
+  }
+
+  /// The status bar's advice when the simulation falls behind: the lighter preset of the most
+  /// detail whose estimated real-time factor reaches 1, or none.
+  void lighterPresetThatKeepsUp() {
+    const auto samples = [](const QualityPreset& p) { return int64_t(p.bristles) * p.samples_per_bristle; };
+    const QualityPreset cpu = QualityPreset::cpu(), gpu = QualityPreset::gpu(), tiny = QualityPreset::tiny();
+    // The CPU preset at a third of real time (docs/STUDIO.md): tiny costs about a seventh of it.
+    auto p = lighter_preset_that_keeps_up(samples(cpu), cpu.window(), 0.33);
+    QVERIFY(p && p->id == "tiny");
+    QVERIFY(!lighter_preset_that_keeps_up(samples(cpu), cpu.window(), 0.05));
+    // The paper's preset at half real time: the CPU preset keeps up, and has more detail than tiny.
+    p = lighter_preset_that_keeps_up(samples(gpu), gpu.window(), 0.5);
+    QVERIFY(p && p->id == "cpu");
+    QVERIFY(!lighter_preset_that_keeps_up(samples(tiny), tiny.window(), 0.5));  // none is lighter
   }
 
   void brushPanelRangesAreTheBrushTable() {
