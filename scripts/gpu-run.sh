@@ -1,18 +1,22 @@
 #!/usr/bin/env bash
 # Runs what scripts/bundle-gpu.sh built on a machine with a CUDA GPU: the test suite on the
 # CUDA backend, the benchmarks, the step bench of the examples and their replays, writing logs,
-# stats and pictures to DIR; on request compute-sanitizer over the kernels' own tests and a soak.
-#   scripts/gpu-run.sh DIR [tests|bench|steps|replay|sanitize|soak]...   (the first four when none
-#   is named; WB_SOAK_MINUTES sets the soak's length, default 4)
+# stats and pictures to DIR; on request compute-sanitizer over the kernels' own tests, a soak, and
+# the studio's scripted demo (from build-gpu/studio.tar.zst alone: build-gpu/bin is not needed).
+#   scripts/gpu-run.sh DIR [tests|bench|steps|replay|sanitize|soak|studio]...   (the first four when
+#   none is named; WB_SOAK_MINUTES sets the soak's length, default 4; WB_STUDIO_DEVICE and
+#   WB_STUDIO_PRESET the studio's device and preset, default cuda and gpu, WB_STUDIO_ARGS more of
+#   its options; WB_GPU_BUILD the build folder, default build-gpu)
 set -uo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 out="${1:?output directory}"; shift
 what="${*:-tests bench steps replay}"
-bin="$here/build-gpu/bin"
+build="$(realpath -m "${WB_GPU_BUILD:-$here/build-gpu}")"
+bin="$build/bin"
 export LD_LIBRARY_PATH="$bin${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 mkdir -p "$out"
 nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader | tee "$out/gpu.txt"
-"$bin/wetbrush" devices | tee -a "$out/gpu.txt"
+[ -x "$bin/wetbrush" ] && "$bin/wetbrush" devices | tee -a "$out/gpu.txt"
 for w in $what; do
   case "$w" in
     tests)
@@ -48,5 +52,22 @@ for w in $what; do
         "$here"/tests/data/strokes/good/minimal.json "$here"/tests/data/strokes/good/tablet.txt --minutes "$m" \
         --device cuda --json "$out/soak.json" > "$out/soak.txt" 2>&1
       echo "soak (cuda, $m min): exit $?"; tail -4 "$out/soak.txt" ;;
+    studio)
+      # The studio's scripted demo on the offscreen platform (no display, no OpenGL: the raster
+      # view), from its archive: simulation rate, view frame rate, pen-to-paint latency
+      # (studio-stats.json) and the window's picture (studio.png); docs/STUDIO.md "On a GPU".
+      run="$build/studio-run"
+      rm -rf "$run" && mkdir -p "$run"
+      zstd_bin="$(command -v zstd || echo "$build/zstd/zstd")"  # bundle-gpu.sh's, where none is installed
+      LD_LIBRARY_PATH="$build/zstd" "$zstd_bin" -dcq "$build/studio.tar.zst" | tar -C "$run" -xf -
+      s="$run/studio"
+      dev="${WB_STUDIO_DEVICE:-cuda}" preset="${WB_STUDIO_PRESET:-gpu}"
+      # shellcheck disable=SC2086  # WB_STUDIO_ARGS: options, split on spaces
+      env -u DISPLAY -u WAYLAND_DISPLAY QT_QPA_PLATFORM=offscreen QT_PLUGIN_PATH="$s/plugins" \
+        FONTCONFIG_FILE="$s/fonts.conf" LD_LIBRARY_PATH="$s/lib" \
+        timeout 400 "$s/wetbrush-studio" --device "$dev" --preset "$preset" --view raster --data-dir "$run/data" \
+        --demo-stats "$out/studio-stats.json" --demo-screenshot "$out/studio.png" ${WB_STUDIO_ARGS:-} \
+        > "$out/studio.txt" 2>&1
+      echo "studio ($dev, preset $preset, raster view): exit $?"; grep -E "^demo: [0-9]|latency|canvas:|wrote" "$out/studio.txt" ;;
   esac
 done
