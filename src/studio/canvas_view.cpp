@@ -1,5 +1,6 @@
 #include "studio/canvas_view.h"
 
+#include <QGuiApplication>
 #include <QKeyEvent>
 #include <QMouseEvent>
 #include <QOffscreenSurface>
@@ -32,6 +33,12 @@ const char* view_kind_name(ViewKind k) {
 
 bool opengl_available() {
   static const bool ok = [] {
+    // Platforms that draw into memory only do not compose widgets through OpenGL, which
+    // QOpenGLWidget needs ("not supported on this platform", then a crash) even where a context
+    // can be made: the offscreen platform makes one through GLX when there is a display.
+    const QString platform = QGuiApplication::platformName();
+    for (const char* memory_only : {"offscreen", "minimal", "linuxfb", "vnc"})
+      if (platform == QLatin1String(memory_only)) return false;
     QOpenGLContext context;
     if (!context.create()) return false;
     QOffscreenSurface surface;

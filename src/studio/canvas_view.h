@@ -30,8 +30,9 @@ enum class ViewKind { Auto, Gl, Raster };
 /// "auto", "gl" or "raster"; nothing for another name.
 std::optional<ViewKind> parse_view_kind(const QString& name);
 const char* view_kind_name(ViewKind k);
-/// Whether an OpenGL context can be made current here (on an offscreen surface), checked once:
-/// QOpenGLWidget crashes on a platform without one (the `offscreen` platform without GLX).
+/// Whether the OpenGL view can work here, checked once: a platform that composes widgets through
+/// OpenGL (not offscreen, minimal, linuxfb or vnc) on which an OpenGL context can be made current
+/// on an offscreen surface. QOpenGLWidget crashes where either is missing.
 bool opengl_available();
 
 class CanvasView : public QWidget {

@@ -74,8 +74,8 @@ int main(int argc, char** argv) {
   }
   opt.view = *view;
   if (opt.view == ViewKind::Gl && !opengl_available()) {
-    std::fprintf(stderr, "wetbrush-studio: --view gl: no OpenGL context can be made on the '%s' platform; use --view "
-                 "raster or auto\n", qPrintable(QGuiApplication::platformName()));
+    std::fprintf(stderr, "wetbrush-studio: --view gl: no OpenGL view on the '%s' platform (it composes no OpenGL, or "
+                 "no context can be made); use --view raster or auto\n", qPrintable(QGuiApplication::platformName()));
     return 2;
   }
   bool interval_ok = false;
