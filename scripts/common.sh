@@ -12,7 +12,9 @@ WB_PACKAGES=(cmake ninja-build g++ pkg-config libgtest-dev libgmock-dev libbench
   nlohmann-json3-dev libcli11-dev libpng-dev libzstd-dev libzip-dev zlib1g-dev
   qt6-base-dev libqt6opengl6-dev xvfb xauth libgl1-mesa-dri
   # Hardening (docs/RELIABILITY.md): clang with libFuzzer and its OpenMP for the fuzz harnesses.
-  clang libclang-rt-dev libomp-dev)
+  clang libclang-rt-dev libomp-dev
+  # scripts/bundle-gpu.sh packs the studio for the GPU machine with the zstd program.
+  zstd)
 
 wb_install_deps() {
   local missing=()

@@ -1,6 +1,8 @@
 // Grid stage, advection (paper §4.2). The velocity is advected semi-Lagrangianly (Stam 1999:
 // trilinear sampling of the staggered field, RK2 backtrace); the paint is moved in flux form
-// (finite volumes on the MAC faces), so every cell gives exactly what its neighbours receive.
+// with semi-Lagrangian fluxes (finite volumes on the MAC faces, each face's flux the paint
+// between it and its departure point), so every cell gives exactly what its neighbours receive
+// and a pass costs the same at any speed.
 // Positions are in window cells; velocities in cells/s; dt in s.
 #pragma once
 #include <cstdint>
@@ -58,65 +60,105 @@ WB_HD WB_INLINE float face_volume_flux(const GridView& g, int c, int i, int j, i
   return face_mixture_velocity(g, c, d.fidx(c, i, j, k));
 }
 
-/// Paint crossing face (c; i,j,k) in time dt as the scheme reconstructs it, density units (cell
-/// volumes), positive along +c, and the donor (upwind) cell it leaves. Second-order upwind: the
-/// donor's density plus its van Leer-limited slope, evaluated at the centre of the swept region
-/// (van Leer 1977; LeVeque 2002, §6.12), so a ridge keeps its edges and no new extremum is made.
-/// The slope is 0 where the upwind neighbour is outside the window or solid.
-WB_HD WB_INLINE float face_paint_flux_unlimited(const GridView& g, const float* rho, int c, int i, int j, int k,
-                                                float dt, int64_t& donor) {
-  const GridDims& d = g.d;
+/// What crosses a face in one pass: the paint (cell volumes, positive along +axis) and the
+/// pigment, oil and dryness it carries (each times the paint).
+struct FaceCarry {
+  float m = 0.f, r = 0.f, y = 0.f, b = 0.f, oil = 0.f, dry = 0.f;
+};
+
+/// (e^x - 1) / x, and log(1 + x) / x: the exact motion through a cell whose velocity is linear
+/// between its faces (below), with their limits at x -> 0 written out where the quotient loses
+/// its digits.
+WB_HD WB_INLINE float expm1_over(float x) { return fabsf(x) < 1e-3f ? 1.f + x * (0.5f + x * (1.f / 6.f)) : expm1f(x) / x; }
+WB_HD WB_INLINE float log1p_over(float x) { return fabsf(x) < 1e-3f ? 1.f - x * (0.5f - x * (1.f / 3.f)) : log1pf(x) / x; }
+
+/// The paint that crosses face (c; i,j,k) in one pass of time dt along axis c: the paint lying,
+/// at the pass's start, between the face and the point whose path along the axis ends on the
+/// face (its departure point). The path is followed exactly through the velocity the faces of
+/// the axis carry (the mixture velocity, linear across each cell), so its length is not bounded
+/// by one cell: a pass costs the same at any speed, and the walk visits as many cells as the
+/// paint really comes from (flux-form semi-Lagrangian; Lin & Rood 1996, Leonard et al. 1996).
+/// The whole cells on the way count whole; the last one its swept part of the donor's density
+/// plus its van Leer-limited slope (van Leer 1977; LeVeque 2002, §6.12).
+///
+/// Paths along one axis never cross, so the departure points of a cell's two faces bound an
+/// interval and the cell's new paint is what lay in it: never negative, with no donor limit.
+/// Both cells a face joins compute its flux from the same values, bit for bit, so mass is kept
+/// exactly. A closed face (a wall, a solid cell's) carries no flow and stops every path. The
+/// walk stops after `reach` cells and at the bounds [lo, hi) of the cells whose faces were
+/// classified this step: the paint's reach and the box around it (Grid::advect); a path cut
+/// there still bounds an interval, so both properties hold.
+WB_HD WB_INLINE FaceCarry face_paint_carry(const GridView& g, const PaintWindowView& p, int c, int i, int j, int k,
+                                           float dt, int reach, int lo, int hi) {
+  FaceCarry out;
   const float U = face_volume_flux(g, c, i, j, k);
-  donor = -1;
-  if (U == 0.f) return 0.f;
-  const int ei = c == 0, ej = c == 1, ek = c == 2;
-  // Donor cell s (upwind), receiver r, and the donor's own upwind neighbour u.
+  if (U == 0.f) return out;
+  const GridDims& d = g.d;
   const int sgn = U > 0.f ? 1 : -1;
-  const int si = U > 0.f ? i - ei : i, sj = U > 0.f ? j - ej : j, sk = U > 0.f ? k - ek : k;
-  const int ri = U > 0.f ? i : i - ei, rj = U > 0.f ? j : j - ej, rk = U > 0.f ? k : k - ek;
-  const int ui = si - sgn * ei, uj = sj - sgn * ej, uk = sk - sgn * ek;
-  donor = d.cell(si, sj, sk);
-  const float rs = rho[donor], rr = rho[d.cell(ri, rj, rk)];
-  float slope = 0.f;
-  if (ui >= 0 && uj >= 0 && uk >= 0 && ui < d.nx && uj < d.ny && uk < d.nz) {
-    const int64_t up = d.cell(ui, uj, uk);
-    if (g.cls[up] != kCellSolid) {
-      const float d1 = rs - rho[up], d2 = rr - rs;
-      slope = d1 * d2 > 0.f ? 2.f * d1 * d2 / (d1 + d2) : 0.f;  // van Leer's harmonic limiter
+  const int at = c == 0 ? i : (c == 1 ? j : k);
+  const int64_t stride = c == 0 ? 1 : (c == 1 ? int64_t(d.nx) : int64_t(d.nx) * d.ny);
+  const int64_t row = d.cell(c == 0 ? 0 : i, c == 1 ? 0 : j, c == 2 ? 0 : k);
+  auto face_speed = [&](int f) {  // along the walk (upwind), cells/s
+    return float(sgn) * face_volume_flux(g, c, c == 0 ? f : i, c == 1 ? f : j, c == 2 ? f : k);
+  };
+  int s = sgn > 0 ? at - 1 : at;  // the cell the path comes through, from the face upwind
+  float w_in = fabsf(U), tau = dt;
+  for (int n = 0; n < reach && s >= lo && s < hi; ++n, s -= sgn) {
+    const int64_t cs = row + int64_t(s) * stride;
+    // The velocity along the walk is w_in at the face the path leaves s by, w_out at the face it
+    // entered s through, linear between: back in time the path moves by dx/dt' = w, so w grows
+    // (or decays) as e^{(w_out - w_in) t'}, and it crosses s in log(w_out / w_in) / (w_out - w_in)
+    // when w_out > 0; it never reaches a face where the flow stops or turns.
+    const float w_out = face_speed(sgn > 0 ? s : s + 1), h = w_out - w_in;
+    const float cross = w_out > 0.f ? log1p_over(h / w_in) / w_in : INFINITY;
+    const float rho = p.density[cs];
+    if (cross < tau && n + 1 < reach) {
+      out.m += rho;
+      out.r += rho * p.pigment_r[cs];
+      out.y += rho * p.pigment_y[cs];
+      out.b += rho * p.pigment_b[cs];
+      out.oil += rho * p.oil[cs];
+      out.dry += rho * p.dryness[cs];
+      tau -= cross;
+      w_in = w_out;
+      continue;
     }
+    // The path starts in s: the swept part eta of it, from the face it leaves s by.
+    if (rho > 0.f) {
+      const float eta = minf(w_in * tau * expm1_over(h * tau), 1.f);
+      // Slope along the flow from s's upwind neighbour and the cell it flows into.
+      const int su = s - sgn, sr = s + sgn;
+      const float rr = sr >= 0 && sr < (c == 0 ? d.nx : (c == 1 ? d.ny : d.nz)) ? p.density[cs + sgn * stride] : rho;
+      float slope = 0.f;
+      if (su >= lo && su < hi) {
+        const int64_t up = cs - sgn * stride;
+        if (g.cls[up] != kCellSolid) {
+          const float d1 = rho - p.density[up], d2 = rr - rho;
+          slope = d1 * d2 > 0.f ? 2.f * d1 * d2 / (d1 + d2) : 0.f;  // van Leer's harmonic limiter
+        }
+      }
+      // The limited value lies between the donor's and the next cell's; clamping to that
+      // interval removes round-off only.
+      const float face = clampf(rho + 0.5f * (1.f - eta) * slope, minf(rho, rr), maxf(rho, rr));
+      const float part = eta * face;
+      out.m += part;
+      out.r += part * p.pigment_r[cs];
+      out.y += part * p.pigment_y[cs];
+      out.b += part * p.pigment_b[cs];
+      out.oil += part * p.oil[cs];
+      out.dry += part * p.dryness[cs];
+    }
+    break;
   }
-  const float courant = fabsf(U) * dt;
-  // The limited value lies between the donor's and the receiver's; clamping to that interval
-  // only removes round-off (rs^2 / r_up - rs(1 - C) ... can come out a few ulps below 0).
-  const float face = rs + 0.5f * (1.f - minf(courant, 1.f)) * slope;
-  return U * dt * clampf(face, minf(rs, rr), maxf(rs, rr));
-}
-
-/// Density below which a cell gives nothing: 1e-30 of a cell is no paint, and the limiter's
-/// margin below needs normal (not subnormal) floats.
-inline constexpr float kNoPaint = 1e-30f;
-
-/// The paint that crosses face (c; i,j,k) in time dt, with its donor: the reconstructed flux,
-/// scaled down where the donor's outflow through its two faces of this axis would exceed what
-/// it holds. Below the sub-step Courant bound the scale is 1; it acts only where paint enters a
-/// fast cell during the step, or at the work bound, and keeps every density non-negative.
-/// Each of the two cells a face joins computes it from the same values, so both get the same
-/// number and the exchange is exact.
-WB_HD WB_INLINE float face_paint_flux(const GridView& g, const float* rho, int c, int i, int j, int k, float dt,
-                                      int64_t& donor) {
-  const float F = face_paint_flux_unlimited(g, rho, c, i, j, k, dt, donor);
-  if (donor < 0) return 0.f;
-  const float held = rho[donor];
-  if (!(held > kNoPaint)) return 0.f;
-  // The donor's other face along c: its low face when paint leaves it upwards, else its high face.
-  const int e = F > 0.f ? -1 : 1;
-  const int oi = i + e * (c == 0), oj = j + e * (c == 1), ok = k + e * (c == 2);
-  int64_t other_donor;
-  const float Fo = face_paint_flux_unlimited(g, rho, c, oi, oj, ok, dt, other_donor);
-  const float out = fabsf(F) + (other_donor == donor ? fabsf(Fo) : 0.f);
-  // The scale keeps a part in 10^6 back, more than the round-off of the two products, so the
-  // donor never goes below 0.
-  return out > held ? F * ((held / out) * (1.f - 1e-6f)) : F;
+  if (sgn < 0) {
+    out.m = -out.m;
+    out.r = -out.r;
+    out.y = -out.y;
+    out.b = -out.b;
+    out.oil = -out.oil;
+    out.dry = -out.dry;
+  }
+  return out;
 }
 
 /// Outflow of a cell holding paint along axis c, cells/s: the flux out through its two faces of

@@ -26,16 +26,21 @@ void first_extent_d(const Device& d, GridDims g, const float* maxima, GridExtent
   WB_DISPATCH(d, grid_first_extent(g, maxima, e));
 }
 void outflow_d(const Device& d, GridView g, const float* rho, float* out) { WB_DISPATCH(d, grid_paint_outflow(g, rho, out)); }
-void advect_axis_d(const Device& d, GridView g, PaintWindowView s, PaintWindowView t, int axis, float dt,
-                   PaintTiles tiles, const int32_t* process, int32_t* painted, const int32_t* below, int32_t* next) {
-  WB_DISPATCH(d, grid_advect_paint_axis(g, s, t, axis, dt, tiles, process, painted, below, next));
+void advect_axis_d(const Device& d, GridView g, PaintWindowView s, PaintWindowView t, int axis, float dt, int reach,
+                   float dry, PaintTiles tiles, const int32_t* process, int32_t* painted, const int32_t* below,
+                   int32_t* next) {
+  WB_REQUIRE(g.extent, "grid advection: the paint's box is not set");
+  WB_DISPATCH(d, grid_advect_paint_axis(g, s, t, axis, dt, reach, dry, tiles, process, painted, below, next));
 }
-void tiles_pass_d(const Device& d, GridDims g, PaintTiles tiles, const int32_t* before, int32_t* p) {
-  WB_DISPATCH(d, grid_paint_tiles_pass(g, tiles, before, p));
+void tiles_pass_d(const Device& d, GridDims g, PaintTiles tiles, const int32_t* before, int axis, int reach_tiles,
+                  int32_t* process) {
+  WB_DISPATCH(d, grid_paint_tiles_pass(g, tiles, before, axis, reach_tiles, process));
 }
-void paint_tiles_d(const Device& d, GridDims g, const float* rho, const float* dryness, float dry_threshold, int layers,
-                   int reach, int32_t* mark, int32_t* a, int32_t* h, int64_t* counts, int32_t* below) {
-  WB_DISPATCH(d, grid_paint_tiles(g, rho, dryness, dry_threshold, layers, reach, mark, a, h, counts, below));
+void paint_tiles_d(const Device& d, GridDims g, const float* rho, const float* dryness, float dry_threshold, int top,
+                   int layers, int reach, int halo, int deep, int32_t* mark, int32_t* a, int32_t* h, int64_t* counts,
+                   int32_t* below) {
+  WB_DISPATCH(d, grid_paint_tiles(g, rho, dryness, dry_threshold, top, layers, reach, halo, deep, mark, a, h, counts,
+                                  below));
 }
 void copy_tiles_d(const Device& d, GridDims g, PaintTiles t, PaintWindowView s, PaintWindowView dst, bool reads) {
   WB_DISPATCH(d, grid_copy_paint_tiles(g, t, s, dst, reads));
@@ -140,9 +145,6 @@ void check_params(const GridParams& p) {
   WB_REQUIRE(p.dry_rate >= 0.f && p.dry_rate <= 1000.f, "grid: dry_rate must be in [0, 1000] /s");
   WB_REQUIRE(p.dry_threshold > 0.f && p.dry_threshold <= 1.f, "grid: dry_threshold must be in (0, 1]");
   WB_REQUIRE(p.window_snap >= 1 && p.window_snap <= 64, "grid: window_snap must be in [1, 64]");
-  WB_REQUIRE(p.advect_courant >= 0.05f && p.advect_courant <= 0.5f, "grid: advect_courant must be in [0.05, 0.5]");
-  WB_REQUIRE(p.advect_max_substeps >= 1 && p.advect_max_substeps <= 1024,
-             "grid: advect_max_substeps must be in [1, 1024]");
 }
 }  // namespace
 
@@ -347,17 +349,16 @@ void Grid::advect(float dt) {
   PaintWindow& paint = window_.paint();
   paint_tmp_.set_origin(paint.origin());
   GridView v = view();
-  // Paint: flux form on the faces of the last step's velocity, one axis at a time, each axis in
-  // passes that keep its outflow Courant number at most advect_courant: no cell gives more than
-  // it holds, and no global correction is needed. An axis takes as many passes as its own flow
-  // needs (a stroke along x moves paint fast along x and slowly up), spread evenly over the
-  // step's sub-steps, which alternate the order x y z and z y x (Strang).
+  // Paint: flux form on the faces of the last step's velocity, in passes along one axis each,
+  // each face's flux the paint between it and its departure point (face_paint_carry): a pass
+  // moves paint as far as the flow takes it at the cost of one, so the step's work does not grow
+  // with the pen's speed. The axes alternate x y z and z y x from step to step (Strang).
   const int64_t cells = g.cells();
-  // The classes and face fractions the advection reads (solids for the backtrace, dried paint
-  // never moved) lie in the cells of the paint and particles and a few beyond: those of the
-  // columns and layers holding them first, found on the device, for the outflow rates; the rest
-  // once the one read has told how far the paint moves (below). Beyond, nothing in the step
-  // reads them (docs/GRID.md).
+  // The classes and face fractions the advection reads (solids, dried paint never moved) lie in
+  // the cells of the paint and particles and a few beyond: those of the columns and layers
+  // holding them first, found on the device, for the outflow rates; the rest once the one read
+  // has told how far the paint moves (below). Beyond, nothing in the step reads them
+  // (docs/GRID.md).
   column_maxima(kTraceDensity, kPaintTop);
   first_extent_d(d, g, advect_max_.data() + kJointTop, advect_extent_.data());
   within(advect_extent_.data(), [&] { classify(); });
@@ -369,34 +370,33 @@ void Grid::advect(float dt) {
     reduce_max_into(d, face_tmp_.data() + a * cells, cells, advect_max_.data() + kRateX + a, ws_);
   float maxima[kJointTop + 5];
   advect_max_.copy_to_host(maxima, kJointTop + 5);
-  int passes[3];
-  float courant = 0.f;
+  // The paint's reach along each axis, cells: the most a painted cell's face carries in the
+  // step, rounded up, and the cell the last part comes from. None where no painted cell's face
+  // carries flow along the axis: its pass would copy.
+  int reach[3];
+  float c[3], courant = 0.f;
   for (int a = 0; a < 3; ++a) {
-    const float c = std::isfinite(maxima[kRateX + a]) ? maxima[kRateX + a] * dt : 0.f;
-    // No pass along an axis where no face of a painted cell carries flow: it would copy.
-    passes[a] = c > 0.f ? std::clamp(int(std::ceil(c / params_.advect_courant)), 1, params_.advect_max_substeps) : 0;
-    if (passes[a] > 0) courant = std::max(courant, c / float(passes[a]));
+    c[a] = std::isfinite(maxima[kRateX + a]) ? std::min(maxima[kRateX + a] * dt, float(std::max({g.nx, g.ny, g.nz}))) : 0.f;
+    reach[a] = c[a] > 0.f ? int(std::ceil(c[a])) + 1 : 0;
+    courant = std::max(courant, c[a]);
   }
   const int top = int(maxima[kPaintTop]), joint_top = int(maxima[kJointTop]);
-  // The velocity's layers (below): the paint's and particles', risen a cell a z pass, and the
-  // stencils that reach them. The paint's passes read less (the paint's top plus its z passes,
-  // and the donor and slope cells beyond).
-  // Across, the paint's and particles' columns, as far as its x and y passes reach, and the
-  // stencils' two cells beyond.
-  const int layers = std::min(g.nz, joint_top + passes[2] + 2);
+  // The velocity's layers (below): the paint's and particles', risen by the paint's reach up,
+  // and the stencils that reach them. Across, the paint's and particles' columns, as far as the
+  // paint reaches along x and y, and the stencils' two cells beyond: the box whose faces the
+  // paint's passes read, and which bounds their walks.
+  const int layers = std::min(g.nz, joint_top + reach[2] + 2);
   int box[4];
-  column_box(g, maxima + kJointTop + 1, std::max(passes[0], passes[1]) + 2, box);
+  column_box(g, maxima + kJointTop + 1, std::max(reach[0], reach[1]) + 2, box);
   {
     GridExtent e{};
     set_extent(e, g, layers, box[0], box[1], box[2], box[3]);
     advect_extent_.copy_range_from_host(&e, 1, 1);
     within(advect_extent_.data() + 1, [&] { classify(); });
   }
-  const int n = std::max({passes[0], passes[1], passes[2]});
-  stats_.advect_substeps = n;
-  stats_.advect_passes = passes[0] + passes[1] + passes[2];
+  stats_.advect_passes = (reach[0] > 0) + (reach[1] > 0) + (reach[2] > 0);
   stats_.advect_courant = courant;
-  if (n > 0) advect_paint(dt, passes, top);
+  if (stats_.advect_passes > 0) within(advect_extent_.data() + 1, [&] { advect_paint(dt, reach, top); });
   // Velocity: backtrace every open face through a copy of the field, up to the layers that can
   // hold liquid in this step. Above, no face is fluid before the projection's extrapolation
   // writes it again, and nothing in the step reads it where there is no paint (docs/GRID.md).
@@ -407,55 +407,54 @@ void Grid::advect(float dt) {
   });
 }
 
-void Grid::advect_paint(float dt, const int passes[3], int top) {
+void Grid::advect_paint(float dt, const int reach[3], int top) {
   const Device& d = device();
   const GridDims g = dims();
   PaintWindow& paint = window_.paint();
   const GridView v = view();
-  const int n = std::max({passes[0], passes[1], passes[2]});
-  // Work in proportion to the paint: a pass moves paint at most one cell along its axis, so in
-  // this step's passes the paint reaches at most passes[a] cells from where it is along a, and
-  // no cell beyond that (plus one) computes a flux. The passes visit the columns of the tiles
-  // within that reach (and the layers below top + passes[z]); the advected cells read at most
-  // two cells further (donor and slope), in the ring of halo tiles and the two layers above,
-  // which the scratch copy takes from the paint once (docs/GRID.md "Work in proportion to the
-  // paint").
-  const int layers = std::min(g.nz, top + passes[2]);
-  const int reach = (std::max(passes[0], passes[1]) + 1 + kPaintTile - 1) / kPaintTile;
+  // Work in proportion to the paint: in this step's passes the paint moves at most reach[a]
+  // cells along a, so no cell farther from it (in tiles, and above top + reach[z]) computes a
+  // flux. A pass's walks read at most reach[a] cells beyond a cell it advects, and the last
+  // one's upwind neighbour: the ring of halo tiles and the layers above, which the scratch copy
+  // takes from the paint once (docs/GRID.md "Work in proportion to the paint").
+  const int layers = std::min(g.nz, top + reach[2]);
+  const int deep = std::min(g.nz, layers + reach[2] + 1);
+  const int across = std::max(reach[0], reach[1]);
+  const int reach_tiles = (across + kPaintTile - 1) / kPaintTile;
+  const int halo_tiles = std::max(1, (across + 1 + kPaintTile - 1) / kPaintTile);
   tile_counts_.fill_zero();
-  paint_tiles_d(d, g, paint.density.data(), paint.dryness.data(), params_.dry_threshold, layers, reach,
-                tile_mark_.data(), tile_active_.data(),
-                tile_halo_.data(), tile_counts_.data(), pass_below_.data());
+  paint_tiles_d(d, g, paint.density.data(), paint.dryness.data(), params_.dry_threshold, top, layers, reach_tiles,
+                halo_tiles, deep, tile_mark_.data(), tile_active_.data(), tile_halo_.data(), tile_counts_.data(),
+                pass_below_.data());
   const int tiles_x = (g.nx + kPaintTile - 1) / kPaintTile, tiles_y = (g.ny + kPaintTile - 1) / kPaintTile;
-  const PaintTiles tiles{tile_active_.data(), tile_halo_.data(), tile_counts_.data(), layers, tiles_x,
+  const PaintTiles tiles{tile_active_.data(), tile_halo_.data(), tile_counts_.data(), layers, deep, tiles_x,
                          int64_t(tiles_x) * tiles_y * kPaintTile * g.nz};
   copy_tiles_d(d, g, tiles, paint.view(), paint_tmp_.view(), true);
-  // Which tiles held paint after the last pass (before the first: the paint's) and after this one.
+  // Which tiles held paint that can move after the last pass (before the first: the paint's) and
+  // after this one; which the step's passes visit; the layers holding paint after each pass.
   int32_t* painted[2] = {tile_painted_[0].data(), tile_painted_[1].data()};
   int32_t* below[2] = {pass_below_.data(), pass_below_.data() + 1};
   const size_t tile_bytes = tile_mark_.size() * sizeof(int32_t);
   mem::copy_on_device(d, painted[0], tile_mark_.data(), tile_bytes);
-  int done[3] = {0, 0, 0}, made = 0;
-  for (int s = 0; s < n; ++s)
-    for (int a = 0; a < 3; ++a) {
-      const int axis = (s % 2 == 0) ? a : 2 - a;
-      // The axis's passes due by the end of sub-step s: passes[axis] spread evenly over n, each
-      // at the middle of its share (one pass of n: at the middle sub-step).
-      const int due = int((int64_t(2) * (s + 1) * passes[axis] + n) / (int64_t(2) * n));
-      if (done[axis] == due) continue;
-      ++done[axis];
-      ++made;
-      tiles_pass_d(d, g, tiles, painted[0], tile_process_.data());
-      mem::fill_zero(d, painted[1], tile_bytes);
-      mem::fill_zero(d, below[1], sizeof(int32_t));
-      advect_axis_d(d, v, paint.view(), paint_tmp_.view(), axis, dt / float(passes[axis]), tiles,
-                    tile_process_.data(), painted[1], below[0], below[1]);
-      std::swap(painted[0], painted[1]);
-      std::swap(below[0], below[1]);
+  mem::fill_zero(d, tile_process_.data(), tile_bytes);
+  int made = 0;
+  for (int n = 0; n < 3; ++n) {
+    const int axis = advect_order_ == 0 ? n : 2 - n;
+    if (reach[axis] == 0) continue;
+    const int walk = reach[axis];
+    tiles_pass_d(d, g, tiles, painted[0], axis, (walk + kPaintTile - 1) / kPaintTile, tile_process_.data());
+    mem::fill_zero(d, painted[1], tile_bytes);
+    mem::copy_on_device(d, below[1], below[0], sizeof(int32_t));
+    advect_axis_d(d, v, paint.view(), paint_tmp_.view(), axis, dt, walk, params_.dry_threshold, tiles,
+                  tile_process_.data(), painted[1], below[0], below[1]);
+    std::swap(painted[0], painted[1]);
+    std::swap(below[0], below[1]);
+    ++made;
 #define WB_X(name, doc) paint.name.swap(paint_tmp_.name);
-      WB_PAINT_FIELDS(WB_X)
+    WB_PAINT_FIELDS(WB_X)
 #undef WB_X
-    }
+  }
+  advect_order_ = 1 - advect_order_;
   if (made % 2 == 1) {
     // An odd number of passes left the result in the scratch buffers, complete only where the
     // passes wrote: the paint's own buffers are complete elsewhere, so they take the tiles back.

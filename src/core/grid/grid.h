@@ -18,9 +18,8 @@ namespace wb {
 
 /// One step's counts and solver figures (the mass books are the simulator's, PaintBooks).
 struct GridStats {
-  int advect_substeps = 0;      ///< sub-steps the paint's flux-form advection took (Courant <= advect_courant)
-  int advect_passes = 0;        ///< one-axis passes over those sub-steps (each axis as many as its flow needs)
-  float advect_courant = 0;     ///< largest one-axis outflow Courant number of a sub-step that moved paint
+  int advect_passes = 0;        ///< one-axis passes of the paint's advection: one per axis along which it flows
+  float advect_courant = 0;     ///< largest one-axis outflow Courant number of the paint (cells a step)
   double rhs_norm = 0;          ///< with projection_norms: ||rhs||_2 over liquid cells before the projection
   double residual_norm = 0;     ///< with projection_norms: ||residual||_2 after it
   float chebyshev_rho = 0;      ///< rho used by the Chebyshev solver (estimated or given)
@@ -172,10 +171,11 @@ class Grid {
   enum AdvectMax { kRateX = 0, kPaintTop = 3, kJointTop = 4, kExtentPaintTop = 9, kExtentTop = 10, kAdvectMaxSlots = 15 };
   DeviceBuffer<float> advect_max_;
   DeviceBuffer<int32_t> tile_mark_, tile_active_, tile_halo_;  ///< the advection's tiles (PaintTiles)
-  /// Per tile: whether it held paint after the last pass and after this one (swapped each
-  /// pass), and whether this pass visits it.
+  /// Per tile: whether it held paint that can move after the last pass and after this one
+  /// (swapped each pass), and whether a pass of the step visits it.
   DeviceBuffer<int32_t> tile_painted_[2], tile_process_;
-  DeviceBuffer<int32_t> pass_below_;  ///< the layers the last pass and this one visit (two values, swapped)
+  DeviceBuffer<int32_t> pass_below_;  ///< the layers holding paint after the last pass and this one (swapped)
+  int advect_order_ = 0;  ///< the axes' order of the next step's passes: x y z, then z y x (Strang)
   DeviceBuffer<int64_t> tile_counts_;
   DeviceBuffer<GridExtent> extent_;  ///< the layers the stages after the joint fields visit (device)
   /// The advection's classifications: the layers holding paint or particles, then those the
@@ -198,8 +198,9 @@ class Grid {
   /// The maxima of grid_column_tops (paint and particles above `trace`) into advect_max_'s six
   /// slots from `slot`: the paint's top, the joint top, then x, -x, y, -y of the joint columns.
   void column_maxima(float trace, int slot);
-  /// The paint's flux-form passes of advect(): passes[a] along axis a, the paint below layer top.
-  void advect_paint(float dt, const int passes[3], int top);
+  /// The paint's passes of advect(): one along each axis whose reach[a] (cells) is not 0, the
+  /// paint below layer top.
+  void advect_paint(float dt, const int reach[3], int top);
   PaintWindow paint_tmp_;
   SolverScratch scratch_;
   Workspace ws_;
@@ -212,12 +213,13 @@ class Grid {
   void grid_column_tops(GridDims d, const float* rho, const float* particle_density, float trace, float* out);    \
   void grid_first_extent(GridDims d, const float* maxima, GridExtent* e);                                          \
   void grid_paint_outflow(GridView g, const float* rho, float* out);                                                \
-  void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt,             \
-                              PaintTiles tiles, const int32_t* process, int32_t* painted, const int32_t* below,      \
-                              int32_t* below_next);                                                                  \
-  void grid_paint_tiles_pass(GridDims d, PaintTiles tiles, const int32_t* before, int32_t* process);                \
-  void grid_paint_tiles(GridDims d, const float* rho, const float* dryness, float dry_threshold, int layers,        \
-                        int reach, int32_t* mark, int32_t* active,                                                \
+  void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt, int reach, \
+                              float dry_threshold, PaintTiles tiles, const int32_t* process, int32_t* painted,       \
+                              const int32_t* below, int32_t* below_next);                                            \
+  void grid_paint_tiles_pass(GridDims d, PaintTiles tiles, const int32_t* before, int axis, int reach_tiles,        \
+                             int32_t* process);                                                                      \
+  void grid_paint_tiles(GridDims d, const float* rho, const float* dryness, float dry_threshold, int top,          \
+                        int layers, int reach, int halo_width, int deep, int32_t* mark, int32_t* active,            \
                         int32_t* halo, int64_t* counts, int32_t* below);                                             \
   void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst, bool reads);   \
   void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt);                  \

@@ -126,12 +126,13 @@ struct CgGuard {
 constexpr int kPaintTile = 8;
 /// The tiles the advection visits (device lists and counts, grid.cpp). counts: the active tiles,
 /// the halo tiles around them, then the cells of the active tiles below `layers`, of the active
-/// tiles below `layers + 2` and of the halo tiles below `layers + 2`, in rows of kPaintTile cells.
+/// tiles below `deep` and of the halo tiles below `deep`, in rows of kPaintTile cells.
 struct PaintTiles {
   const int32_t* active;
   const int32_t* halo;
   const int64_t* counts;
   int layers;  ///< the advection's layers
+  int deep;    ///< the layers its passes read: the paint's reach up and a cell more
   int tiles_x;
   int64_t capacity;  ///< every tile's rows, the window's depth deep (tiles overhang its edges)
 };

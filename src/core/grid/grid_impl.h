@@ -164,7 +164,8 @@ namespace detail {
 /// Row q of the tiles in `list`, `layers` deep: each element is a row of kPaintTile cells along x
 /// (tile-major, then k, then the tile's rows), so the index arithmetic is paid once a row and the
 /// row's cells are contiguous. fn(t, c) for each of its cells inside the window (t its tile);
-/// with `process`, only in the tiles it flags; with `below`, only in the layers under *below.
+/// with `process`, only in the tiles it flags; with `below`, only in the layers under *below +
+/// rise.
 template <class F>
 struct TileCells {
   GridDims d;
@@ -173,13 +174,14 @@ struct TileCells {
   F fn;
   const int32_t* process = nullptr;
   const int32_t* below = nullptr;
+  int rise = 0;
   WB_HD void operator()(int64_t q) const {
     const uint32_t per_tile = uint32_t(kPaintTile) * uint32_t(layers), e = uint32_t(q);
     const int32_t t = list[e / per_tile];
     if (process && !process[t]) return;
     const uint32_t r = e % per_tile;
     const int k = int(r / kPaintTile), j = (t / tiles_x) * kPaintTile + int(r % kPaintTile);
-    if (j >= d.ny || (below && k >= *below)) return;
+    if (j >= d.ny || (below && k >= *below + rise)) return;
     const int i0 = (t % tiles_x) * kPaintTile, i1 = i0 + kPaintTile < d.nx ? i0 + kPaintTile : d.nx;
     const int64_t row = d.cell(0, j, k);
     for (int i = i0; i < i1; ++i) fn(t, row + i);
@@ -187,8 +189,9 @@ struct TileCells {
 };
 }  // namespace detail
 
-void grid_paint_tiles(GridDims d, const float* rho, const float* dryness, float dry_threshold, int layers, int reach,
-                      int32_t* mark, int32_t* active, int32_t* halo, int64_t* counts, int32_t* below) {
+void grid_paint_tiles(GridDims d, const float* rho, const float* dryness, float dry_threshold, int top, int layers,
+                      int reach, int halo_width, int deep, int32_t* mark, int32_t* active, int32_t* halo,
+                      int64_t* counts, int32_t* below) {
   const int tx = (d.nx + kPaintTile - 1) / kPaintTile, ty = (d.ny + kPaintTile - 1) / kPaintTile;
   parallel_for(int64_t(tx) * ty, [=] WB_HD(int64_t t) {
     const int i0 = int(t % tx) * kPaintTile, j0 = int(t / tx) * kPaintTile;
@@ -205,27 +208,26 @@ void grid_paint_tiles(GridDims d, const float* rho, const float* dryness, float 
         }
     mark[t] = any;
   }, 1);
-  // A tile within `reach` tiles of paint is advected; the ring beyond it is the halo the
-  // advected cells read (at most two cells away: the donor and its slope).
+  // A tile within `reach` tiles of paint is advected; the ring of `halo_width` tiles beyond it
+  // is the halo the advected cells read (their faces' walks and the last cell's slope).
   parallel_for(int64_t(tx) * ty, [=] WB_HD(int64_t t) {
-    const int x = int(t % tx), y = int(t / tx);
-    int best = reach + 2;
-    for (int b = y - reach - 1; b <= y + reach + 1; ++b)
-      for (int a = x - reach - 1; a <= x + reach + 1; ++a) {
+    const int x = int(t % tx), y = int(t / tx), far = reach + halo_width;
+    int best = far + 1;
+    for (int b = y - far; b <= y + far; ++b)
+      for (int a = x - far; a <= x + far; ++a) {
         if (a < 0 || b < 0 || a >= tx || b >= ty || !mark[int64_t(b) * tx + a]) continue;
         const int dx = a > x ? a - x : x - a, dy = b > y ? b - y : y - b;
         const int dist = dx > dy ? dx : dy;
         best = best < dist ? best : dist;
       }
     if (best <= reach) active[atomic_add(&counts[0], int64_t(1))] = int32_t(t);
-    else if (best == reach + 1) halo[atomic_add(&counts[1], int64_t(1))] = int32_t(t);
+    else if (best <= far) halo[atomic_add(&counts[1], int64_t(1))] = int32_t(t);
   }, 1);
-  const int deep = layers + 2 < d.nz ? layers + 2 : d.nz;
   parallel_for(1, [=] WB_HD(int64_t) {
     counts[2] = counts[0] * kPaintTile * layers;  // rows of kPaintTile cells (TileCells)
     counts[3] = counts[0] * kPaintTile * deep;
     counts[4] = counts[1] * kPaintTile * deep;
-    *below = layers;  // the first pass visits every layer of the advection
+    *below = top;  // the layers holding paint before the first pass
   });
 }
 
@@ -236,82 +238,98 @@ void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, Pa
     WB_PAINT_FIELDS(WB_X)
 #undef WB_X
   };
-  // reads: every cell the passes read (the listed and halo tiles, two layers above the
-  // advection's); else the cells they write.
-  const int deep = tiles.layers + 2 < d.nz ? tiles.layers + 2 : d.nz;
+  // reads: every cell the passes read (the listed and halo tiles, `deep` layers); else the cells
+  // they write.
   using Rows = detail::TileCells<decltype(copy)>;
   parallel_for_count(tiles.counts + (reads ? 3 : 2), tiles.capacity,
-                     Rows{d, tiles.active, tiles.tiles_x, reads ? deep : tiles.layers, copy});
-  if (reads) parallel_for_count(tiles.counts + 4, tiles.capacity, Rows{d, tiles.halo, tiles.tiles_x, deep, copy});
+                     Rows{d, tiles.active, tiles.tiles_x, reads ? tiles.deep : tiles.layers, copy});
+  if (reads)
+    parallel_for_count(tiles.counts + 4, tiles.capacity, Rows{d, tiles.halo, tiles.tiles_x, tiles.deep, copy});
 }
 
-void grid_paint_tiles_pass(GridDims d, PaintTiles tiles, const int32_t* before, int32_t* process) {
-  // A tile none of whose 3 x 3 tiles held paint after the last pass is quiet: paint moves at
-  // most a cell a pass, so it held none the pass before either, this pass would copy its cells,
-  // and the buffer it would write holds them already (written at the last pass that visited it,
-  // quiet since). It is skipped.
+void grid_paint_tiles_pass(GridDims d, PaintTiles tiles, const int32_t* before, int axis, int reach_tiles,
+                           int32_t* process) {
+  // A pass along an axis moves paint only along it, at most reach_tiles tiles: a tile with no
+  // paint that far along the axis (after the last pass; before the first: the paint's) gets
+  // none and gives none. It is skipped when no pass of the step has visited it either: then the
+  // buffer it would write holds its cells already (the scratch copy's, or those of two passes
+  // ago, which the pass between left unchanged). So the flags gather over the step's passes.
   const int tx = tiles.tiles_x, ty = (d.ny + kPaintTile - 1) / kPaintTile;
   const int32_t* active = tiles.active;
   parallel_for_count(tiles.counts, tiles.capacity, [=] WB_HD(int64_t slot) {
     const int32_t t = active[slot];
     const int x = t % tx, y = t / tx;
-    int32_t busy = 0;
-    for (int b = y - 1; b <= y + 1; ++b)
-      for (int a = x - 1; a <= x + 1; ++a)
-        if (a >= 0 && b >= 0 && a < tx && b < ty) busy |= before[b * tx + a];
+    const int rx = axis == 0 ? reach_tiles : 0, ry = axis == 1 ? reach_tiles : 0;
+    int32_t busy = process[t];
+    for (int b = y - ry; b <= y + ry && !busy; ++b)
+      for (int a = x - rx; a <= x + rx; ++a)
+        if (a >= 0 && b >= 0 && a < tx && b < ty && before[b * tx + a]) {
+          busy = 1;
+          break;
+        }
     process[t] = busy;
   });
 }
 
-void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt,
-                            PaintTiles tiles, const int32_t* process, int32_t* painted, const int32_t* below,
-                            int32_t* below_next) {
+void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt, int reach,
+                            float dry_threshold, PaintTiles tiles, const int32_t* process, int32_t* painted,
+                            const int32_t* below, int32_t* below_next) {
   const GridDims d = g.d;
+  const GridExtent* box = g.extent;
   auto cell = [=] WB_HD(int32_t t, int64_t c) {
     int i, j, k;
     d.decompose_cell(c, i, j, k);
-    // Paint can only come from the cell or its two neighbours along the axis: air stays air.
+    // The cells whose faces were classified this step: paint moves within them (Grid::advect).
+    const bool inside = i >= box->x0 && i < box->x1 && j >= box->y0 && j < box->y1 && k < box->layers;
+    const int lo = axis == 0 ? box->x0 : (axis == 1 ? box->y0 : 0);
+    const int hi = axis == 0 ? box->x1 : (axis == 1 ? box->y1 : box->layers);
     const int64_t stride = axis == 0 ? 1 : (axis == 1 ? int64_t(d.nx) : int64_t(d.nx) * d.ny);
-    const int at = axis == 0 ? i : (axis == 1 ? j : k), n_axis = axis == 0 ? d.nx : (axis == 1 ? d.ny : d.nz);
-    if (src.density[c] == 0.f && (at == 0 || src.density[c - stride] == 0.f) &&
-        (at + 1 == n_axis || src.density[c + stride] == 0.f)) {
+    const int at = axis == 0 ? i : (axis == 1 ? j : k);
+    // A pass along z may change every layer it visits: the passes after it visit them too, so
+    // that none is left with what the buffer held two passes ago.
+    if (axis == 2 && k + 1 > atomic_load(below_next)) atomic_max(below_next, k + 1);
+    // Air stays air: no walk of the cell's faces can reach paint when none lies within the reach.
+    bool near = false;
+    for (int o = -reach; o <= reach && inside && !near; ++o)
+      near = at + o >= lo && at + o < hi && src.density[c + o * stride] != 0.f;
+    if (!near) {
 #define WB_X(name, doc) dst.name[c] = src.name[c];
       WB_PAINT_FIELDS(WB_X)
 #undef WB_X
       return;
     }
-    int64_t from_lo, from_hi;
-    // Paint in through the low face, out through the high one (signed): the same face flux is
+    // In through the low face, out through the high one (signed): the same face flux is
     // computed, bit for bit, by the two cells it joins, so what one loses the other gains.
-    const float lo = face_paint_flux(g, src.density, axis, i, j, k, dt, from_lo);
-    const float hi = face_paint_flux(g, src.density, axis, i + (axis == 0), j + (axis == 1), k + (axis == 2), dt,
-                                     from_hi);
+    const FaceCarry in = face_paint_carry(g, src, axis, i, j, k, dt, reach, lo, hi);
+    const FaceCarry out =
+        face_paint_carry(g, src, axis, i + (axis == 0), j + (axis == 1), k + (axis == 2), dt, reach, lo, hi);
     const float rho = src.density[c];
-    const float rho_new = add_rn(rho, sub_rn(lo, hi));
+    // The paths of the two faces bound the interval the cell's paint comes from, so the sum is
+    // >= 0 but for the round-off of the three terms (a few ulps of the larger flux): cut to 0.
+    const float rho_new = maxf(add_rn(rho, sub_rn(in.m, out.m)), 0.f);
     dst.density[c] = rho_new;
-    if (rho_new > 0.f) {
+    const float dry_new = rho_new > 1e-12f ? add_rn(rho * src.dryness[c], sub_rn(in.dry, out.dry)) / rho_new : src.dryness[c];
+    if (rho_new > 0.f && !dried_solid(rho_new, dry_new, dry_threshold)) {
+      // Paint that can move: the next passes visit this tile's neighbours and this layer.
       if (!atomic_load(&painted[t])) atomic_or(&painted[t], 1);
-      // The next pass visits the layers up to one above the highest holding paint: above
-      // them no cell nor its neighbours holds any.
-      if (k + 2 > atomic_load(below_next)) atomic_max(below_next, k + 2);
+      if (k + 1 > atomic_load(below_next)) atomic_max(below_next, k + 1);
     }
-    // Pigment, oil and dryness travel with the paint at their donor's value (mass-weighted),
-    // so each stays a convex mix of what met in the cell.
-    auto carry = [&](const float* q, float* out) {
-      const float in = from_lo >= 0 ? lo * q[from_lo] : 0.f;
-      const float gone = from_hi >= 0 ? hi * q[from_hi] : 0.f;
-      out[c] = rho_new > 1e-12f ? add_rn(rho * q[c], sub_rn(in, gone)) / rho_new : q[c];
+    // Pigment, oil and dryness travel with the paint (mass-weighted), so each stays a convex mix
+    // of what met in the cell.
+    auto carry = [&](const float* q, float q_in, float q_out, float* to) {
+      to[c] = rho_new > 1e-12f ? add_rn(rho * q[c], sub_rn(q_in, q_out)) / rho_new : q[c];
     };
     static_assert(kPaintFieldCount == 6, "advect every paint field");
-    carry(src.pigment_r, dst.pigment_r);
-    carry(src.pigment_y, dst.pigment_y);
-    carry(src.pigment_b, dst.pigment_b);
-    carry(src.oil, dst.oil);
-    carry(src.dryness, dst.dryness);
+    carry(src.pigment_r, in.r, out.r, dst.pigment_r);
+    carry(src.pigment_y, in.y, out.y, dst.pigment_y);
+    carry(src.pigment_b, in.b, out.b, dst.pigment_b);
+    carry(src.oil, in.oil, out.oil, dst.oil);
+    dst.dryness[c] = dry_new;
   };
+  // A pass along z lifts paint at most `reach` layers above those holding it.
   parallel_for_count(tiles.counts + 2, tiles.capacity,
                      detail::TileCells<decltype(cell)>{d, tiles.active, tiles.tiles_x, tiles.layers, cell, process,
-                                                       below});
+                                                       below, axis == 2 ? reach : 0});
 }
 
 void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt) {
@@ -602,8 +620,10 @@ void grid_dry(PaintWindowView pw, float amount) {
 }
 
 void grid_shift_lattice(const float* src, float* dst, int ex, int ey, int ez, int dx, int dy, int dz) {
+  // A window's lattices number fewer than 2^32 (GridDims::split): 32-bit divisions, the cheaper.
   parallel_for(int64_t(ex) * ey * ez, [=] WB_HD(int64_t t) {
-    const int i = int(t % ex), j = int((t / ex) % ey), k = int(t / (int64_t(ex) * ey));
+    const uint32_t u = uint32_t(t), w = uint32_t(ex), h = uint32_t(ey);
+    const int i = int(u % w), j = int((u / w) % h), k = int(u / (w * h));
     const int si = i + dx, sj = j + dy, sk = k + dz;
     const bool in = si >= 0 && sj >= 0 && sk >= 0 && si < ex && sj < ey && sk < ez;
     dst[t] = in ? src[(int64_t(sk) * ey + sj) * ex + si] : 0.f;

@@ -85,13 +85,6 @@ struct GridParams {
   float dry_threshold = 0.95f;
 
   // --- advection and mass ---
-  /// Largest outflow Courant number of a paint sub-step, per axis: the paint's flux-form
-  /// advection takes ceil(max outflow * dt / advect_courant) sub-steps, the outflow of the cells
-  /// holding more than a trace (1e-6 of a cell). At 0.5 no cell gives more
-  /// than it holds (docs/GRID.md "Advection and mass"). Default 0.5, range [0.05, 0.5].
-  float advect_courant = 0.5f;
-  /// Work bound of the paint's advection, sub-steps per step. Default 64, range [1, 1024].
-  int advect_max_substeps = 64;
   /// Measure ||div|| before and after each projection (GridStats::rhs_norm, residual_norm): two
   /// norms, two host reads a step. Default off.
   bool projection_norms = false;
