@@ -64,6 +64,15 @@ WB_HD WB_INLINE float face_volume_flux(const GridView& g, int c, int i, int j, i
 /// pigment, oil and dryness it carries (each times the paint).
 struct FaceCarry {
   float m = 0.f, r = 0.f, y = 0.f, b = 0.f, oil = 0.f, dry = 0.f;
+  /// Adds `part` cell volumes of cell c's paint.
+  WB_HD void add(const PaintWindowView& p, int64_t c, float part) {
+    m += part;
+    r += part * p.pigment_r[c];
+    y += part * p.pigment_y[c];
+    b += part * p.pigment_b[c];
+    oil += part * p.oil[c];
+    dry += part * p.dryness[c];
+  }
 };
 
 /// (e^x - 1) / x, and log(1 + x) / x: the exact motion through a cell whose velocity is linear
@@ -113,12 +122,7 @@ WB_HD WB_INLINE FaceCarry face_paint_carry(const GridView& g, const PaintWindowV
     const float cross = w_out > 0.f ? log1p_over(h / w_in) / w_in : INFINITY;
     const float rho = p.density[cs];
     if (cross < tau && n + 1 < reach) {
-      out.m += rho;
-      out.r += rho * p.pigment_r[cs];
-      out.y += rho * p.pigment_y[cs];
-      out.b += rho * p.pigment_b[cs];
-      out.oil += rho * p.oil[cs];
-      out.dry += rho * p.dryness[cs];
+      out.add(p, cs, sgn * rho);
       tau -= cross;
       w_in = w_out;
       continue;
@@ -140,23 +144,9 @@ WB_HD WB_INLINE FaceCarry face_paint_carry(const GridView& g, const PaintWindowV
       // The limited value lies between the donor's and the next cell's; clamping to that
       // interval removes round-off only.
       const float face = clampf(rho + 0.5f * (1.f - eta) * slope, minf(rho, rr), maxf(rho, rr));
-      const float part = eta * face;
-      out.m += part;
-      out.r += part * p.pigment_r[cs];
-      out.y += part * p.pigment_y[cs];
-      out.b += part * p.pigment_b[cs];
-      out.oil += part * p.oil[cs];
-      out.dry += part * p.dryness[cs];
+      out.add(p, cs, sgn * (eta * face));
     }
     break;
-  }
-  if (sgn < 0) {
-    out.m = -out.m;
-    out.r = -out.r;
-    out.y = -out.y;
-    out.b = -out.b;
-    out.oil = -out.oil;
-    out.dry = -out.dry;
   }
   return out;
 }
