@@ -78,8 +78,12 @@ struct FaceCarry {
 /// (e^x - 1) / x, and log(1 + x) / x: the exact motion through a cell whose velocity is linear
 /// between its faces (below), with their limits at x -> 0 written out where the quotient loses
 /// its digits.
-WB_HD WB_INLINE float expm1_over(float x) { return fabsf(x) < 1e-3f ? 1.f + x * (0.5f + x * (1.f / 6.f)) : expm1f(x) / x; }
-WB_HD WB_INLINE float log1p_over(float x) { return fabsf(x) < 1e-3f ? 1.f - x * (0.5f - x * (1.f / 3.f)) : log1pf(x) / x; }
+WB_HD WB_INLINE float expm1_over(float x) {
+  return fabsf(x) < 1e-3f ? 1.f + x * (0.5f + x * (1.f / 6.f)) : expm1f(x) / x;
+}
+WB_HD WB_INLINE float log1p_over(float x) {
+  return fabsf(x) < 1e-3f ? 1.f - x * (0.5f - x * (1.f / 3.f)) : log1pf(x) / x;
+}
 
 /// The paint that crosses face (c; i,j,k) in one pass of time dt along axis c: the paint lying,
 /// at the pass's start, between the face and the point whose path along the axis ends on the

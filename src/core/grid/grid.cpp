@@ -374,11 +374,12 @@ void Grid::advect(float dt) {
   // step, rounded up, and the cell the last part comes from. None where no painted cell's face
   // carries flow along the axis: its pass would copy.
   int reach[3];
-  float c[3], courant = 0.f;
+  float courant = 0.f;
+  const float longest = float(std::max({g.nx, g.ny, g.nz}));
   for (int a = 0; a < 3; ++a) {
-    c[a] = std::isfinite(maxima[kRateX + a]) ? std::min(maxima[kRateX + a] * dt, float(std::max({g.nx, g.ny, g.nz}))) : 0.f;
-    reach[a] = c[a] > 0.f ? int(std::ceil(c[a])) + 1 : 0;
-    courant = std::max(courant, c[a]);
+    const float c = std::isfinite(maxima[kRateX + a]) ? std::min(maxima[kRateX + a] * dt, longest) : 0.f;
+    reach[a] = c > 0.f ? int(std::ceil(c)) + 1 : 0;
+    courant = std::max(courant, c);
   }
   const int top = int(maxima[kPaintTop]), joint_top = int(maxima[kJointTop]);
   // The velocity's layers (below): the paint's and particles', risen by the paint's reach up,

@@ -308,7 +308,8 @@ void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst
     // >= 0 but for the round-off of the three terms (a few ulps of the larger flux): cut to 0.
     const float rho_new = maxf(add_rn(rho, sub_rn(in.m, out.m)), 0.f);
     dst.density[c] = rho_new;
-    const float dry_new = rho_new > 1e-12f ? add_rn(rho * src.dryness[c], sub_rn(in.dry, out.dry)) / rho_new : src.dryness[c];
+    const float dry_new =
+        rho_new > 1e-12f ? add_rn(rho * src.dryness[c], sub_rn(in.dry, out.dry)) / rho_new : src.dryness[c];
     if (rho_new > 0.f && !dried_solid(rho_new, dry_new, dry_threshold)) {
       // Paint that can move: the next passes visit this tile's neighbours and this layer.
       if (!atomic_load(&painted[t])) atomic_or(&painted[t], 1);
