@@ -442,11 +442,10 @@ void Grid::advect_paint(float dt, const int reach[3], int top) {
   for (int n = 0; n < 3; ++n) {
     const int axis = advect_order_ == 0 ? n : 2 - n;
     if (reach[axis] == 0) continue;
-    const int walk = reach[axis];
-    tiles_pass_d(d, g, tiles, painted[0], axis, (walk + kPaintTile - 1) / kPaintTile, tile_process_.data());
+    tiles_pass_d(d, g, tiles, painted[0], axis, (reach[axis] + kPaintTile - 1) / kPaintTile, tile_process_.data());
     mem::fill_zero(d, painted[1], tile_bytes);
     mem::copy_on_device(d, below[1], below[0], sizeof(int32_t));
-    advect_axis_d(d, v, paint.view(), paint_tmp_.view(), axis, dt, walk, params_.dry_threshold, tiles,
+    advect_axis_d(d, v, paint.view(), paint_tmp_.view(), axis, dt, reach[axis], params_.dry_threshold, tiles,
                   tile_process_.data(), painted[1], below[0], below[1]);
     std::swap(painted[0], painted[1]);
     std::swap(below[0], below[1]);
