@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs what is missing, checks the install list, builds every product (CLI, tests,
 # benchmarks, studio; CPU and, when nvcc exists, CUDA backends), runs every test and ends with a
-# summary: the products built and the tests per group (core, cli, studio). Fails when a test
+# summary: the products built and the tests per group (core, long, cli, studio). Fails when a test
 # fails or a group has no test.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
@@ -37,19 +37,14 @@ echo "products built: ${products[*]} (CUDA backend: ${cuda:-OFF})"
 statuses=$(sed -n 's/.*<testcase name="\([^"]*\)".*status="\([^"]*\)".*/\1\t\2/p' "$junit" 2>/dev/null |
   sed 's/&lt;/</g; s/&gt;/>/g; s/&quot;/"/g; s/&apos;/'"'"'/g; s/&amp;/\&/g' || true)
 total_pass=0 total_fail=0 total_skip=0
-for group in core cli studio; do
-  names=$(ctest -N -L "^${group}\$" | sed -n 's/^ *Test *#[0-9]*: //p')
-  n=0 pass=0 fail=0 skip=0
-  while IFS= read -r name; do
-    [ -n "$name" ] || continue
-    n=$((n + 1))
-    st=$(printf '%s\n' "$statuses" | awk -F'\t' -v t="$name" '$1 == t { print $2; exit }')
-    case "$st" in
-      run) pass=$((pass + 1)) ;;
-      fail | "") fail=$((fail + 1)) ;;
-      *) skip=$((skip + 1)) ;;
-    esac
-  done <<< "$names"
+for group in core long cli studio; do
+  # One awk over the statuses and the group's names: no reader that stops early, so no SIGPIPE
+  # for the writer under pipefail however many tests there are.
+  read -r n pass fail skip < <(ctest -N -L "^${group}\$" | sed -n 's/^ *Test *#[0-9]*: //p' |
+    awk -F'\t' 'NR == FNR { st[$1] = $2; next }
+      $0 != "" { n++; s = ($0 in st) ? st[$0] : ""
+        if (s == "run") p++; else if (s == "fail" || s == "") f++; else k++ }
+      END { print n + 0, p + 0, f + 0, k + 0 }' <(printf '%s\n' "$statuses") -)
   printf '  %-7s %4d tests: %d passed, %d failed, %d skipped\n' "$group" "$n" "$pass" "$fail" "$skip"
   if [ "$n" -eq 0 ]; then echo "  ERROR: the $group group has no tests"; ok=0; fi
   total_pass=$((total_pass + pass)) total_fail=$((total_fail + fail)) total_skip=$((total_skip + skip))
