@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "core/io/stroke.h"
 #include "sim/sim_fixture.h"
 
 namespace wb::test {
@@ -237,8 +238,11 @@ class StrokePropertiesTest : public SimulatorTest {
 };
 
 TEST_F(StrokePropertiesTest, SameStrokeWithMoreOrFewerSubstepsPaintsTheSame) {
-  // 160 mm/s, sub-steps of at most 1, 2 and 4 cells (14, 7 and 4 sub-steps a step).
-  const std::vector<float> a = paint_stroke(800.f, 1.f), b = paint_stroke(800.f, 2.f), c = paint_stroke(800.f, 4.f);
+  // 160 mm/s, sub-steps of at most 1 cell, the stroke format's default (3 cells, what a replay
+  // and the studio take) and 4 cells (14, 5 and 4 sub-steps a step). The other tests here take
+  // 2-cell sub-steps, in the middle.
+  const std::vector<float> a = paint_stroke(800.f, 1.f), b = paint_stroke(800.f, wb::Stroke{}.max_move_per_substep),
+                           c = paint_stroke(800.f, 4.f);
   std::printf("coverage of the track: %.0f %%, %.0f %%, %.0f %%\n", 100 * coverage(a), 100 * coverage(b), 100 * coverage(c));
   auto total = [](const std::vector<float>& v) { double s = 0; for (float x : v) s += x; return s; };
   // L1 of the paint per 4 x 4-cell block (0.8 mm, a third of the brush's width): the same
@@ -254,7 +258,7 @@ TEST_F(StrokePropertiesTest, SameStrokeWithMoreOrFewerSubstepsPaintsTheSame) {
       }
     return d / s;
   };
-  std::printf("paint on the canvas: %.1f, %.1f, %.1f cells; block L1 to the middle: %.3f, %.3f\n", total(a), total(b),
+  std::printf("paint on the canvas: %.1f, %.1f, %.1f cells; block L1 to the default: %.3f, %.3f\n", total(a), total(b),
               total(c), l1(b, a), l1(b, c));
   EXPECT_NEAR(total(a), total(b), 0.1 * total(b));
   EXPECT_NEAR(total(c), total(b), 0.1 * total(b));

@@ -48,7 +48,7 @@ struct Stroke {
 
   // Simulation settings for replay (docs/FORMATS.md, "simulation").
   double dt = 1.0 / 60.0;             ///< step length, seconds
-  float max_move_per_substep = 2.f;   ///< cells a brush point may move in one sub-step
+  float max_move_per_substep = 3.f;   ///< cells a brush point may move in one sub-step (docs/FORMATS.md)
   int max_substeps = 64;              ///< cap on sub-steps per step
   double lead_in = 0.25;              ///< seconds the brush descends from the air to the first sample
   double lead_out = 0.25;             ///< seconds it rises after the last sample
