@@ -11,7 +11,14 @@
 int main(int argc, char** argv) {
   CLI::App app{"wetbrush: bristle-level 3D oil-paint simulator (headless tools)"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "wetbrush 0.1.0");
+  app.set_version_flag("--version", "wetbrush " WB_VERSION);
+  // Errors say what is wrong in the user's terms; the source location that raised one is for a
+  // bug report, on request. Options the subcommands do not know fall through to here, so
+  // --verbose goes anywhere on the line.
+  bool verbose = false;
+  app.add_flag("--verbose", verbose, "Errors also name the source location that raised them (for a bug report)")
+      ->envname("WB_VERBOSE");
+  app.fallthrough();
   wb::cli::register_all(app);
   try {
     app.parse(argc, argv);
@@ -20,11 +27,8 @@ int main(int argc, char** argv) {
   }
   try {
     return wb::cli::run_selected(app);
-  } catch (const wb::Error& e) {
-    std::fprintf(stderr, "wetbrush: error: %s\n", e.what());
-    return 1;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "wetbrush: error: %s\n", e.what());
+    std::fprintf(stderr, "wetbrush: error: %s\n", verbose ? e.what() : wb::user_message(e).c_str());
     return 1;
   }
 }

@@ -9,6 +9,7 @@
 #include <QTimer>
 
 #include <cstdio>
+#include <string_view>
 
 #include <nlohmann/json.hpp>
 
@@ -20,15 +21,29 @@
 
 using namespace wb::studio;
 
+namespace {
+
+/// True when the command line asks only for the help or the version: answered without a display.
+bool asks_for_help_or_version(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view a = argv[i];
+    if (a == "--") break;
+    if (a == "-h" || a == "--help" || a == "--help-all" || a == "-v" || a == "--version") return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
-  QApplication::setAttribute(Qt::AA_ShareOpenGLContexts);
-  QApplication app(argc, argv);
-  QApplication::setApplicationName("wetbrush-studio");
-  QApplication::setOrganizationName("wetbrush");
+  QCoreApplication::setApplicationName("wetbrush-studio");
+  QCoreApplication::setOrganizationName("wetbrush");
+  QCoreApplication::setApplicationVersion(WB_VERSION);
 
   QCommandLineParser cli;
   cli.setApplicationDescription("wetbrush studio: paint with a simulated bristle brush and 3D oil paint");
   cli.addHelpOption();
+  cli.addVersionOption();
   QCommandLineOption device_opt("device", "Simulation device: auto, cpu, cuda or cuda:N.", "device", "auto");
   QCommandLineOption preset_opt("preset", "Quality preset: auto (from the device), cpu, gpu or tiny (small canvas and brush, fast).", "preset", "auto");
   QCommandLineOption view_opt("view",
@@ -57,6 +72,15 @@ int main(int argc, char** argv) {
   cli.addOptions(
       {device_opt, preset_opt, view_opt, data_opt, norecover_opt, autosave_opt, demo_opt, stats_opt, short_opt, loop_opt});
   cli.addPositionalArgument("painting", "OpenRaster painting to open (.ora).", "[painting]");
+  if (asks_for_help_or_version(argc, argv)) {
+    // The help and the version need no display: a core application parses, prints and exits.
+    QCoreApplication core(argc, argv);
+    cli.process(core);
+    return 0;
+  }
+
+  QApplication::setAttribute(Qt::AA_ShareOpenGLContexts);
+  QApplication app(argc, argv);
   cli.process(app);
 
   StudioOptions opt;
@@ -64,7 +88,7 @@ int main(int argc, char** argv) {
     opt.device = wb::Device::parse(cli.value(device_opt).toStdString());
     opt.preset = QualityPreset::from_name(cli.value(preset_opt).toStdString(), opt.device);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "wetbrush-studio: %s\n", e.what());
+    std::fprintf(stderr, "wetbrush-studio: %s\n", wb::user_message(e).c_str());
     return 2;
   }
   const std::optional<ViewKind> view = parse_view_kind(cli.value(view_opt));

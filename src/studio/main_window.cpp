@@ -111,10 +111,7 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   view_->set_cursor_radius(cfg.brush.width * 0.5f);
   setCentralWidget(view_);
   connect(sim_.get(), &SimThread::frameReady, view_, &CanvasView::frame_ready);
-  connect(sim_.get(), &SimThread::failed, this, [this](const QString& m) {
-    std::fprintf(stderr, "wetbrush-studio: %s\n", qPrintable(m));
-    statusBar()->showMessage("Error: " + m, 10000);
-  });
+  connect(sim_.get(), &SimThread::failed, this, [this](const QString& m) { statusBar()->showMessage("Error: " + m, 10000); });
 
   undo_ = new QUndoStack(this);
   undo_->setUndoLimit(kUndoLimit);
@@ -131,10 +128,8 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   connect(palette_, &PalettePanel::placePaint, this,
           [this](QPointF c) { palette_->put_paint(c, paint_panel_->current_paint()); });
   connect(palette_, &PalettePanel::pickColor, this, [this](QPointF c) { pick_color(c, palette_->sim()); });
-  connect(palette_->sim(), &SimThread::failed, this, [this](const QString& m) {
-    std::fprintf(stderr, "wetbrush-studio: palette: %s\n", qPrintable(m));
-    statusBar()->showMessage("Palette error: " + m, 10000);
-  });
+  connect(palette_->sim(), &SimThread::failed, this,
+          [this](const QString& m) { statusBar()->showMessage("Palette error: " + m, 10000); });
 
   // Pen input -> session clock -> simulation thread.
   connect(view_, &CanvasView::penPress, this, [this](PenInput p, double t) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 
 #include "core/color/ryb.h"
@@ -264,6 +265,13 @@ void SimThread::publish_status(bool force) {
   status_.lag_s = session_.lag();
 }
 
+void SimThread::fail(const std::exception& e) {
+  // The log (standard error) keeps the source location for a bug report; the painter is told
+  // what went wrong in the studio's terms.
+  std::fprintf(stderr, "wetbrush-studio: %s\n", e.what());
+  Q_EMIT failed(QString::fromStdString(user_message(e)));
+}
+
 void SimThread::run() {
   for (;;) {
     std::deque<std::function<void(SimThread&)>> cmds;
@@ -282,7 +290,7 @@ void SimThread::run() {
       try {
         fn(*this);
       } catch (const std::exception& e) {
-        Q_EMIT failed(QString::fromStdString(user_message(e)));
+        fail(e);
       }
     }
     t = lap(times_.commands, t);
@@ -308,7 +316,7 @@ void SimThread::run() {
         std::lock_guard lk(status_mu_);
         status_.error = user_message(e);
       }
-      Q_EMIT failed(QString::fromStdString(user_message(e)));
+      fail(e);
     }
     t = wall_now();
     const bool pending = !failed_ && step_available();
@@ -319,7 +327,7 @@ void SimThread::run() {
         try {
           finish_stroke();
         } catch (const std::exception& e) {
-          Q_EMIT failed(QString::fromStdString(user_message(e)));
+          fail(e);
         }
       }
       t = lap(times_.undo, t);

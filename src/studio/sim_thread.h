@@ -13,6 +13,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <deque>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -138,6 +139,8 @@ class SimThread : public QObject {
 
  private:
   void run();
+  /// Logs an exception with its source location and tells the window its message.
+  void fail(const std::exception& e);
   bool step_available() { return !failed_ && sim_ && session_.has_step(); }
   void run_step(const SessionStep& step);
   void finish_stroke();

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <string>
 
 #include "core/io/document.h"
@@ -77,6 +78,29 @@ TEST(Cli, BadStrokeFilesFailCleanly) {
     ++checked;
   }
   EXPECT_GE(checked, 15);
+}
+
+TEST(Cli, ErrorsNameTheSourceLocationOnlyWhenVerbose) {
+  // A stroke file without its samples: the message names the file and the missing key; the
+  // source line that raised it is for a bug report (--verbose anywhere on the line, or
+  // WB_VERBOSE=1).
+  const std::string bad = "'" + data("strokes/bad/missing-samples.json") + "'";
+  const std::regex location(R"(\[[A-Za-z_0-9]+\.(cpp|h|cu):[0-9]+\])");
+  const RunResult plain = run_cli("replay --device cpu -q " + bad);
+  EXPECT_EQ(plain.exit_code, 1) << plain.output;
+  EXPECT_NE(plain.output.find("missing-samples.json: top level: missing required key 'samples'"), std::string::npos)
+      << plain.output;
+  EXPECT_FALSE(std::regex_search(plain.output, location)) << plain.output;
+  for (const std::string& args : {"replay --device cpu -q --verbose " + bad, "--verbose replay --device cpu -q " + bad}) {
+    const RunResult r = run_cli(args);
+    EXPECT_EQ(r.exit_code, 1) << args << ": " << r.output;
+    EXPECT_TRUE(std::regex_search(r.output, location)) << args << ": " << r.output;
+  }
+  ::setenv("WB_VERBOSE", "1", 1);
+  const RunResult env = run_cli("replay --device cpu -q " + bad);
+  ::unsetenv("WB_VERBOSE");
+  EXPECT_EQ(env.exit_code, 1) << env.output;
+  EXPECT_TRUE(std::regex_search(env.output, location)) << "WB_VERBOSE=1: " << env.output;
 }
 
 TEST(Cli, BadOptionsFailCleanly) {

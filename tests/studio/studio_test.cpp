@@ -378,6 +378,24 @@ class StudioTest : public QObject {
   /// raster view itself, runs its scripted demo (the short one) to the end and writes the demo's
   /// statistics with the pen-to-paint latency; `--view gl` says why it cannot run there instead of
   /// crashing.
+  void helpAndVersionNeedNoDisplay() {
+    // No display, no platform chosen: the help and the version still print, and exit 0.
+    QProcessEnvironment env = QProcessEnvironment::systemEnvironment();
+    for (const char* v : {"DISPLAY", "WAYLAND_DISPLAY", "QT_QPA_PLATFORM"}) env.remove(v);
+    for (const QStringList& args : {QStringList{"--help"}, QStringList{"--device", "cpu", "-h"}, QStringList{"--version"}}) {
+      QProcess studio;
+      studio.setProcessEnvironment(env);
+      studio.start(WB_STUDIO_PATH, args);
+      QVERIFY2(studio.waitForFinished(20000), "answered within 20 s");
+      const QString out = QString::fromUtf8(studio.readAllStandardOutput()),
+                    err = QString::fromUtf8(studio.readAllStandardError());
+      QVERIFY2(studio.exitStatus() == QProcess::NormalExit && studio.exitCode() == 0,
+               qPrintable(QString("%1: exit %2, stderr:\n%3").arg(args.join(' ')).arg(studio.exitCode()).arg(err)));
+      const bool version = args.contains("--version");
+      QVERIFY2(out.contains(version ? "wetbrush-studio 0." : "--preset"), qPrintable(out));
+    }
+  }
+
   void offscreenDemoChoosesRasterAndReportsLatency() {
     const QString data = dir_->path() + "/offscreen";
     QVERIFY(QDir().mkpath(data));
