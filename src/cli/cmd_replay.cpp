@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
+#include "cli/progress.h"
 #include "core/exec/memory.h"
 #include "core/io/atomic_file.h"
 #include "core/io/document.h"
@@ -47,6 +48,7 @@ struct ReplayArgs {
   std::vector<std::string> sets;
   std::string params_file;
   bool quiet = false;
+  double progress_every = 10.0;  ///< seconds between progress lines written to a log
   bool bench = false;  ///< `wetbrush bench`: no pictures; a per-stage timing table
   std::string bench_json;
 };
@@ -238,10 +240,8 @@ int run_replay(const ReplayArgs& a) {
   const CanvasRect& r = replay.region();
   const Camera camera = Camera::top_region(float(r.x0), float(r.y0), float(r.width), float(r.height), 1.f);
 
-  const bool progress = !a.quiet && isatty(STDERR_FILENO);
-  const auto t0 = std::chrono::steady_clock::now();
-  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
-  double last_print = -1.0;
+  Progress progress(!a.quiet, a.progress_every);
+  const auto elapsed = [&] { return progress.elapsed(); };
   mem::reset_peak();
   SolveLog solve;
   // The bench times every other step whole, its stages untimed: on CUDA the stages' scopes wait
@@ -263,16 +263,12 @@ int run_replay(const ReplayArgs& a) {
       const Image img = renderer.render(sim.canvas(), camera, sim.live_window(), &overlay);
       write_png8(a.frames_dir + name, img.rgba.data(), img.width, img.height, 4);
     }
-    if (progress && (elapsed() - last_print > 0.25 || done == replay.step_count())) {
-      last_print = elapsed();
-      const double rate = done / std::max(1e-9, elapsed());
-      const double eta = (replay.step_count() - done) / std::max(1e-9, rate);
-      std::fprintf(stderr, "\rstep %lld/%lld  %.2f s simulated  %.2f steps/s  %lld particles  ETA %.0f s   ",
-                   static_cast<long long>(done), static_cast<long long>(replay.step_count()), replay.sim_time(), rate,
-                   static_cast<long long>(sim.particles().size()), eta);
-    }
+    char detail[128];
+    std::snprintf(detail, sizeof detail, "%.2f s simulated  %.2f steps/s  %lld particles", replay.sim_time(),
+                  double(done) / std::max(1e-9, elapsed()), static_cast<long long>(sim.particles().size()));
+    progress.step(done, replay.step_count(), "", detail, done == replay.step_count());
   }
-  if (progress) std::fprintf(stderr, "\n");
+  progress.finish();
   const double wall_ms = elapsed() * 1e3;
   if (a.bench) {
     report_bench(a, sim, stroke, device, replay.steps_done(), solve);
@@ -380,6 +376,7 @@ struct SoakArgs {
   double minutes = 60.0;
   std::string device = "auto";
   std::string json;
+  double progress_every = 10.0;
 };
 
 /// Resident memory of this process, bytes, and the part of it backed by files (the program's and
@@ -415,7 +412,6 @@ int run_soak(const SoakArgs& s) {
     int64_t nonfinite;
   };
   std::vector<Run> runs;
-  const bool tty = isatty(STDERR_FILENO);
   const auto t0 = std::chrono::steady_clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   for (int cycle = 0; cycle == 0 || elapsed() < s.minutes * 60.0; ++cycle) {
@@ -429,18 +425,17 @@ int run_soak(const SoakArgs& s) {
         Simulator sim(cfg, player.pose_at(player.t_begin()));
         Replay replay(sim, player);
         std::vector<double> ms;
-        double last_print = elapsed();
+        Progress progress(true, s.progress_every);
+        const std::string what = "cycle " + std::to_string(cycle) + "  " + s.strokes[i];
         for (;;) {
           const auto ts = std::chrono::steady_clock::now();
           if (!replay.advance()) break;
           ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - ts).count());
-          if (tty && elapsed() - last_print > 1.0) {
-            last_print = elapsed();
-            std::fprintf(stderr, "\rcycle %d  %s  step %lld/%lld  %.0f s elapsed   ", cycle, s.strokes[i].c_str(),
-                         static_cast<long long>(replay.steps_done()), static_cast<long long>(replay.step_count()),
-                         elapsed());
-          }
+          char detail[64];
+          std::snprintf(detail, sizeof detail, "%.0f s into the soak", elapsed());
+          progress.step(replay.steps_done(), replay.step_count(), what, detail);
         }
+        progress.finish();
         sim.settle();
         r.steps = int64_t(ms.size());
         if (!ms.empty()) {
@@ -461,7 +456,6 @@ int run_soak(const SoakArgs& s) {
       r.heap = double(mi.uordblks + mi.hblkhd);  // live C-library allocations, the process's own data
       r.held = double(mem::usage(!device.is_cpu()).in_use);
       runs.push_back(r);
-      if (tty) std::fprintf(stderr, "\r");
       std::printf("cycle %d  %-28s %5lld steps  %8.2f ms/step  drift %.1e  resident %7.1f MiB (files %6.1f MiB)  "
                   "heap %8.1f KiB  held %6.1f MiB  %.0f s\n",
                   cycle, s.strokes[i].c_str(), static_cast<long long>(r.steps), r.step_ms, r.drift, r.rss / 1048576.0,
@@ -538,6 +532,7 @@ void register_replay(CLI::App& app) {
   sub->add_option("--set", args->sets, "Set a parameter, id=value (see `wetbrush params`); repeatable");
   sub->add_option("--params", args->params_file, "Read parameters from a JSON file (`wetbrush params --json`)");
   sub->add_flag("-q,--quiet", args->quiet, "No progress or summary output");
+  add_progress_option(sub, args->progress_every);
   add_device_option(sub, args->device);
   set_action(sub, [args]() { return run_replay(*args); });
 
@@ -551,8 +546,9 @@ void register_replay(CLI::App& app) {
   b->add_option("--window", bench->window, "Active window size X,Y,Z in cells")->delimiter(',');
   b->add_option("--set", bench->sets, "Set a parameter, id=value (see `wetbrush params`); repeatable");
   b->add_option("--params", bench->params_file, "Read parameters from a JSON file");
+  b->add_flag("-q,--quiet", bench->quiet, "No progress output");
+  add_progress_option(b, bench->progress_every);
   add_device_option(b, bench->device);
-  bench->quiet = true;
   set_action(b, [bench]() { return run_replay(*bench); });
 
   auto soak = std::make_shared<SoakArgs>();
@@ -563,6 +559,7 @@ void register_replay(CLI::App& app) {
       ->check(CLI::ExistingFile);
   k->add_option("--minutes", soak->minutes, "How long to keep going (whole cycles; at least one)")->capture_default_str();
   k->add_option("--json", soak->json, "Also write every run's figures as JSON");
+  add_progress_option(k, soak->progress_every);
   add_device_option(k, soak->device);
   set_action(k, [soak]() { return run_soak(*soak); });
 }

@@ -16,6 +16,13 @@ void add_device_option(CLI::App* sub, std::string& device_text) {
       ->capture_default_str();
 }
 
+void add_progress_option(CLI::App* sub, double& seconds) {
+  sub->add_option("--progress-every", seconds,
+                  "Seconds between the progress lines written when standard error is not a terminal (a log)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 3600.0));
+}
+
 Device resolve_device(const std::string& device_text) {
   Device d = Device::parse(device_text);
   d.activate();

@@ -12,6 +12,8 @@ namespace wb::cli {
 
 /// Adds the common --device option to a subcommand.
 void add_device_option(CLI::App* sub, std::string& device_text);
+/// Adds --progress-every: seconds between the progress lines a long command writes to a log.
+void add_progress_option(CLI::App* sub, double& seconds);
 /// Parses the --device text ("auto" by default).
 Device resolve_device(const std::string& device_text);
 

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <sstream>
 #include <string>
 
 #include "core/io/document.h"
@@ -101,6 +102,30 @@ TEST(Cli, ErrorsNameTheSourceLocationOnlyWhenVerbose) {
   ::unsetenv("WB_VERBOSE");
   EXPECT_EQ(env.exit_code, 1) << env.output;
   EXPECT_TRUE(std::regex_search(env.output, location)) << "WB_VERBOSE=1: " << env.output;
+}
+
+TEST(Cli, ProgressLinesReachALog) {
+  // Standard error is a pipe here, as in a log: whole lines, steps done of the total with the
+  // simulated, elapsed and remaining time, every --progress-every seconds and at the end; -q none.
+  const std::string args = "replay --device cpu --grid-only --progress-every 0.1 " + data("strokes/good/tablet.txt");
+  const RunResult r = run_cli(args);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::regex line(R"(step ([0-9]+)/([0-9]+)  [0-9.]+ s simulated  .* [0-9]+ s elapsed, [0-9]+ s left)");
+  int lines = 0;
+  std::string last;
+  std::istringstream in(r.output);
+  for (std::string l; std::getline(in, l);) {
+    std::smatch m;
+    if (!std::regex_match(l, m, line)) continue;
+    ++lines;
+    last = m[1] == m[2] ? "the final count" : l;
+  }
+  EXPECT_GE(lines, 2) << r.output;
+  EXPECT_EQ(last, "the final count") << r.output;
+  EXPECT_EQ(r.output.find('\r'), std::string::npos) << "no terminal redraws in a log";
+  const RunResult quiet = run_cli(args + " -q");
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.output;
+  EXPECT_EQ(quiet.output.find(" s left"), std::string::npos) << quiet.output;
 }
 
 TEST(Cli, BadOptionsFailCleanly) {
