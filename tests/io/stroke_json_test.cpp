@@ -150,7 +150,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"not-an-object.json", {"top level: expected an object, found an array"}},
         BadCase{"ground-unknown-weave.json", {"canvas.ground.weave: unknown weave 'burlap'"}},
         BadCase{"ground-too-thick.json", {"canvas.ground", "thicker than half the canvas's paint depth", "refused"}},
-        BadCase{"ground-too-large.json", {"canvas.ground", "224.0 GiB of paint", "refused"}}),
+        BadCase{"ground-too-large.json", {"canvas.ground", "224.0 GiB of paint", "refused"}},
+        BadCase{"longer-than-a-week.txt", {"the samples span 700000.01 s, more than a week (604800 s)"}}),
     [](const ::testing::TestParamInfo<BadCase>& info) {
       std::string n = info.param.file;
       for (char& ch : n)
@@ -162,7 +163,7 @@ TEST(StrokeBad, EveryFixtureIsCovered) {
   // A new bad fixture must get an expectation above.
   size_t files = 0;
   for (const auto& e : std::filesystem::directory_iterator(fixture("bad"))) files += e.is_regular_file();
-  EXPECT_EQ(files, 25u);
+  EXPECT_EQ(files, 26u);
 }
 
 TEST(StrokeJson, MissingFileNamesIt) {

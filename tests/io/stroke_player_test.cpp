@@ -134,6 +134,59 @@ TEST(StrokePlayer, HoverNearContactIsPartlyLifted) {
   EXPECT_LE(max_n, 8);
 }
 
+TEST(StrokePlayer, APauseIsSpentInTheAirAndThePenLandsInTheLiftTime) {
+  // Lifted at 0.5 s, down again at 60.5 s with no sample between (a recording's pause): the pen
+  // rises in kLiftTime, stays fully lifted and comes down in kLiftTime, not over the minute.
+  Stroke s = make_stroke({pen(0.0, 300, 500, 0.4), pen(0.5, 350, 500, 0.4), pen(0.51, 351, 500, 0, false),
+                          pen(60.5, 600, 500, 0.4), pen(61.0, 650, 500, 0.4)});
+  StrokePlayer player(s);
+  EXPECT_FLOAT_EQ(player.elevation_at(0.51 + kLiftTime), -1.f);
+  EXPECT_FLOAT_EQ(player.elevation_at(30.0), -1.f);
+  EXPECT_FLOAT_EQ(player.elevation_at(60.5 - kLiftTime), -1.f);
+  EXPECT_GT(player.elevation_at(60.5 - 0.5 * kLiftTime), -1.f);
+  EXPECT_NEAR(player.pen_at(30.0).x, 351.f + (600.f - 351.f) * float((30.0 - 0.51) / (60.5 - 0.51)), 1e-3f)
+      << "the path between the samples is the straight one";
+  // The lead-in keeps its own descent (0.25 s from full lift).
+  EXPECT_GT(player.elevation_at(-0.2), -1.f);
+  EXPECT_LT(player.elevation_at(-0.2), -0.5f);
+
+  // The air ahead: none while the pen is down; from the first step in the air, up to the
+  // margin before the pen starts down at 60.5 - kLiftTime.
+  PlayerStep st;
+  int64_t in_air = -1;
+  while (player.next(st)) {
+    const int64_t ahead = player.air_steps_ahead(0.25);
+    if (st.pen_down) EXPECT_EQ(ahead, 0) << "step " << st.index;
+    if (!st.pen_down && st.t > 1.0) {
+      in_air = ahead;
+      const double until = st.t + double(ahead) * s.dt;
+      EXPECT_LE(until, 60.5 - kLiftTime - 0.25 + 1e-9);
+      EXPECT_GT(until, 60.5 - kLiftTime - 0.25 - s.dt - 1e-9);
+      player.skip(ahead);
+      PlayerStep next;
+      ASSERT_TRUE(player.next(next));
+      EXPECT_FALSE(next.pen_down) << "the margin is played in the air";
+      EXPECT_NEAR(next.t, until + s.dt, 1e-9);
+      break;
+    }
+  }
+  EXPECT_GT(in_air, 3000);
+  while (player.next(st)) EXPECT_EQ(player.air_steps_ahead(0.25), 0) << "lead-out: the last steps are played";
+}
+
+TEST(StrokePlayer, AnEventEndsTheAirAhead) {
+  Stroke s = make_stroke({pen(0.0, 300, 500, 0.4), pen(0.5, 350, 500, 0.4), pen(0.51, 351, 500, 0, false),
+                          pen(20.5, 600, 500, 0.4)});
+  StrokeEvent dip;
+  dip.t = 10.0;
+  dip.kind = StrokeEventKind::Dip;
+  s.events = {dip};
+  StrokePlayer player(s);
+  PlayerStep st;
+  while (player.next(st) && (st.pen_down || st.t < 1.0)) {}
+  EXPECT_LE(st.t + double(player.air_steps_ahead(0.25)) * s.dt, 10.0);
+}
+
 TEST(StrokePlayer, SubstepsBoundMovement) {
   // 300 cells in 0.1 s with a twist: 50 cells per 1/60 s step.
   Stroke s = make_stroke({pen(0.0, 300, 500, 0.3), pen(0.1, 600, 500, 0.6, true, 90, 20),

@@ -83,6 +83,11 @@ struct GridParams {
   /// Dryness at and above which a cell holding paint is solid for brush, projection and
   /// advection. Default 0.95, range (0, 1].
   float dry_threshold = 0.95f;
+  /// Paint whose every painted cell's faces carry less than this is at rest, cells/s: a replay
+  /// passes over a pen-up pause from there in one call, drying only (Simulator::rest). Default
+  /// 0.01 cells/s (2 µm/s: after a lift the flow falls below it within a second and settles
+  /// near 1e-4, the creep of unyielded paint; docs/FORMATS.md "Pauses"), range [0, 100].
+  float rest_speed = 0.01f;
 
   // --- advection and mass ---
   /// Measure ||div|| before and after each projection (GridStats::rhs_norm, residual_norm): two

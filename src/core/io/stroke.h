@@ -16,6 +16,10 @@
 
 namespace wb {
 
+/// The longest span of samples a stroke may have, seconds (a week): validate_stroke refuses a
+/// longer recording (its pauses replay fast-forwarded, its strokes do not).
+inline constexpr double kMaxStrokeSeconds = 7.0 * 24.0 * 3600.0;
+
 enum class StrokeEventKind {
   Dip,    ///< dip the brush into a palette well: load paint `ryb`/`oil` up to `load`
   Wipe,   ///< wipe the brush on a rag: remove `fraction` of the paint it carries

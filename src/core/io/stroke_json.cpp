@@ -163,6 +163,9 @@ void validate_stroke(const Stroke& st) {
       WB_THROW(sample(i) + "t = " + number_text(s.t) + " is not after samples[" + std::to_string(i - 1) +
                "].t = " + number_text(st.samples[i - 1].t) + " (samples must be strictly increasing in time)");
   }
+  const double span = st.samples.back().t - st.samples.front().t;
+  WB_REQUIRE(span <= kMaxStrokeSeconds, src + ": the samples span " + number_text(span) + " s, more than a week (" +
+                                            number_text(kMaxStrokeSeconds) + " s), the longest stroke a replay takes");
   for (size_t i = 0; i < st.events.size(); ++i) {
     const StrokeEvent& e = st.events[i];
     const std::string where = src + ": events[" + std::to_string(i) + "]: ";

@@ -65,6 +65,31 @@ StrokePlayer::StrokePlayer(Stroke stroke) : stroke_(std::move(stroke)) {
       keys_[first + i].e = -float(std::min(1.0, gap / kLiftTime));
     }
   }
+  // Across a gap longer than 2 kLiftTime in which the pen is not held down, the pen rises from
+  // its last sample (or comes down to its next) in kLiftTime and is fully lifted for the rest:
+  // a key at full lift kLiftTime from each end not already fully lifted, on the straight path
+  // between the two samples. Without them the brush would sink towards the canvas for the whole
+  // gap (an hour's pause: an hour's descent). The lead-in and lead-out keep their own descent
+  // and rise.
+  {
+    const size_t first = stroke_.lead_in > 0 ? 1 : 0, end = first + s.size();
+    std::vector<Key> keys;
+    keys.reserve(keys_.size() + 2 * s.size());
+    for (size_t i = 0; i < keys_.size(); ++i) {
+      keys.push_back(keys_[i]);
+      if (i < first || i + 1 >= end) continue;
+      const Key &a = keys_[i], &b = keys_[i + 1];
+      if (b.t - a.t <= 2.0 * kLiftTime || (a.e >= 0.f && b.e >= 0.f)) continue;
+      const auto lifted_at = [&](double t) {
+        const float f = float((t - a.t) / (b.t - a.t));
+        return Key{t, a.x + f * (b.x - a.x), a.y + f * (b.y - a.y), -1.f, a.tilt_x + f * (b.tilt_x - a.tilt_x),
+                   a.tilt_y + f * (b.tilt_y - a.tilt_y), a.twist + f * shortest_angle(a.twist, b.twist), 0.f};
+      };
+      if (a.e > -1.f) keys.push_back(lifted_at(a.t + kLiftTime));
+      if (b.e > -1.f) keys.push_back(lifted_at(b.t - kLiftTime));
+    }
+    keys_ = std::move(keys);
+  }
   for (size_t i = 0; i + 1 < keys_.size(); ++i) keys_[i].twist_delta = shortest_angle(keys_[i].twist, keys_[i + 1].twist);
   // The tiny tolerance keeps an exact multiple of dt from gaining a step to rounding.
   step_count_ = std::max<int64_t>(1, int64_t(std::ceil(duration() / stroke_.dt - 1e-9)));
@@ -177,6 +202,30 @@ int StrokePlayer::substeps_for(double ta, double tb, float* max_move) const {
     }
     n = std::min(cap, std::max(n + 1, int(std::ceil(double(n) * worst / limit))));
   }
+}
+
+int64_t StrokePlayer::air_steps_ahead(double margin) const {
+  if (prev_contact_ || next_index_ >= step_count_) return 0;
+  const double dt = stroke_.dt, t0 = t_begin() + double(next_index_) * dt;
+  if (!(elevation_at(t0) < 0.f)) return 0;
+  // The elevation is linear between keys: the air lasts until the key before the first one at
+  // or above the canvas, where the pen starts down.
+  double until = t_end();
+  const auto after = std::upper_bound(keys_.begin(), keys_.end(), t0, [](double t, const Key& k) { return t < k.t; });
+  for (auto it = after; it != keys_.end(); ++it)
+    if (it->e >= 0.f) {
+      until = it == after ? t0 : std::prev(it)->t;
+      break;
+    }
+  if (next_event_ < stroke_.events.size()) until = std::min(until, stroke_.events[next_event_].t - dt);
+  const double span = until - margin - t0;
+  if (!(span > 0.0)) return 0;
+  return std::min<int64_t>(int64_t(std::floor(span / dt)), step_count_ - 1 - next_index_);
+}
+
+void StrokePlayer::skip(int64_t n) {
+  WB_REQUIRE(n >= 0 && next_index_ + n < step_count_, "StrokePlayer::skip: the last step is always played");
+  next_index_ += n;
 }
 
 bool StrokePlayer::next(PlayerStep& out) {

@@ -32,7 +32,8 @@ struct PlayerStep {
 };
 
 /// Seconds of hover between full lift and contact: a pen-up sample closer than this (in
-/// time) to a pen-down sample is lifted only by that fraction of the full lift.
+/// time) to a pen-down sample is lifted only by that fraction of the full lift, and across a
+/// longer gap the pen comes down (and goes up) in this time, fully lifted before (after).
 inline constexpr double kLiftTime = 0.1;
 
 /// Replays a stroke. Timeline: from t_begin() = first sample t - lead_in (the brush held
@@ -55,6 +56,12 @@ class StrokePlayer {
 
   /// Fills `out` with the next step; false when all steps have been played.
   bool next(PlayerStep& out);
+  /// Steps from the next one on in which the brush stays in the air (elevation below 0 from
+  /// their start to their end) and no event fires, ending `margin` seconds before the pen starts
+  /// down to its next contact; 0 after a step with contact.
+  int64_t air_steps_ahead(double margin) const;
+  /// Passes over the next n steps without playing them (a pause fast-forwarded).
+  void skip(int64_t n);
   /// Back to the first step.
   void rewind();
 

@@ -86,6 +86,8 @@ std::vector<ParamInfo> build_table() {
       WB_PARAM(grid.dry_rate, "Drying rate", "1/s", "§4.2", 0, 1000, "Dryness added per second"),
       WB_PARAM(grid.dry_threshold, "Dry threshold", "", "§4.2", 0.01, 1,
                "Dryness at and above which paint is solid"),
+      WB_PARAM(grid.rest_speed, "Rest speed", "cells/s", "", 0, 100,
+               "Paint slower than this everywhere is at rest: a replay passes over a pen-up pause in one call, drying only"),
       WB_PARAM(grid.projection_norms, "Projection norms", "", "", 0, 1,
                "Measure the divergence before and after each projection (two reductions a step)"),
       WB_PARAM(grid.window_snap, "Window snap", "cells", "§4.2", 1, 64,

@@ -59,6 +59,18 @@ void drive_step(Simulator& sim, const StrokePlayer& player, const PlayerStep& st
 }
 
 bool Replay::advance() {
+  // A pause: the pen in the air for at least kMinRestSeconds more, no event, the paint at rest.
+  // It is passed over in one call (Simulator::rest: the particles back into the grid, drying
+  // for its length, the brush waiting where the pause ends), so that an hour's pause costs what
+  // a step does. It ends kRestMargin before the pen starts down, which the brush then plays.
+  constexpr double kMinRestSeconds = 2.0, kRestMargin = 0.25;
+  const double dt = player_.stroke().dt;
+  if (const int64_t n = player_.air_steps_ahead(kRestMargin); double(n) * dt >= kMinRestSeconds && sim_.paint_at_rest()) {
+    const double t = player_.t_begin() + double(player_.steps_done() + n) * dt;
+    sim_.rest(double(n) * dt, player_.pose_at(t));
+    player_.skip(n);
+    last_t_ = t;
+  }
   PlayerStep step;
   if (!player_.next(step)) return false;
   drive_step(sim_, player_, step, step.events, step.pen_down_edge && player_.stroke().paint.reload_on_pen_down, poses_);

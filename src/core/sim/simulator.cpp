@@ -87,6 +87,21 @@ void Simulator::reset_brush(const BrushPose& pose) {
   box_ = samples_box();  // the next step's window holds where the brush is now, not the path to it
 }
 
+bool Simulator::paint_at_rest() const {
+  const Grid& g = *grid_;
+  // advect_courant: the largest outflow of a painted cell's face over the step, cells.
+  return counters_.steps > 0 && g.stats().advect_courant <= g.params().rest_speed * last_dt_;
+}
+
+void Simulator::rest(double seconds, const BrushPose& pose) {
+  WB_REQUIRE(std::isfinite(seconds) && seconds >= 0.0, "Simulator::rest: seconds must be finite and >= 0");
+  settle();
+  grid_->dry(float(seconds));
+  reset_brush(pose);
+  ++counters_.rests;
+  counters_.rest_seconds += seconds;
+}
+
 PaintCensus Simulator::census() {
   return PaintBooks::census(*load_, particles_, grid_->window().total_mass(ws_), transfer_->params(), ws_);
 }
@@ -511,6 +526,7 @@ void Simulator::step(const BrushPose* pen_poses, int substeps, float dt) {
   clamp_particles_to_canvas();
   ++counters_.steps;
   counters_.substeps += substeps;
+  last_dt_ = dt;
   counters_.particles_max = std::max(counters_.particles_max, particles_.size());
 }
 

@@ -52,6 +52,9 @@ struct SimCounters {
   /// Particles returned to the grid because the window moved off them (deposit_leaving_particles):
   /// where the zone fits, only the slow ones beyond it that the step's own pass would return.
   int64_t returned_at_moves = 0;
+  /// Pauses passed over by rest(): how many, and their seconds.
+  int64_t rests = 0;
+  double rest_seconds = 0.0;
 };
 
 /// The brush as the artist sees it (the studio's brush preview and paint swatch), read from
@@ -91,6 +94,13 @@ class Simulator {
   void step(const BrushPose& pose, float dt) { step(&pose, 1, dt); }
   /// Puts the brush at rest at `pose` (a new stroke after a lift, or a teleport).
   void reset_brush(const BrushPose& pose);
+  /// True when the last step left the paint at rest: no face of a painted cell carried paint
+  /// faster than grid.rest_speed (the flow the step's advection started from).
+  bool paint_at_rest() const;
+  /// A pause of `seconds` in which nothing moves, in one call instead of its steps: the particles
+  /// go back into the grid (settle), every painted cell dries by the pause (Grid::dry) and the
+  /// brush waits at rest at `pose`, where the pause ends.
+  void rest(double seconds, const BrushPose& pose);
 
   // --- paint on the brush (books record what enters and leaves) ---
   void load_paint(const PaintLoad& paint);  ///< a freshly loaded brush
@@ -217,6 +227,7 @@ class Simulator {
   DeviceBuffer<float> wet_top_;       ///< wet-paint surface per window column (free particles land on it)
   DeviceBuffer<float> surface_;       ///< the ground per window column (paint_surface)
   int64_t raster_step_ = -2;          ///< step (counters_.steps) raster_density_ was last made in
+  float last_dt_ = 0.f;               ///< the last step's length, s
   Int3 raster_origin_{};              ///< and the window origin it was made at
   DeviceBuffer<float> extent_scratch_, extent_;  ///< the samples' box and the ground (samples_box)
   std::array<float, 4> box_{};                   ///< the samples' box at the end of the last step
