@@ -263,9 +263,9 @@ int run_replay(const ReplayArgs& a) {
       const Image img = renderer.render(sim.canvas(), camera, sim.live_window(), &overlay);
       write_png8(a.frames_dir + name, img.rgba.data(), img.width, img.height, 4);
     }
-    char detail[128];
-    std::snprintf(detail, sizeof detail, "%.2f s simulated  %.2f steps/s  %lld particles", replay.sim_time(),
-                  double(done) / std::max(1e-9, elapsed()), static_cast<long long>(sim.particles().size()));
+    char detail[96];
+    std::snprintf(detail, sizeof detail, "%.2f s simulated  %lld particles", replay.sim_time(),
+                  static_cast<long long>(sim.particles().size()));
     progress.step(done, replay.step_count(), "", detail, done == replay.step_count());
   }
   progress.finish();

@@ -15,15 +15,15 @@ class Progress {
   /// Seconds since the progress began.
   double elapsed() const;
   /// Reports `done` of `total` steps, `what` before them (a name, or empty) and `detail` after
-  /// (simulated time, rate); the wall time and the time left are added. Written only when due;
-  /// `last` always (the final count).
+  /// (the simulated time); the step rate, the wall time and the time left are added. Written
+  /// only when due; `last` always (the final count).
   void step(int64_t done, int64_t total, const std::string& what, const std::string& detail, bool last = false);
   /// Ends a terminal's redrawn line.
   void finish();
 
  private:
   bool enabled_, tty_;
-  double every_, last_ = -1.0;
+  double every_, last_;
   bool drawn_ = false;
   std::chrono::steady_clock::time_point t0_;
 };

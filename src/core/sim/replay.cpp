@@ -63,6 +63,8 @@ bool Replay::advance() {
   // It is passed over in one call (Simulator::rest: the particles back into the grid, drying
   // for its length, the brush waiting where the pause ends), so that an hour's pause costs what
   // a step does. It ends kRestMargin before the pen starts down, which the brush then plays.
+  // Shorter pauses are played: they save few steps, and passing over one settles the particles
+  // left near the lifted brush into the grid, which playing it would not.
   constexpr double kMinRestSeconds = 2.0, kRestMargin = 0.25;
   const double dt = player_.stroke().dt;
   if (const int64_t n = player_.air_steps_ahead(kRestMargin); double(n) * dt >= kMinRestSeconds && sim_.paint_at_rest()) {
