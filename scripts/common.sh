@@ -11,14 +11,17 @@ WB_BUILD="${WB_BUILD:-$WB_ROOT/build}"
 WB_PACKAGES=(cmake ninja-build g++ pkg-config libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libcli11-dev libpng-dev libzstd-dev libzip-dev zlib1g-dev
   qt6-base-dev libqt6opengl6-dev xvfb xauth libgl1-mesa-dri
-  # Hardening (docs/RELIABILITY.md): clang with libFuzzer and its OpenMP for the fuzz harnesses.
-  clang libclang-rt-dev libomp-dev
   # scripts/bundle-gpu.sh packs the studio for the GPU machine with the zstd program.
   zstd)
 
+# The libFuzzer runs only (scripts/hardening.sh fuzz): clang with libFuzzer and its OpenMP.
+WB_FUZZ_PACKAGES=(clang libclang-rt-dev libomp-dev)
+
+# Installs the packages named, WB_PACKAGES when none are.
 wb_install_deps() {
-  local missing=()
-  for p in "${WB_PACKAGES[@]}"; do
+  local missing=() wanted=("$@")
+  [ ${#wanted[@]} -eq 0 ] && wanted=("${WB_PACKAGES[@]}")
+  for p in "${wanted[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
   if [ ${#missing[@]} -gt 0 ]; then

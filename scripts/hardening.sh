@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
-# The hardening checks scripts/test.sh runs after the main suite (docs/RELIABILITY.md):
-#  1. the GoogleTest suite built with AddressSanitizer + UndefinedBehaviorSanitizer (CPU backend,
-#     no studio, no benchmarks) in build-asan/, run by CTest as a second configuration;
-#  2. a 10-second libFuzzer smoke run of every harness in tests/fuzz/ (build-fuzz/, clang), on a
-#     copy of its committed corpus; skipped with a message when clang or libFuzzer is missing.
-# WB_HARDENING=asan or =fuzz runs one of the two; WB_FUZZ_SECONDS sets the smoke run's length.
+# The hardening checks (docs/RELIABILITY.md):
+#  asan: the GoogleTest suite built with AddressSanitizer + UndefinedBehaviorSanitizer (CPU
+#        backend, no studio, no benchmarks) in build-asan/, run by CTest as a second
+#        configuration, with every fuzz harness replaying its committed corpus (FuzzCorpus.*);
+#  fuzz: a libFuzzer run of every harness in tests/fuzz/ (build-fuzz/, clang; WB_FUZZ_SECONDS
+#        each, 10 by default) on a copy of its corpus, the Debian packages for it installed first.
+# WB_HARDENING=asan (scripts/test.sh's), fuzz or all (the default here).
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 what="${WB_HARDENING:-all}"
@@ -35,6 +36,7 @@ if [ "$what" = all ] || [ "$what" = asan ]; then
 fi
 
 if [ "$what" = all ] || [ "$what" = fuzz ]; then
+  wb_install_deps "${WB_FUZZ_PACKAGES[@]}"
   probe=$(mktemp -d)
   echo 'extern "C" int LLVMFuzzerTestOneInput(const unsigned char*, unsigned long) { return 0; }' > "$probe/p.cpp"
   if ! command -v clang++ > /dev/null || ! clang++ -fsanitize=fuzzer "$probe/p.cpp" -o "$probe/p" 2> /dev/null; then
