@@ -328,7 +328,10 @@ int run_replay(const ReplayArgs& a) {
                   {"bristles", census.bristles},
                   {"particles", census.particles},
                   {"grid", census.grid}};
-    j["particles"] = {{"max", sim.counters().particles_max}, {"final", particles_final}};
+    j["particles"] = {{"max", sim.counters().particles_max},
+                      {"final", particles_final},
+                      {"limit", sim.particle_limit()},
+                      {"refused", sim.counters().particles_refused}};
     const TransferTotals& t = books.totals();
     j["transfer"] = {{"absorbed", t.absorbed},         {"emitted", t.emitted},
                      {"to_particles", t.to_particles}, {"to_grid", t.to_grid},

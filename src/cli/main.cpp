@@ -4,9 +4,11 @@
 
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include "cli/commands.h"
 #include "core/exec/error.h"
+#include "core/exec/memory.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"wetbrush: bristle-level 3D oil-paint simulator (headless tools)"};
@@ -18,6 +20,11 @@ int main(int argc, char** argv) {
   bool verbose = false;
   app.add_flag("--verbose", verbose, "Errors also name the source location that raised them (for a bug report)")
       ->envname("WB_VERBOSE");
+  std::string memory_limit;
+  app.add_option("--memory-limit", memory_limit,
+                 "Most memory a run may hold, host and GPU each (e.g. 4G, 512M); without it, what the machine has "
+                 "available. A run larger than this is refused before it allocates")
+      ->envname("WB_MEMORY_LIMIT");
   app.fallthrough();
   wb::cli::register_all(app);
   try {
@@ -26,6 +33,7 @@ int main(int argc, char** argv) {
     return app.exit(e);
   }
   try {
+    wb::mem::set_budget_from(memory_limit);
     return wb::cli::run_selected(app);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "wetbrush: error: %s\n", verbose ? e.what() : wb::user_message(e).c_str());

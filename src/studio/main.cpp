@@ -15,6 +15,7 @@
 
 #include "core/exec/device.h"
 #include "core/exec/error.h"
+#include "core/exec/memory.h"
 #include "core/io/atomic_file.h"
 #include "studio/demo.h"
 #include "studio/main_window.h"
@@ -69,8 +70,12 @@ int main(int argc, char** argv) {
                               "Paint scripted tablet strokes without end, announcing each on standard output when the "
                               "pen goes down and when it lifts (the autosave and recovery test kills the studio "
                               "mid-stroke).");
-  cli.addOptions(
-      {device_opt, preset_opt, view_opt, data_opt, norecover_opt, autosave_opt, demo_opt, stats_opt, short_opt, loop_opt});
+  QCommandLineOption memory_opt("memory-limit",
+                                "Most memory the paintings may hold, host and GPU each (e.g. 4G, 512M); without it, "
+                                "what the machine has available (also WB_MEMORY_LIMIT).",
+                                "size");
+  cli.addOptions({device_opt, preset_opt, view_opt, data_opt, norecover_opt, autosave_opt, demo_opt, stats_opt, short_opt,
+                  loop_opt, memory_opt});
   cli.addPositionalArgument("painting", "OpenRaster painting to open (.ora).", "[painting]");
   if (asks_for_help_or_version(argc, argv)) {
     // The help and the version need no display: a core application parses, prints and exits.
@@ -87,6 +92,8 @@ int main(int argc, char** argv) {
   try {
     opt.device = wb::Device::parse(cli.value(device_opt).toStdString());
     opt.preset = QualityPreset::from_name(cli.value(preset_opt).toStdString(), opt.device);
+    const QString limit = cli.isSet(memory_opt) ? cli.value(memory_opt) : qEnvironmentVariable("WB_MEMORY_LIMIT");
+    wb::mem::set_budget_from(limit.toStdString());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "wetbrush-studio: %s\n", wb::user_message(e).c_str());
     return 2;

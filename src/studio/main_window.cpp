@@ -111,7 +111,7 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   view_->set_cursor_radius(cfg.brush.width * 0.5f);
   setCentralWidget(view_);
   connect(sim_.get(), &SimThread::frameReady, view_, &CanvasView::frame_ready);
-  connect(sim_.get(), &SimThread::failed, this, [this](const QString& m) { statusBar()->showMessage("Error: " + m, 10000); });
+  connect(sim_.get(), &SimThread::failed, this, [this](const QString& m) { statusBar()->showMessage("Error: " + m, 30000); });
 
   undo_ = new QUndoStack(this);
   undo_->setUndoLimit(kUndoLimit);

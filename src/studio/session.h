@@ -45,6 +45,11 @@ class SessionTimeline {
   const PaintLoad& paint() const { return rec_.paint; }
   /// The pen is down as of the last step.
   bool pen_down() const { return prev_contact_; }
+  /// The pen is down as of the last sample appended (the painter's pen now).
+  bool pen_down_now() const {
+    std::lock_guard lk(mu_);
+    return !rec_.samples.empty() && rec_.samples.back().down;
+  }
   /// Any pen-down sample in this recording (something may have been painted).
   bool painted() const;
   /// Session time recorded but not simulated yet, s.

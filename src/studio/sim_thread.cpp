@@ -8,10 +8,18 @@
 
 #include "core/color/ryb.h"
 #include "core/exec/error.h"
+#include "core/io/undo_tiles.h"
 #include "core/sim/replay.h"
 
 namespace wb::studio {
 namespace {
+
+/// Where a new simulator's brush waits: above the middle of the canvas.
+BrushPose rest_pose(const SimConfig& config) {
+  BrushPose rest;
+  rest.position = Vec3(config.canvas.width * 0.5f, config.canvas.height * 0.5f, config.brush.length * 1.5f);
+  return rest;
+}
 
 /// Adds the time since `since` to `bucket`; returns now.
 double lap(double& bucket, double since) {
@@ -44,6 +52,21 @@ SimThread::~SimThread() {
 void SimThread::push(const ClockOutput& out) {
   if (out.samples.empty() && out.events.empty()) return;
   post([out](SimThread& self) {
+    if (self.dropping_) {
+      // After a stroke that failed, nothing until the pen comes down again after a lift: the rest
+      // of that stroke and the lifted pen's path are not simulated (a new recording starts with
+      // the next stroke).
+      ClockOutput rest = out;
+      auto next = rest.samples.begin();
+      for (; next != rest.samples.end(); ++next) {
+        if (!next->down) self.lifted_since_fault_ = true;
+        else if (self.lifted_since_fault_) break;
+      }
+      self.dropping_ = next == rest.samples.end();
+      rest.samples.erase(rest.samples.begin(), next);
+      self.session_.append(rest);
+      return;
+    }
     self.session_.append(out);
     if (out.input) self.pending_inputs_.push_back(*out.input);
   });
@@ -85,9 +108,7 @@ void SimThread::rebuild(const SimConfig& config, bool keep_canvas) {
   std::unique_ptr<Simulator> old = std::move(sim_);
   const bool same_dims = old && old->canvas().dims() == config.canvas;
   config_ = config;
-  BrushPose rest;
-  rest.position = Vec3(config.canvas.width * 0.5f, config.canvas.height * 0.5f, config.brush.length * 1.5f);
-  sim_ = std::make_unique<Simulator>(config_, rest);
+  sim_ = std::make_unique<Simulator>(config_, rest_pose(config_));
   carried_paint_ = false;  // a new brush is clean: its first stroke loads the well's paint
   // Nothing painted in this recording: a new one from the blank (primed) canvas is the same.
   const bool painted = session_.painted();
@@ -120,6 +141,10 @@ void SimThread::restart_recording(bool from_blank) {
   // The old time line is simulated to its end first, and its open stroke closed.
   if (!failed_) drain();
   finish_stroke();
+  begin_recording(from_blank);
+}
+
+void SimThread::begin_recording(bool from_blank) {
   Stroke header;
   header.canvas = config_.canvas;
   header.brush = config_.brush;
@@ -196,6 +221,58 @@ void SimThread::drain() {
 }
 
 void SimThread::run_step(const SessionStep& s) {
+  try {
+    step_once(s);
+  } catch (const std::exception& e) {
+    recover(e);
+  }
+}
+
+void SimThread::recover(const std::exception& e) {
+  std::fprintf(stderr, "wetbrush-studio: a step failed: %s\n", e.what());
+  // The failed step left the simulation half-made (window, particles, brush): all of it goes with
+  // the simulator, and the canvas returns to where the stroke began: the undo record's "before"
+  // of every tile the stroke may have touched (it never reached the others). The paint the brush
+  // held goes too; its next stroke loads the well's.
+  const std::vector<TileSnapshot> before = undo_.abandon();
+  std::unique_ptr<Simulator> old = std::move(sim_);
+  try {
+    sim_ = std::make_unique<Simulator>(config_, rest_pose(config_));
+    write_canvas([&](TileStore& canvas) {
+      canvas.copy_from(old->canvas());
+      for (const TileSnapshot& t : before) restore_tile(canvas, t);
+    });
+    old.reset();
+  } catch (const std::exception& again) {
+    // Nothing can be read back from the device (a fault that stays): the last autosave holds the
+    // painting, and the studio offers it when it starts again.
+    sim_.reset();
+    failed_ = true;
+    const std::string m = "the device failed (" + user_message(e) + ") and the painting cannot be read back from it (" +
+                          user_message(again) + "): quit and start the studio again to recover the last autosave";
+    {
+      std::lock_guard lk(status_mu_);
+      status_.error = m;
+    }
+    std::fprintf(stderr, "wetbrush-studio: %s\n", again.what());
+    Q_EMIT failed(QString::fromStdString(m));
+    return;
+  }
+  carried_paint_ = false;
+  dropping_ = true;
+  lifted_since_fault_ = !session_.pen_down_now();
+  pending_inputs_.clear();
+  begin_recording(false);
+  invalidate_all();
+  {
+    std::lock_guard lk(status_mu_);
+    ++status_.faults;
+  }
+  Q_EMIT failed(QString::fromStdString("the stroke could not be finished (" + user_message(e) +
+                                       "): the painting is as it was before it; save it now"));
+}
+
+void SimThread::step_once(const SessionStep& s) {
   Simulator& sim = *sim_;
   if (s.first) {
     sim.reset_brush(session_.player().pose_at(session_.player().t_begin()));
@@ -231,7 +308,12 @@ void SimThread::finish_stroke() {
 }
 
 void SimThread::render(bool force) {
-  if (sim_ && frames_.render(*sim_, force)) Q_EMIT frameReady();
+  if (!sim_) return;
+  try {
+    if (frames_.render(*sim_, force)) Q_EMIT frameReady();
+  } catch (const std::exception& e) {
+    recover(e);  // the device failed between steps: the same as in one
+  }
 }
 
 void SimThread::publish_status(bool force) {
@@ -327,7 +409,7 @@ void SimThread::run() {
         try {
           finish_stroke();
         } catch (const std::exception& e) {
-          fail(e);
+          recover(e);  // settling the stroke's paint failed: the stroke is not finished
         }
       }
       t = lap(times_.undo, t);

@@ -60,6 +60,7 @@ struct SimStatus {
   std::array<float, 3> brush_ryb{};  ///< mean colour of the paint on the brush (RYB), from the device
   float brush_amount = 0.f;          ///< how full the brush is: load / potential capacity
   std::string error;            ///< first error; stepping stops, the document is kept
+  int64_t faults = 0;           ///< failed steps recovered from (the stroke ended, the canvas as before it)
   WorkerTimes times;
 };
 
@@ -142,7 +143,15 @@ class SimThread : public QObject {
   /// Logs an exception with its source location and tells the window its message.
   void fail(const std::exception& e);
   bool step_available() { return !failed_ && sim_ && session_.has_step(); }
+  /// One step of the time line; a step that throws (a device fault, a failed allocation) is
+  /// recovered from (recover) rather than left half-made.
   void run_step(const SessionStep& step);
+  void step_once(const SessionStep& step);
+  /// The stroke a step failed in ends: the simulator is made anew on the canvas as it was before
+  /// the stroke, the painter is told, and painting and saving go on.
+  void recover(const std::exception& e);
+  /// A new time line for the recording, the old one not simulated further.
+  void begin_recording(bool from_blank);
   void finish_stroke();
   void render(bool force);
   void publish_status(bool force);
@@ -153,6 +162,9 @@ class SimThread : public QObject {
   PaintLoad paint_{};
   std::optional<CanvasGround> ground_;  ///< the canvas's priming (unset: bare)
   bool carried_paint_ = false;  ///< the brush holds paint carried in: the next recording loads none
+  /// After a failed stroke: samples are dropped until the pen comes down after a lift.
+  bool dropping_ = false;
+  bool lifted_since_fault_ = false;
 
   // Inputs (UI -> worker).
   mutable std::mutex in_mu_;

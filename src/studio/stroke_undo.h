@@ -19,6 +19,12 @@ class StrokeUndo {
   /// The stroke is over: its record (null when none is open or nothing changed). The tiles under
   /// the window, at rest now, start the next record, so that its undo returns to this canvas.
   std::shared_ptr<TileDiff> finish(Simulator& sim);
+  /// The stroke cannot be finished (a step failed): the tiles it may have touched as they were
+  /// before it, read from the record alone; no record is open.
+  std::vector<TileSnapshot> abandon() {
+    open_ = false;
+    return rec_.take_before();
+  }
   /// The canvas was written from outside: no record is open.
   void reset() {
     rec_.reset();

@@ -1,10 +1,12 @@
 // The CLI as a user meets it: every subcommand has --help, bad stroke files give a clear
 // message and a non-zero exit (never a crash), and a replay writes its image and stats.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <zip.h>
 
 #include <array>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -126,6 +128,31 @@ TEST(Cli, ProgressLinesReachALog) {
   const RunResult quiet = run_cli(args + " -q");
   ASSERT_EQ(quiet.exit_code, 0) << quiet.output;
   EXPECT_EQ(quiet.output.find(" s left"), std::string::npos) << quiet.output;
+}
+
+TEST(Cli, AWindowTooLargeForTheMemoryIsRefusedAtOnce) {
+  // A valid stroke file asking for the largest window it may (1024 x 1024 x 64: 67 M cells, about
+  // 19 GiB) against a 2 GiB budget: refused before it allocates, in under a second and 100 MB.
+  const auto dir = temp_dir("huge-window");
+  const std::string f = (dir / "huge-window.json").string();
+  std::ofstream(f) << R"({"format": "wetbrush-stroke", "version": 1, "canvas": {"width": 2048, "height": 2048},
+    "simulation": {"window": [1024, 1024, 64]},
+    "samples": [{"t": 0.0, "x": 100, "y": 128, "pressure": 0.0}, {"t": 0.5, "x": 200, "y": 128, "pressure": 0.6}]})";
+  const auto t0 = std::chrono::steady_clock::now();
+  const RunResult r = run_cli("replay --device cpu -q --memory-limit 2G " + f);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  rusage use{};
+  getrusage(RUSAGE_CHILDREN, &use);
+  EXPECT_FALSE(r.crashed) << r.output;
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("1024 x 1024 x 64 cells needs about"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--memory-limit 2.00 GiB"), std::string::npos) << r.output;
+  EXPECT_LT(seconds, 1.0) << r.output;
+  EXPECT_LT(use.ru_maxrss, 100 * 1024) << "KiB resident at most";
+  const RunResult bad = run_cli("replay --device cpu -q --memory-limit lots " + f);
+  EXPECT_EQ(bad.exit_code, 1) << bad.output;
+  EXPECT_NE(bad.output.find("memory size 'lots'"), std::string::npos) << bad.output;
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Cli, BadOptionsFailCleanly) {

@@ -16,6 +16,7 @@
 #include <QOpenGLContext>
 #include <QOpenGLWidget>
 #include <QProcess>
+#include <QSignalSpy>
 #include <QPushButton>
 #include <QTemporaryDir>
 #include <QTest>
@@ -38,6 +39,7 @@
 #include <tuple>
 
 #include "core/color/ryb.h"
+#include "core/exec/fault.h"
 #include "core/exec/memory.h"
 #include "core/io/brush_json.h"
 #include "core/io/document.h"
@@ -985,6 +987,41 @@ class StudioTest : public QObject {
     w_->undo_stack()->redo();
     w_->settle();
     QVERIFY2(volume_bytes(*w_, false) == after, "redo of both strokes gives the painting back");
+  }
+
+  void aFaultMidStrokeKeepsThePaintingAsBeforeTheStroke() {
+    // A device fault in the middle of a stroke (the fault hook: the n-th launch from now throws,
+    // as a kernel fault or a failed allocation would): the stroke ends, the painting is as it was
+    // before it, the painter is told, and painting and saving go on.
+    grid_only_canvas(false);
+    const int64_t l0 = on_sim(*w_, [](SimThread&) { return mem::launches(); });
+    stroke(35.f, 0.6f);
+    const int64_t per_stroke = on_sim(*w_, [](SimThread&) { return mem::launches(); }) - l0;
+    const std::vector<uint8_t> before = volume_bytes(*w_, false);
+    const int undo0 = w_->undo_stack()->count();
+    QSignalSpy told(w_->sim(), &SimThread::failed);
+    // Half-way through a stroke like the first (the launches the simulation thread makes).
+    mem::inject_fault_after(per_stroke / 2);
+    stroke(80.f, 0.7f);
+    mem::inject_fault_after(0);
+    qInfo("%lld launches a stroke; fault after %lld", (long long)per_stroke, (long long)(per_stroke / 2));
+    QCOMPARE(told.count(), 1);
+    const QString m = told.first().first().toString();
+    qInfo("the painter is told: %s", qPrintable(m));
+    QVERIFY2(m.contains("before it") && m.contains("save it now") && m.contains("injected fault"), qPrintable(m));
+    const SimStatus st = w_->sim()->status();
+    QCOMPARE(st.faults, int64_t(1));
+    QVERIFY2(st.error.empty(), "the simulation goes on");
+    QVERIFY2(volume_bytes(*w_, false) == before, "the painting is as it was before the stroke");
+    QCOMPARE(w_->undo_stack()->count(), undo0);
+    // The next stroke paints, with the well's paint, and the painting saves and opens.
+    stroke(110.f, 0.7f);
+    QVERIFY2(volume_bytes(*w_, false) != before, "the next stroke paints");
+    QCOMPARE(w_->undo_stack()->count(), undo0 + 1);
+    const QString path = dir_->path() + "/after-fault.ora";
+    QVERIFY(w_->save_to(path, true));
+    QVERIFY2(encode_volume(load_painting(path.toStdString(), Device::parse("cpu")).canvas) == volume_bytes(*w_),
+             "the saved file holds the canvas");
   }
 
   void saveThenOpenGivesSameVolume() {

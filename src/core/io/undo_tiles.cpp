@@ -124,4 +124,13 @@ TileDiff StrokeTileRecorder::finish(const TileStore& canvas) {
   return diff;
 }
 
+std::vector<TileSnapshot> StrokeTileRecorder::take_before() {
+  std::vector<TileSnapshot> out;
+  out.reserve(before_.size());
+  for (auto& [id, snap] : before_) out.push_back(std::move(snap));
+  std::sort(out.begin(), out.end(), [](const TileSnapshot& a, const TileSnapshot& b) { return a.tile_id < b.tile_id; });
+  before_.clear();
+  return out;
+}
+
 }  // namespace wb

@@ -46,6 +46,9 @@ class StrokeTileRecorder {
   size_t captured() const { return before_.size(); }
   /// The diff of the captured tiles against the canvas now; resets the recorder.
   TileDiff finish(const TileStore& canvas);
+  /// The captured tiles as they were, in tile order, without reading the canvas (a stroke that
+  /// cannot be finished goes back to them); resets the recorder.
+  std::vector<TileSnapshot> take_before();
   void reset() { before_.clear(); }
 
  private:

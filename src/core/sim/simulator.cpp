@@ -6,7 +6,9 @@
 #include <cmath>
 
 #include "core/exec/algorithms.h"
+#include "core/exec/memory.h"
 #include "core/io/undo_tiles.h"
+#include "core/sim/memory_plan.h"
 #include "core/particles/particles.h"
 #include "core/sim/joint_fields.h"
 
@@ -39,10 +41,13 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
     : config_(config), profiler_(config.device), ws_(config.device) {
   const Device& d = config_.device;
   d.activate();
+  // A run too large for the machine or the budget is refused here, before its first large
+  // allocation; the particle store may grow into what the rest leaves.
+  const int64_t particle_limit = check_memory(plan_memory(config_), config_, config_.params.particles.max_particles);
   canvas_ = std::make_unique<TileStore>(d, config_.canvas);
   brush_ = std::make_unique<Brush>(d, config_.brush, initial_pose, config_.params.brush_solver);
   grid_ = std::make_unique<Grid>(*canvas_, config_.params.grid, config_.window, Int3{});
-  particles_ = ParticleStore(d, config_.params.particles.max_particles);
+  particles_ = ParticleStore(d, particle_limit);
   sample_grid_ = SampleGrid(d);
   // This brush's bristles hold in proportion to their volume (Eq. 12's M_max).
   const TransferParams tp = config_.params.transfer.for_bristle_radius(config_.brush.bristle_radius);
@@ -290,6 +295,17 @@ void Simulator::lay_ground(const CanvasGround& ground, Vec3 primer_ryb) {
   const CanvasDims& d = config_.canvas;
   const std::string why = ground_refusal(ground, d.width, d.height, d.depth, config_.params.grid.cell_size);
   WB_REQUIRE(why.empty(), why);
+  // Every tile of the canvas is allocated: refused at once where the room is short, and the
+  // particle store's share shrinks by what the ground takes.
+  const int64_t need = ground_bytes(d);
+  const size_t room = mem::room(device());
+  if (size_t(need) > room)
+    WB_THROW("a canvas ground allocates the whole " + std::to_string(d.width) + " x " + std::to_string(d.height) +
+             " x " + std::to_string(d.depth) + " canvas: " + mem::format_bytes(double(need)) + ", and " +
+             mem::format_bytes(double(room)) + " is left (the machine's available memory or --memory-limit): " +
+             "paint on a smaller canvas or without a ground");
+  const int64_t per = plan_memory(config_).per_particle;
+  particles_.set_limit(std::max({int64_t(1), particles_.size(), particles_.limit() - need / per}));
   const WeaveField w = weave_field(ground, config_.params.grid.cell_size, primer_ryb);
   replace_canvas([&](TileStore& canvas) { canvas.lay_weave(w); });
 }
@@ -514,6 +530,7 @@ void Simulator::step(const BrushPose* pen_poses, int substeps, float dt) {
     env.dt = dt;  // wicking along the bristles over this step
     // The device's sums include the particles deposited before the window moved.
     rec = transfer_->step(brush_->samples(), *load_, particles_, env);
+    counters_.particles_refused += rec.emission_dropped + rec.to_particles_dropped;
   }
 
   {

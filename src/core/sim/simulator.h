@@ -55,6 +55,9 @@ struct SimCounters {
   /// Pauses passed over by rest(): how many, and their seconds.
   int64_t rests = 0;
   double rest_seconds = 0.0;
+  /// Particles not made because the store was at its limit (the parameter's, or what the memory
+  /// budget leaves: check_memory): their paint stayed on the bristles or in the grid.
+  int64_t particles_refused = 0;
 };
 
 /// The brush as the artist sees it (the studio's brush preview and paint swatch), read from
@@ -86,6 +89,9 @@ class Simulator {
   Profiler& profiler() { return profiler_; }
   const Profiler& profiler() const { return profiler_; }
   const SimCounters& counters() const { return counters_; }
+  /// The most particles the store may hold: the parameter's limit, or less where the memory
+  /// budget leaves less room (check_memory).
+  int64_t particle_limit() const { return particles_.limit(); }
 
   /// One time step of length dt (Figure 4): the brush runs `substeps` sub-steps ending at
   /// poses[0..substeps), then the paint (window, particles, joint fields, grid, FLIP/PIC,
