@@ -12,6 +12,8 @@
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QFormLayout>
+#include <QInputDialog>
+#include <QLineEdit>
 #include <QMenuBar>
 #include <QMessageBox>
 #include <QPushButton>
@@ -32,6 +34,7 @@
 #include "core/io/brush_json.h"
 #include "core/io/document.h"
 #include "core/exec/error.h"
+#include "core/exec/memory.h"
 #include "core/io/material_maps.h"
 #include "core/io/png.h"
 
@@ -92,6 +95,15 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   if (options_.data_dir.isEmpty())
     options_.data_dir = QStandardPaths::writableLocation(QStandardPaths::AppDataLocation);
   QDir().mkpath(options_.data_dir);
+  // The memory budget: --memory-limit or WB_MEMORY_LIMIT (main.cpp), else the saved setting.
+  if (wb::mem::budget(false) == 0) {
+    const QString saved = QSettings(options_.data_dir + "/studio.ini", QSettings::IniFormat).value("memory_limit").toString();
+    try {
+      wb::mem::set_budget_from(saved.toStdString());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "wetbrush-studio: the saved memory limit is ignored: %s\n", wb::user_message(e).c_str());
+    }
+  }
 
   const QualityPreset& q = options_.preset;
   SimConfig cfg;
@@ -411,6 +423,8 @@ void MainWindow::build_menus() {
   r->setShortcut(QKeySequence::Redo);
   edit->addAction(u);
   edit->addAction(r);
+  edit->addSeparator();
+  edit->addAction("&Memory limit\u2026", this, &MainWindow::ask_memory_limit);
 
   QMenu* canvas = menuBar()->addMenu("&Canvas");
   canvas->addAction("&Dry canvas", QKeySequence(Qt::CTRL | Qt::Key_D), this, [this] { dry_canvas(); });
@@ -869,6 +883,32 @@ void MainWindow::add_recent(const QString& path) {
   while (list.size() > 8) list.removeLast();
   s.setValue("recent", list);
   rebuild_recent_menu();
+}
+
+void MainWindow::ask_memory_limit() {
+  const size_t now = wb::mem::budget(false);
+  bool ok = false;
+  const QString text = QInputDialog::getText(
+      this, "Memory limit",
+      "Most memory the paintings may hold, host and GPU each (e.g. 4G, 512M; empty: what the machine has).\n"
+      "A canvas or preset larger than this is refused with the memory it needs.",
+      QLineEdit::Normal, now ? QString::fromStdString(wb::mem::format_bytes(double(now))).remove(' ').remove("i") : "",
+      &ok);
+  if (!ok) return;
+  const QString t = text.trimmed();
+  try {
+    if (t.isEmpty()) {
+      wb::mem::set_budget(false, 0);
+      wb::mem::set_budget(true, 0);
+    } else {
+      wb::mem::set_budget_from(t.toStdString());
+    }
+  } catch (const std::exception& e) {
+    QMessageBox::warning(this, "Memory limit", QString::fromStdString(wb::user_message(e)));
+    return;
+  }
+  QSettings(options_.data_dir + "/studio.ini", QSettings::IniFormat).setValue("memory_limit", t);
+  statusBar()->showMessage(t.isEmpty() ? "Memory limit: what the machine has" : "Memory limit: " + t, 5000);
 }
 
 void MainWindow::rebuild_recent_menu() {

@@ -99,6 +99,8 @@ class MainWindow : public QMainWindow {
   void update_title();
   void add_recent(const QString& path);
   void rebuild_recent_menu();
+  /// Edit > Memory limit: the budget (mem::set_budget), kept in the settings for the next start.
+  void ask_memory_limit();
   bool maybe_save();
   /// Returns when every save in flight has succeeded or failed (and said so).
   void wait_for_saves();

@@ -105,10 +105,13 @@ void SimThread::rebuild(const SimConfig& config, bool keep_canvas) {
   // Finish the old time line on the old simulator first.
   if (sim_ && !failed_) drain();
   finish_stroke();
+  // The new simulator first: one the memory cannot hold is refused while the old one, and its
+  // painting, stay.
+  std::unique_ptr<Simulator> next = std::make_unique<Simulator>(config, rest_pose(config));
   std::unique_ptr<Simulator> old = std::move(sim_);
   const bool same_dims = old && old->canvas().dims() == config.canvas;
   config_ = config;
-  sim_ = std::make_unique<Simulator>(config_, rest_pose(config_));
+  sim_ = std::move(next);
   carried_paint_ = false;  // a new brush is clean: its first stroke loads the well's paint
   // Nothing painted in this recording: a new one from the blank (primed) canvas is the same.
   const bool painted = session_.painted();

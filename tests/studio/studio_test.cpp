@@ -1024,6 +1024,32 @@ class StudioTest : public QObject {
              "the saved file holds the canvas");
   }
 
+  void aSimulatorTooLargeForTheMemoryLimitKeepsThePainting() {
+    // A brush or canvas change that the memory limit cannot hold is refused with the bytes it
+    // needs, and the painting and its simulation stay as they were.
+    grid_only_canvas(false);
+    stroke(40.f, 0.6f);
+    const std::vector<uint8_t> before = volume_bytes(*w_, false);
+    const size_t held = mem::usage(false).in_use;
+    mem::set_budget(false, held + (size_t(8) << 20));
+    const std::string refused = on_sim(*w_, [](SimThread& s) {
+      SimConfig c = s.config();
+      c.window = Int3{512, 512, 64};
+      try {
+        s.rebuild(c, true);
+      } catch (const Error& e) {
+        return std::string(e.what());
+      }
+      return std::string();
+    });
+    mem::set_budget(false, 0);
+    qInfo("refused: %s", refused.c_str());
+    QVERIFY2(refused.find("512 x 512 x 64 cells needs about") != std::string::npos, refused.c_str());
+    QVERIFY2(volume_bytes(*w_, false) == before, "the painting stays");
+    stroke(90.f, 0.7f);
+    QVERIFY2(volume_bytes(*w_, false) != before, "and the simulation paints on");
+  }
+
   void saveThenOpenGivesSameVolume() {
     grid_only_canvas(false);
     stroke(50.f, 0.6f);
