@@ -136,14 +136,16 @@ TEST(StrokePlayer, HoverNearContactIsPartlyLifted) {
 
 TEST(StrokePlayer, APauseIsSpentInTheAirAndThePenLandsInTheLiftTime) {
   // Lifted at 0.5 s, down again at 60.5 s with no sample between (a recording's pause): the pen
-  // rises in kLiftTime, stays fully lifted and comes down in kLiftTime, not over the minute.
+  // rises in kLiftTime, stays fully lifted and comes down in the last half kLiftTime (above the
+  // contact by then), not over the minute.
   Stroke s = make_stroke({pen(0.0, 300, 500, 0.4), pen(0.5, 350, 500, 0.4), pen(0.51, 351, 500, 0, false),
                           pen(60.5, 600, 500, 0.4), pen(61.0, 650, 500, 0.4)});
   StrokePlayer player(s);
   EXPECT_FLOAT_EQ(player.elevation_at(0.51 + kLiftTime), -1.f);
   EXPECT_FLOAT_EQ(player.elevation_at(30.0), -1.f);
   EXPECT_FLOAT_EQ(player.elevation_at(60.5 - kLiftTime), -1.f);
-  EXPECT_GT(player.elevation_at(60.5 - 0.5 * kLiftTime), -1.f);
+  EXPECT_FLOAT_EQ(player.elevation_at(60.5 - 0.5 * kLiftTime), -1.f);
+  EXPECT_GT(player.elevation_at(60.5 - 0.25 * kLiftTime), -1.f);
   EXPECT_NEAR(player.pen_at(30.0).x, 351.f + (600.f - 351.f) * float((30.0 - 0.51) / (60.5 - 0.51)), 1e-3f)
       << "the path between the samples is the straight one";
   // The lead-in keeps its own descent (0.25 s from full lift).
@@ -151,7 +153,7 @@ TEST(StrokePlayer, APauseIsSpentInTheAirAndThePenLandsInTheLiftTime) {
   EXPECT_LT(player.elevation_at(-0.2), -0.5f);
 
   // The air ahead: none while the pen is down; from the first step in the air, up to the
-  // margin before the pen starts down at 60.5 - kLiftTime.
+  // margin before the pen starts down at 60.5 - kLiftTime / 2.
   PlayerStep st;
   int64_t in_air = -1;
   while (player.next(st)) {
@@ -160,8 +162,8 @@ TEST(StrokePlayer, APauseIsSpentInTheAirAndThePenLandsInTheLiftTime) {
     if (!st.pen_down && st.t > 1.0) {
       in_air = ahead;
       const double until = st.t + double(ahead) * s.dt;
-      EXPECT_LE(until, 60.5 - kLiftTime - 0.25 + 1e-9);
-      EXPECT_GT(until, 60.5 - kLiftTime - 0.25 - s.dt - 1e-9);
+      EXPECT_LE(until, 60.5 - 0.5 * kLiftTime - 0.25 + 1e-9);
+      EXPECT_GT(until, 60.5 - 0.5 * kLiftTime - 0.25 - s.dt - 1e-9);
       player.skip(ahead);
       PlayerStep next;
       ASSERT_TRUE(player.next(next));
@@ -172,6 +174,27 @@ TEST(StrokePlayer, APauseIsSpentInTheAirAndThePenLandsInTheLiftTime) {
   }
   EXPECT_GT(in_air, 3000);
   while (player.next(st)) EXPECT_EQ(player.air_steps_ahead(0.25), 0) << "lead-out: the last steps are played";
+}
+
+TEST(StrokePlayer, APenLandingFromAfarArrivesThenComesDown) {
+  // The last hover sample 200 cells and 0.1 s from the contact (a tablet's fast approach): the
+  // brush keeps the hover's height until it is above the contact, then comes down onto it.
+  Stroke s = make_stroke({pen(0.0, 100, 128, 0, false), pen(0.1, 300, 128, 0.5), pen(0.4, 400, 128, 0.5)});
+  StrokePlayer player(s);
+  const float hover = player.elevation_at(0.0);
+  EXPECT_FLOAT_EQ(hover, -1.f);
+  for (double t = 0.0; t < 0.1; t += 0.002) {
+    const float x = player.pen_at(t).x, e = player.elevation_at(t);
+    if (x < 299.9f) EXPECT_FLOAT_EQ(e, hover) << "t " << t << ": the brush comes down before it arrives (x " << x << ")";
+  }
+  EXPECT_NEAR(player.pen_at(0.05).x, 300.f, 1e-3f) << "above the contact half-way";
+  EXPECT_NEAR(player.elevation_at(0.075), -0.25f, 1e-5f) << "coming down: from the hover to the press";
+  EXPECT_FLOAT_EQ(player.elevation_at(0.1), 0.5f);
+  // A hover just above the contact (5 ms events) comes down as before, within its 5 ms.
+  Stroke near = make_stroke({pen(0.0, 100, 128, 0, false), pen(0.005, 101, 128, 0.2)});
+  StrokePlayer p2(near);
+  EXPECT_FLOAT_EQ(p2.elevation_at(0.0), -0.05f);
+  EXPECT_GE(p2.elevation_at(0.005), 0.f);
 }
 
 TEST(StrokePlayer, AnEventEndsTheAirAhead) {
@@ -252,10 +275,11 @@ TEST(StrokePlayer, PenDownEdgesFire) {
   ASSERT_EQ(down_edges.size(), 2u);
   ASSERT_EQ(up_edges.size(), 2u);
   // Elevation runs linearly from -1 (lifted) to the pressure 0.4: contact begins where it
-  // crosses 0, 1/1.4 of the way down; it ends 0.4/1.4 of the way up.
+  // crosses 0, 1/1.4 of the way down (over the lead-in; over the second half of the gap before a
+  // contact, the pen being above it by then); it ends 0.4/1.4 of the way up.
   const auto contains = [](const PlayerStep& step, double t) { return step.t_begin < t && t <= step.t; };
   EXPECT_TRUE(contains(down_edges[0], -s.lead_in + s.lead_in / 1.4)) << down_edges[0].t;
-  EXPECT_TRUE(contains(down_edges[1], 0.8 + 0.1 / 1.4)) << down_edges[1].t;
+  EXPECT_TRUE(contains(down_edges[1], 0.85 + 0.05 / 1.4)) << down_edges[1].t;
   // The up edge is the first step that begins after the last contact.
   const double last_contact = 0.3 + 0.1 * 0.4 / 1.4;
   EXPECT_GT(up_edges[0].t_begin, last_contact);
