@@ -14,7 +14,10 @@ WB_PACKAGES=(cmake ninja-build g++ pkg-config libgtest-dev libgmock-dev libbench
   # Hardening (docs/RELIABILITY.md): clang with libFuzzer and its OpenMP for the fuzz harnesses.
   clang libclang-rt-dev libomp-dev
   # scripts/bundle-gpu.sh packs the studio for the GPU machine with the zstd program.
-  zstd)
+  zstd
+  # What a painting becomes (docs/FORMATS.md): the float height map (OpenEXR), the glTF relief
+  # (tinygltf) and the time-lapse video (FFmpeg's libraries; H.264 through Debian's libx264).
+  libopenexr-dev libtinygltf-dev libavcodec-dev libavformat-dev libswscale-dev libavutil-dev)
 
 wb_install_deps() {
   local missing=()
