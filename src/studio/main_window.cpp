@@ -33,6 +33,7 @@
 #include "core/io/document.h"
 #include "core/exec/error.h"
 #include "core/io/material_maps.h"
+#include "core/io/relief_export.h"
 #include "core/io/png.h"
 
 namespace wb::studio {
@@ -396,6 +397,18 @@ void MainWindow::build_menus() {
     QString base = p;
     if (base.endsWith(".png")) base.chop(4);
     export_maps(base + "-height.png", base + "-normal.png");
+  });
+  file->addAction("Export height (&OpenEXR)...", this, [this] {
+    const QString p = QFileDialog::getSaveFileName(this, "Export height in mm", "painting.exr", "OpenEXR (*.exr)");
+    if (!p.isEmpty()) export_relief(p, "", "");
+  });
+  file->addAction("Export relief for printing (&STL)...", this, [this] {
+    const QString p = QFileDialog::getSaveFileName(this, "Export STL solid", "painting.stl", "STL (*.stl)");
+    if (!p.isEmpty()) export_relief("", p, "");
+  });
+  file->addAction("Export relief for 3D (&glTF)...", this, [this] {
+    const QString p = QFileDialog::getSaveFileName(this, "Export glTF binary", "painting.glb", "glTF binary (*.glb)");
+    if (!p.isEmpty()) export_relief("", "", p);
   });
   file->addAction("Save &recording...", this, [this] {
     const QString p = QFileDialog::getSaveFileName(this, "Save recording", "session.json", "Stroke file (*.json)");
@@ -789,6 +802,23 @@ bool MainWindow::export_maps(const QString& height_path, const QString& normal_p
     try {
       TileStore canvas = s.sim().settled_canvas_copy(s.sim().device());
       write_material_maps(s.sim().device(), canvas, MaterialMapPaths{hp, np, ""});
+      done->set_value("");
+    } catch (const std::exception& e) {
+      done->set_value(user_message(e));
+    }
+  });
+  const std::string err = done->get_future().get();
+  if (!err.empty()) QMessageBox::warning(this, "Export failed", QString::fromStdString(err));
+  return err.empty();
+}
+
+bool MainWindow::export_relief(const QString& exr_path, const QString& stl_path, const QString& glb_path) {
+  auto done = std::make_shared<std::promise<std::string>>();
+  const ReliefPaths paths{exr_path.toStdString(), stl_path.toStdString(), glb_path.toStdString()};
+  sim_->post([done, paths](SimThread& s) {
+    try {
+      TileStore canvas = s.sim().settled_canvas_copy(s.sim().device());
+      write_relief_exports(s.sim().device(), canvas, paths);
       done->set_value("");
     } catch (const std::exception& e) {
       done->set_value(user_message(e));

@@ -57,6 +57,8 @@ class MainWindow : public QMainWindow {
   bool open_from(const QString& path);
   bool export_png(const QString& path);
   bool export_maps(const QString& height_path, const QString& normal_path);
+  /// Relief exports (core/io/relief_export.h, the CLI's defaults): the paths not empty are written.
+  bool export_relief(const QString& exr_path, const QString& stl_path, const QString& glb_path);
   bool save_recording(const QString& path);
   /// A new canvas, primed with `ground` (a smooth ground lays nothing).
   void new_canvas(int width, int height, QColor paper, const CanvasGround& ground = {});
