@@ -22,7 +22,7 @@
 #include "core/io/document.h"
 #include "core/io/png.h"
 #include "core/io/stroke.h"
-#include "core/io/video_writer.h"
+#include "core/io/timelapse.h"
 #include "core/params/param_table.h"
 #include "core/render/renderer.h"
 #include "core/sim/replay.h"
@@ -245,24 +245,15 @@ int run_replay(const ReplayArgs& a) {
   const CanvasRect& r = replay.region();
   const Camera camera = Camera::top_region(float(r.x0), float(r.y0), float(r.width), float(r.height), 1.f);
 
-  // The time-lapse: a frame every speed / fps simulated seconds from the first step, then the
-  // settled painting as the last frame.
-  std::unique_ptr<VideoWriter> video;
-  Camera video_camera = camera;
-  int64_t next_frame = 1;  ///< frame k shows simulated time k * speed / fps
+  // The time-lapse (core/io/timelapse.h): frame 0 now, the frames due after each step, the
+  // settled painting last.
+  std::unique_ptr<TimelapseRecorder> video;
   if (!a.video.empty()) {
-    WB_REQUIRE(a.fps >= 1 && a.fps <= 240, "--fps must be in 1..240");
-    WB_REQUIRE(std::isfinite(a.speed) && a.speed > 0.0 && a.speed <= 1e6, "--speed must be > 0");
-    if (a.video_camera == "oblique") {
-      // The oblique view of the stroke's region: the whole-canvas camera of a canvas its size, moved there.
-      video_camera = Camera::oblique(CanvasDims{r.width, r.height, stroke.canvas.depth});
-      video_camera.center_x += float(r.x0);
-      video_camera.center_y += float(r.y0);
-    }
-    video = std::make_unique<VideoWriter>(a.video, video_camera.width, video_camera.height, a.fps);
-    if (!video->fallback_note().empty()) std::fprintf(stderr, "wetbrush: warning: %s\n", video->fallback_note().c_str());
-    const Image first = renderer.render(sim.canvas(), video_camera);
-    video->add_frame(first);
+    video = std::make_unique<TimelapseRecorder>(a.video, r, stroke.canvas.depth,
+                                                TimelapseOptions{a.fps, a.speed, a.video_camera == "oblique"});
+    if (!video->video().fallback_note().empty())
+      std::fprintf(stderr, "wetbrush: warning: %s\n", video->video().fallback_note().c_str());
+    video->begin(renderer, sim.canvas());
   }
 
   Progress progress(!a.quiet, a.progress_every);
@@ -288,16 +279,11 @@ int run_replay(const ReplayArgs& a) {
       const Image img = renderer.render(sim.canvas(), camera, sim.live_window(), &overlay);
       write_png8(a.frames_dir + name, img.rgba.data(), img.width, img.height, 4);
     }
-    if (video)
-      // Multiples, not a running sum, so the count is the same as 2 + floor(T * fps / speed).
-      for (; replay.sim_time() >= double(next_frame) * a.speed / a.fps - 1e-9; ++next_frame) {
-        const ParticleOverlay overlay = sim.particle_overlay();
-        video->add_frame(renderer.render(sim.canvas(), video_camera, sim.live_window(), &overlay));
-      }
+    if (video) video->after_step(renderer, sim, replay.sim_time());
     char detail[128];
     if (video)
       std::snprintf(detail, sizeof detail, "%.2f s simulated  %lld particles  %lld video frames", replay.sim_time(),
-                    static_cast<long long>(sim.particles().size()), static_cast<long long>(video->frames()));
+                    static_cast<long long>(sim.particles().size()), static_cast<long long>(video->video().frames()));
     else
       std::snprintf(detail, sizeof detail, "%.2f s simulated  %lld particles", replay.sim_time(),
                     static_cast<long long>(sim.particles().size()));
@@ -322,14 +308,14 @@ int run_replay(const ReplayArgs& a) {
   }
   if (!a.image.empty()) write_png8(a.image, painting.rgba.data(), painting.width, painting.height, 4);
   if (video) {
-    video->add_frame(video_camera.kind == CameraKind::Top && !painting.rgba.empty()
-                        ? painting
-                        : renderer.render(sim.canvas(), video_camera));
-    video->finish();
+    // The top view's last frame is the image -o writes, when it was rendered.
+    const bool same = video->camera().kind == CameraKind::Top && !painting.rgba.empty();
+    video->finish(renderer, sim.canvas(), same ? &painting : nullptr);
+    const VideoWriter& v = video->video();
     if (!a.quiet)
       std::printf("wrote %s: %lld frames at %d fps (%.2f s), %dx%d, %s\n", a.video.c_str(),
-                  static_cast<long long>(video->frames()), a.fps, double(video->frames()) / a.fps,
-                  video->encoded_width(), video->encoded_height(), video->encoder().c_str());
+                  static_cast<long long>(v.frames()), a.fps, double(v.frames()) / a.fps, v.encoded_width(),
+                  v.encoded_height(), v.encoder().c_str());
   }
   if (!a.brush_image.empty()) {
     const auto img = replay.brush_image();

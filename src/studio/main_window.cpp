@@ -10,6 +10,7 @@
 #include <QDockWidget>
 #include <QFile>
 #include <QFileDialog>
+#include <QProgressDialog>
 #include <QFileInfo>
 #include <QFormLayout>
 #include <QMenuBar>
@@ -28,6 +29,7 @@
 #include <cstdio>
 #include <cmath>
 #include <future>
+#include <atomic>
 
 #include "core/io/brush_json.h"
 #include "core/io/document.h"
@@ -409,6 +411,10 @@ void MainWindow::build_menus() {
   file->addAction("Export relief for 3D (&glTF)...", this, [this] {
     const QString p = QFileDialog::getSaveFileName(this, "Export glTF binary", "painting.glb", "glTF binary (*.glb)");
     if (!p.isEmpty()) export_relief("", "", p);
+  });
+  file->addAction("Export &time-lapse...", this, [this] {
+    const QString p = QFileDialog::getSaveFileName(this, "Export time-lapse", "painting.mp4", "MP4 video (*.mp4)");
+    if (!p.isEmpty()) export_timelapse(p);
   });
   file->addAction("Save &recording...", this, [this] {
     const QString p = QFileDialog::getSaveFileName(this, "Save recording", "session.json", "Stroke file (*.json)");
@@ -826,6 +832,51 @@ bool MainWindow::export_relief(const QString& exr_path, const QString& stl_path,
   });
   const std::string err = done->get_future().get();
   if (!err.empty()) QMessageBox::warning(this, "Export failed", QString::fromStdString(err));
+  return err.empty();
+}
+
+bool MainWindow::export_timelapse(const QString& path, const TimelapseOptions& options) {
+  Stroke rec = sim_->recording();
+  if (rec.samples.empty()) {
+    QMessageBox::warning(this, "Export failed", "Nothing painted since the recording started: no time-lapse to make");
+    return false;
+  }
+  // The replay runs as `wetbrush replay` would, with the studio's parameters and view.
+  auto got = std::make_shared<std::promise<std::pair<SimConfig, RenderParams>>>();
+  sim_->post([got](SimThread& s) { got->set_value({s.config(), s.renderer().params()}); });
+  auto [config, render] = got->get_future().get();
+  config.canvas = rec.canvas;
+  config.brush = rec.brush;
+  if (rec.window) config.window = Int3{(*rec.window)[0], (*rec.window)[1], std::min((*rec.window)[2], rec.canvas.depth)};
+  std::atomic<int64_t> done{0}, total{1};
+  std::atomic<bool> cancel{false};
+  const std::string file = path.toStdString();
+  auto job = std::async(std::launch::async, [&]() -> std::string {
+    try {
+      write_timelapse(rec, config, render, file, options, [&](int64_t d, int64_t t) {
+        done = d, total = std::max<int64_t>(t, 1);
+        return !cancel.load();
+      });
+      return "";
+    } catch (const std::exception& e) {
+      return user_message(e);
+    }
+  });
+  QProgressDialog progress("Replaying the session into a time-lapse...", "Cancel", 0, 1000, this);
+  progress.setWindowModality(Qt::WindowModal);
+  progress.setMinimumDuration(500);
+  while (job.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
+    progress.setValue(int(1000 * done.load() / total.load()));
+    QApplication::processEvents();
+    if (progress.wasCanceled()) cancel = true;
+  }
+  progress.reset();
+  const std::string err = job.get();
+  if (!err.empty() && !cancel) QMessageBox::warning(this, "Export failed", QString::fromStdString(err));
+  if (err.empty() && !sim_->recording_from_blank())
+    statusBar()->showMessage("Time-lapse written; the recording started on a painted canvas (after undo, open or a "
+                             "brush change), so it shows only the strokes since then",
+                             8000);
   return err.empty();
 }
 

@@ -30,6 +30,9 @@
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <signal.h>
+extern "C" {
+#include <libavformat/avformat.h>
+}
 #include <tiny_gltf.h>
 #include <sys/resource.h>
 #include <unistd.h>
@@ -1094,6 +1097,27 @@ class StudioTest : public QObject {
     QVERIFY2(loader.LoadBinaryFromFile(&model, &err, &warn, glb.toStdString()), err.c_str());
     QCOMPARE(model.meshes.size(), size_t(1));
     QCOMPARE(model.images.size(), size_t(1));
+  }
+
+  void exportsTheSessionTimeLapse() {
+    // File > Export time-lapse: the session's recording replayed into an H.264 MP4 that
+    // libavformat opens, a frame every speed / fps simulated seconds and the painting last.
+    grid_only_canvas(false);
+    stroke(50.f, 0.6f);
+    w_->settle();
+    const QString path = dir_->path() + "/session.mp4";
+    QVERIFY(w_->export_timelapse(path, TimelapseOptions{10, 1.0, false}));
+    AVFormatContext* fmt = nullptr;
+    QVERIFY(avformat_open_input(&fmt, path.toStdString().c_str(), nullptr, nullptr) == 0);
+    QVERIFY(avformat_find_stream_info(fmt, nullptr) >= 0);
+    QCOMPARE(int(fmt->nb_streams), 1);
+    const AVStream* st = fmt->streams[0];
+    const int64_t frames = st->nb_frames;
+    const AVCodecID codec = st->codecpar->codec_id;
+    avformat_close_input(&fmt);
+    qInfo("time-lapse of the session: %s, %lld frames", avcodec_get_name(codec), static_cast<long long>(frames));
+    QCOMPARE(codec, AV_CODEC_ID_H264);
+    QVERIFY2(frames >= 3, "frame 0, frames of the stroke, the painting");
   }
 
   void recordingReplaysToSameCanvas() {
