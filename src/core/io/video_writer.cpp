@@ -104,7 +104,8 @@ struct VideoWriter::Impl {
   }
 };
 
-VideoWriter::VideoWriter(const std::string& path, int width, int height, int fps) : impl_(std::make_unique<Impl>()) {
+VideoWriter::VideoWriter(const std::string& path, int width, int height, int fps, const std::string& encoder)
+    : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.path = path;
   WB_REQUIRE(width > 0 && height > 0 && width <= 8192 && height <= 8192,
@@ -122,7 +123,8 @@ VideoWriter::VideoWriter(const std::string& path, int width, int height, int fps
   // libx264 reports its statistics on standard error at the default level; errors are enough
   // (they come back as return codes, which the messages below carry).
   av_log_set_level(AV_LOG_ERROR);
-  const AVCodec* codec = avcodec_find_encoder(AV_CODEC_ID_H264);
+  const AVCodec* codec = encoder.empty() ? avcodec_find_encoder(AV_CODEC_ID_H264) : avcodec_find_encoder_by_name(encoder.c_str());
+  WB_REQUIRE(codec || encoder.empty(), path + ": video: libavcodec has no encoder '" + encoder + "'");
   if (!codec) {
     codec = avcodec_find_encoder(AV_CODEC_ID_MPEG4);
     WB_REQUIRE(codec, path + ": video: this machine's libavcodec has neither an H.264 nor an MPEG-4 encoder");

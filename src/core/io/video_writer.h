@@ -15,7 +15,9 @@ class VideoWriter {
  public:
   /// Frames of width x height pixels at `fps`; odd sizes are padded to even ones (4:2:0 chroma
   /// needs them) by repeating the last column or row. Throws wb::Error when no encoder opens.
-  VideoWriter(const std::string& path, int width, int height, int fps);
+  /// `encoder` names a libavcodec encoder to use instead of the H.264 default (tests of the
+  /// MPEG-4 fallback).
+  VideoWriter(const std::string& path, int width, int height, int fps, const std::string& encoder = "");
   ~VideoWriter();
   VideoWriter(const VideoWriter&) = delete;
   VideoWriter& operator=(const VideoWriter&) = delete;
