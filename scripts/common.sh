@@ -12,7 +12,10 @@ WB_PACKAGES=(cmake ninja-build g++ pkg-config libgtest-dev libgmock-dev libbench
   nlohmann-json3-dev libcli11-dev libpng-dev libzstd-dev libzip-dev zlib1g-dev
   qt6-base-dev libqt6opengl6-dev xvfb xauth libgl1-mesa-dri
   # scripts/bundle-gpu.sh packs the studio for the GPU machine with the zstd program.
-  zstd)
+  zstd
+  # What a painting becomes (docs/FORMATS.md): the float height map (OpenEXR), the glTF relief
+  # (tinygltf) and the time-lapse video (FFmpeg's libraries; H.264 through Debian's libx264).
+  libopenexr-dev libtinygltf-dev libavcodec-dev libavformat-dev libswscale-dev libavutil-dev)
 
 # The libFuzzer runs only (scripts/hardening.sh fuzz): clang with libFuzzer and its OpenMP.
 WB_FUZZ_PACKAGES=(clang libclang-rt-dev libomp-dev)

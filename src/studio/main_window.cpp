@@ -10,6 +10,7 @@
 #include <QDockWidget>
 #include <QFile>
 #include <QFileDialog>
+#include <QProgressDialog>
 #include <QFileInfo>
 #include <QFormLayout>
 #include <QInputDialog>
@@ -30,12 +31,14 @@
 #include <cstdio>
 #include <cmath>
 #include <future>
+#include <atomic>
 
 #include "core/io/brush_json.h"
 #include "core/io/document.h"
 #include "core/exec/error.h"
 #include "core/exec/memory.h"
 #include "core/io/material_maps.h"
+#include "core/io/relief_export.h"
 #include "core/io/png.h"
 
 namespace wb::studio {
@@ -408,6 +411,22 @@ void MainWindow::build_menus() {
     QString base = p;
     if (base.endsWith(".png")) base.chop(4);
     export_maps(base + "-height.png", base + "-normal.png");
+  });
+  file->addAction("Export height (&OpenEXR)...", this, [this] {
+    const QString p = QFileDialog::getSaveFileName(this, "Export height in mm", "painting.exr", "OpenEXR (*.exr)");
+    if (!p.isEmpty()) export_relief(p, "", "");
+  });
+  file->addAction("Export relief for printing (&STL)...", this, [this] {
+    const QString p = QFileDialog::getSaveFileName(this, "Export STL solid", "painting.stl", "STL (*.stl)");
+    if (!p.isEmpty()) export_relief("", p, "");
+  });
+  file->addAction("Export relief for 3D (&glTF)...", this, [this] {
+    const QString p = QFileDialog::getSaveFileName(this, "Export glTF binary", "painting.glb", "glTF binary (*.glb)");
+    if (!p.isEmpty()) export_relief("", "", p);
+  });
+  file->addAction("Export &time-lapse...", this, [this] {
+    const QString p = QFileDialog::getSaveFileName(this, "Export time-lapse", "painting.mp4", "MP4 video (*.mp4)");
+    if (!p.isEmpty()) export_timelapse(p);
   });
   file->addAction("Save &recording...", this, [this] {
     const QString p = QFileDialog::getSaveFileName(this, "Save recording", "session.json", "Stroke file (*.json)");
@@ -810,6 +829,68 @@ bool MainWindow::export_maps(const QString& height_path, const QString& normal_p
   });
   const std::string err = done->get_future().get();
   if (!err.empty()) QMessageBox::warning(this, "Export failed", QString::fromStdString(err));
+  return err.empty();
+}
+
+bool MainWindow::export_relief(const QString& exr_path, const QString& stl_path, const QString& glb_path) {
+  auto done = std::make_shared<std::promise<std::string>>();
+  const ReliefPaths paths{exr_path.toStdString(), stl_path.toStdString(), glb_path.toStdString()};
+  sim_->post([done, paths](SimThread& s) {
+    try {
+      TileStore canvas = s.sim().settled_canvas_copy(s.sim().device());
+      write_relief_exports(s.sim().device(), canvas, paths);
+      done->set_value("");
+    } catch (const std::exception& e) {
+      done->set_value(user_message(e));
+    }
+  });
+  const std::string err = done->get_future().get();
+  if (!err.empty()) QMessageBox::warning(this, "Export failed", QString::fromStdString(err));
+  return err.empty();
+}
+
+bool MainWindow::export_timelapse(const QString& path, const TimelapseOptions& options) {
+  Stroke rec = sim_->recording();
+  if (rec.samples.empty()) {
+    QMessageBox::warning(this, "Export failed", "Nothing painted since the recording started: no time-lapse to make");
+    return false;
+  }
+  // The replay runs as `wetbrush replay` would, with the studio's parameters and view.
+  auto got = std::make_shared<std::promise<std::pair<SimConfig, RenderParams>>>();
+  sim_->post([got](SimThread& s) { got->set_value({s.config(), s.renderer().params()}); });
+  auto [config, render] = got->get_future().get();
+  config.canvas = rec.canvas;
+  config.brush = rec.brush;
+  if (rec.window) config.window = Int3{(*rec.window)[0], (*rec.window)[1], std::min((*rec.window)[2], rec.canvas.depth)};
+  std::atomic<int64_t> done{0}, total{1};
+  std::atomic<bool> cancel{false};
+  const std::string file = path.toStdString();
+  auto job = std::async(std::launch::async, [&]() -> std::string {
+    try {
+      write_timelapse(rec, config, render, file, options, [&](int64_t d, int64_t t) {
+        done = d, total = std::max<int64_t>(t, 1);
+        return !cancel.load();
+      });
+      return "";
+    } catch (const std::exception& e) {
+      return user_message(e);
+    }
+  });
+  QProgressDialog progress("Replaying the session into a time-lapse...", "Cancel", 0, 1000, this);
+  progress.setWindowModality(Qt::WindowModal);
+  progress.setMinimumDuration(500);
+  while (job.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
+    progress.setValue(int(1000 * done.load() / total.load()));
+    QApplication::processEvents();
+    if (progress.wasCanceled()) cancel = true;
+  }
+  progress.reset();
+  const std::string err = job.get();
+  if (!err.empty() && !cancel) QMessageBox::warning(this, "Export failed", QString::fromStdString(err));
+  if (err.empty() && !sim_->recording_from_blank())
+    statusBar()->showMessage("Time-lapse written; the recording started on a painted canvas (after undo, open or a "
+                             "brush change), so it shows only the strokes since then",
+                             8000);
   return err.empty();
 }
 

@@ -11,6 +11,9 @@
 #include <QSpinBox>
 #include <QDir>
 #include <QElapsedTimer>
+#include <QFileDialog>
+#include <QLineEdit>
+#include <QMenuBar>
 #include <QFile>
 #include <QMessageBox>
 #include <QOpenGLContext>
@@ -24,11 +27,19 @@
 #include <QTimer>
 #include <QToolButton>
 
+#include <ImfChannelList.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
 #include <signal.h>
+extern "C" {
+#include <libavformat/avformat.h>
+}
+#include <tiny_gltf.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 #include <functional>
 #include <future>
@@ -1093,6 +1104,83 @@ class StudioTest : public QObject {
     QVERIFY(!bytes(h).isEmpty() && !bytes(n).isEmpty());
     QVERIFY2(bytes(h) == bytes(h2), "height maps differ");
     QVERIFY2(bytes(n) == bytes(n2), "normal maps differ");
+  }
+
+  void fileMenuExportsReliefs() {
+    // File > Export height (OpenEXR), relief (STL) and relief (glTF): each action asks for a file
+    // and writes it with the core's relief writers; the files load back.
+    grid_only_canvas(false);
+    stroke(50.f, 0.6f);
+    w_->settle();
+    const QString exr = dir_->path() + "/relief.exr", stl = dir_->path() + "/relief.stl",
+                  glb = dir_->path() + "/relief.glb";
+    QMenu* file = nullptr;
+    for (QAction* a : w_->menuBar()->actions())
+      if (a->text() == "&File") file = a->menu();
+    QVERIFY(file);
+    for (const auto& [label, path] : {std::pair{QString("(&OpenEXR)"), exr}, std::pair{QString("(&STL)"), stl},
+                                      std::pair{QString("(&glTF)"), glb}}) {
+      QAction* action = nullptr;
+      for (QAction* a : file->actions())
+        if (a->text().contains(label)) action = a;
+      QVERIFY2(action, qPrintable("no File menu action " + label));
+      // The file dialog is modal: answer it from a timer while trigger() waits in its loop.
+      bool answered = false;
+      QTimer poll;
+      poll.setInterval(50);
+      connect(&poll, &QTimer::timeout, this, [&, p = path] {
+        if (auto* dialog = qobject_cast<QFileDialog*>(QApplication::activeModalWidget())) {
+          answered = true;
+          poll.stop();
+          // The name typed into the dialog's own field, as a user would.
+          auto* name = dialog->findChild<QLineEdit*>("fileNameEdit");
+          if (name) name->setText(p);
+          static_cast<QDialog*>(dialog)->accept();  // QFileDialog::accept is protected
+        }
+      });
+      poll.start();
+      action->trigger();
+      poll.stop();
+      QVERIFY2(answered, qPrintable("no file dialog for " + label));
+      QVERIFY2(QFile::exists(path), qPrintable(path));
+    }
+    Imf::InputFile in(exr.toStdString().c_str());
+    QCOMPARE(in.header().dataWindow().max.x + 1, kW);
+    QVERIFY(in.header().channels().findChannel("Y") != nullptr);
+    QFile s(stl);
+    QVERIFY(s.open(QIODevice::ReadOnly));
+    const QByteArray bytes = s.readAll();
+    QVERIFY(bytes.size() > 84);
+    uint32_t n = 0;
+    std::memcpy(&n, bytes.constData() + 80, 4);
+    QCOMPARE(qint64(bytes.size()), qint64(84 + 50 * qint64(n)));
+    tinygltf::Model model;
+    tinygltf::TinyGLTF loader;
+    std::string err, warn;
+    QVERIFY2(loader.LoadBinaryFromFile(&model, &err, &warn, glb.toStdString()), err.c_str());
+    QCOMPARE(model.meshes.size(), size_t(1));
+    QCOMPARE(model.images.size(), size_t(1));
+  }
+
+  void exportsTheSessionTimeLapse() {
+    // File > Export time-lapse: the session's recording replayed into an H.264 MP4 that
+    // libavformat opens, a frame every speed / fps simulated seconds and the painting last.
+    grid_only_canvas(false);
+    stroke(50.f, 0.6f);
+    w_->settle();
+    const QString path = dir_->path() + "/session.mp4";
+    QVERIFY(w_->export_timelapse(path, TimelapseOptions{10, 1.0, false}));
+    AVFormatContext* fmt = nullptr;
+    QVERIFY(avformat_open_input(&fmt, path.toStdString().c_str(), nullptr, nullptr) == 0);
+    QVERIFY(avformat_find_stream_info(fmt, nullptr) >= 0);
+    QCOMPARE(int(fmt->nb_streams), 1);
+    const AVStream* st = fmt->streams[0];
+    const int64_t frames = st->nb_frames;
+    const AVCodecID codec = st->codecpar->codec_id;
+    avformat_close_input(&fmt);
+    qInfo("time-lapse of the session: %s, %lld frames", avcodec_get_name(codec), static_cast<long long>(frames));
+    QCOMPARE(codec, AV_CODEC_ID_H264);
+    QVERIFY2(frames >= 3, "frame 0, frames of the stroke, the painting");
   }
 
   void recordingReplaysToSameCanvas() {
