@@ -8,7 +8,9 @@
 #include "cli/commands.h"
 #include "core/io/document.h"
 #include "core/io/material_maps.h"
-#include "core/io/relief_export.h"
+#if WB_WITH_MEDIA
+#include "media/relief_export.h"
+#endif
 
 namespace wb::cli {
 
@@ -16,7 +18,9 @@ namespace {
 struct ExportOpts {
   std::string painting, height, normal, albedo, device = "auto";
   std::string exr, stl, glb;
+#if WB_WITH_MEDIA
   ReliefOptions relief;
+#endif
 };
 }  // namespace
 
@@ -28,6 +32,7 @@ void register_export(CLI::App& app) {
                   "16-bit grey PNG: surface height, value = height / canvas depth * 65535 (scale in its tEXt)");
   sub->add_option("--normal", o->normal, "RGB PNG: tangent-space normal map, OpenGL convention (+Y up the image)");
   sub->add_option("--albedo", o->albedo, "RGB PNG: unlit paint colour");
+#if WB_WITH_MEDIA  // the reliefs (src/media; not in a -DWB_MEDIA=OFF build)
   sub->add_option("--height-exr", o->exr, "OpenEXR: surface height in millimetres, 32-bit float channel Y");
   sub->add_option("--stl", o->stl, "Binary STL: closed solid of the paint on a base, millimetres, z up");
   sub->add_option("--gltf", o->glb, "glTF 2.0 binary (.glb): textured paint surface, metres, y up");
@@ -36,13 +41,16 @@ void register_export(CLI::App& app) {
   sub->add_option("--error-mm", o->relief.error_mm,
                   "STL and glTF: most the decimated surface may differ from the height map, mm")
       ->capture_default_str();
+#endif
   add_device_option(sub, o->device);
   set_action(sub, [o]() {
     if (o->height.empty() && o->normal.empty() && o->albedo.empty() && o->exr.empty() && o->stl.empty() &&
         o->glb.empty())
       WB_THROW("export: nothing to do: give --height, --normal, --albedo, --height-exr, --stl and/or --gltf");
+#if WB_WITH_MEDIA
     WB_REQUIRE(o->relief.base_mm > 0.0 && o->relief.base_mm <= 1000.0, "export: --base-mm must be in (0, 1000]");
     WB_REQUIRE(o->relief.error_mm >= 0.0 && o->relief.error_mm <= 100.0, "export: --error-mm must be in [0, 100]");
+#endif
     const Device device = resolve_device(o->device);
     Painting p = load_painting(o->painting, device);
     if (!o->height.empty() || !o->normal.empty() || !o->albedo.empty()) {
@@ -52,6 +60,7 @@ void register_export(CLI::App& app) {
       for (const std::string* f : {&o->normal, &o->albedo})
         if (!f->empty()) std::printf("wrote %s\n", f->c_str());
     }
+#if WB_WITH_MEDIA
     const ReliefStats s = write_relief_exports(device, p.canvas, ReliefPaths{o->exr, o->stl, o->glb}, o->relief);
     if (!o->exr.empty()) std::printf("wrote %s (height in mm, float)\n", o->exr.c_str());
     if (!o->stl.empty())
@@ -60,6 +69,7 @@ void register_export(CLI::App& app) {
     if (!o->glb.empty())
       std::printf("wrote %s (%zu vertices of %d in the full grid, %zu triangles, within %.3f mm)\n", o->glb.c_str(),
                   s.glb.vertices, s.glb.grid_vertices, s.glb.triangles, o->relief.error_mm);
+#endif
     return 0;
   });
 }

@@ -22,7 +22,9 @@
 #include "core/io/document.h"
 #include "core/io/png.h"
 #include "core/io/stroke.h"
-#include "core/io/timelapse.h"
+#if WB_WITH_MEDIA
+#include "media/timelapse.h"
+#endif
 #include "core/params/param_table.h"
 #include "core/render/renderer.h"
 #include "core/sim/replay.h"
@@ -245,8 +247,9 @@ int run_replay(const ReplayArgs& a) {
   const CanvasRect& r = replay.region();
   const Camera camera = Camera::top_region(float(r.x0), float(r.y0), float(r.width), float(r.height), 1.f);
 
-  // The time-lapse (core/io/timelapse.h): frame 0 now, the frames due after each step, the
+  // The time-lapse (media/timelapse.h): frame 0 now, the frames due after each step, the
   // settled painting last.
+#if WB_WITH_MEDIA
   std::unique_ptr<TimelapseRecorder> video;
   if (!a.video.empty()) {
     video = std::make_unique<TimelapseRecorder>(a.video, r, stroke.canvas.depth,
@@ -255,6 +258,7 @@ int run_replay(const ReplayArgs& a) {
       std::fprintf(stderr, "wetbrush: warning: %s\n", video->video().fallback_note().c_str());
     video->begin(renderer, sim.canvas());
   }
+#endif
 
   Progress progress(!a.quiet, a.progress_every);
   const auto elapsed = [&] { return progress.elapsed(); };
@@ -279,14 +283,16 @@ int run_replay(const ReplayArgs& a) {
       const Image img = renderer.render(sim.canvas(), camera, sim.live_window(), &overlay);
       write_png8(a.frames_dir + name, img.rgba.data(), img.width, img.height, 4);
     }
-    if (video) video->after_step(renderer, sim, replay.sim_time());
     char detail[128];
-    if (video)
+    std::snprintf(detail, sizeof detail, "%.2f s simulated  %lld particles", replay.sim_time(),
+                  static_cast<long long>(sim.particles().size()));
+#if WB_WITH_MEDIA
+    if (video) {
+      video->after_step(renderer, sim, replay.sim_time());
       std::snprintf(detail, sizeof detail, "%.2f s simulated  %lld particles  %lld video frames", replay.sim_time(),
                     static_cast<long long>(sim.particles().size()), static_cast<long long>(video->video().frames()));
-    else
-      std::snprintf(detail, sizeof detail, "%.2f s simulated  %lld particles", replay.sim_time(),
-                    static_cast<long long>(sim.particles().size()));
+    }
+#endif
     progress.step(done, replay.step_count(), "", detail, done == replay.step_count());
   }
   progress.finish();
@@ -307,6 +313,7 @@ int run_replay(const ReplayArgs& a) {
     render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tr).count();
   }
   if (!a.image.empty()) write_png8(a.image, painting.rgba.data(), painting.width, painting.height, 4);
+#if WB_WITH_MEDIA
   if (video) {
     // The top view's last frame is the image -o writes, when it was rendered.
     const bool same = video->camera().kind == CameraKind::Top && !painting.rgba.empty();
@@ -317,6 +324,7 @@ int run_replay(const ReplayArgs& a) {
                   static_cast<long long>(v.frames()), a.fps, double(v.frames()) / a.fps, v.encoded_width(),
                   v.encoded_height(), v.encoder().c_str());
   }
+#endif
   if (!a.brush_image.empty()) {
     const auto img = replay.brush_image();
     write_png8(a.brush_image, img.data(), r.width, r.height, 3);
@@ -554,6 +562,7 @@ void register_replay(CLI::App& app) {
                   "Write the brush picture: bristles of the final pose over every cell they touched (PNG)");
   sub->add_option("--frames", args->frames_dir, "Write a rendered PNG frame every --every steps into this folder");
   sub->add_option("--every", args->every, "Frame interval in steps")->capture_default_str();
+#if WB_WITH_MEDIA  // the time-lapse (src/media; not in a -DWB_MEDIA=OFF build)
   sub->add_option("--video", args->video, "Write a time-lapse video (H.264 MP4) of the replay");
   sub->add_option("--fps", args->fps, "Time-lapse frames per second")->capture_default_str();
   sub->add_option("--speed", args->speed, "Time-lapse speed: simulated seconds per second of video")
@@ -561,6 +570,7 @@ void register_replay(CLI::App& app) {
   sub->add_option("--camera", args->video_camera, "Time-lapse view: top or oblique")
       ->check(CLI::IsMember({"top", "oblique"}))
       ->capture_default_str();
+#endif
   sub->add_option("--brush", args->brush_shape,
                   "Replace the stroke's brush by the default brush of this shape "
                   "(round, flat, fan, filbert, angular, mop, rigger)");

@@ -38,7 +38,9 @@
 #include "core/exec/error.h"
 #include "core/exec/memory.h"
 #include "core/io/material_maps.h"
-#include "core/io/relief_export.h"
+#if WB_WITH_MEDIA
+#include "media/relief_export.h"
+#endif
 #include "core/io/png.h"
 
 namespace wb::studio {
@@ -412,6 +414,7 @@ void MainWindow::build_menus() {
     if (base.endsWith(".png")) base.chop(4);
     export_maps(base + "-height.png", base + "-normal.png");
   });
+#if WB_WITH_MEDIA
   file->addAction("Export height (&OpenEXR)...", this, [this] {
     const QString p = QFileDialog::getSaveFileName(this, "Export height in mm", "painting.exr", "OpenEXR (*.exr)");
     if (!p.isEmpty()) export_relief(p, "", "");
@@ -428,6 +431,7 @@ void MainWindow::build_menus() {
     const QString p = QFileDialog::getSaveFileName(this, "Export time-lapse", "painting.mp4", "MP4 video (*.mp4)");
     if (!p.isEmpty()) export_timelapse(p);
   });
+#endif
   file->addAction("Save &recording...", this, [this] {
     const QString p = QFileDialog::getSaveFileName(this, "Save recording", "session.json", "Stroke file (*.json)");
     if (!p.isEmpty()) save_recording(p);
@@ -832,6 +836,7 @@ bool MainWindow::export_maps(const QString& height_path, const QString& normal_p
   return err.empty();
 }
 
+#if WB_WITH_MEDIA
 bool MainWindow::export_relief(const QString& exr_path, const QString& stl_path, const QString& glb_path) {
   auto done = std::make_shared<std::promise<std::string>>();
   const ReliefPaths paths{exr_path.toStdString(), stl_path.toStdString(), glb_path.toStdString()};
@@ -893,6 +898,7 @@ bool MainWindow::export_timelapse(const QString& path, const TimelapseOptions& o
                              8000);
   return err.empty();
 }
+#endif
 
 bool MainWindow::save_recording(const QString& path) {
   try {

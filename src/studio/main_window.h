@@ -12,7 +12,9 @@
 #include <optional>
 #include <vector>
 
-#include "core/io/timelapse.h"
+#if WB_WITH_MEDIA
+#include "media/timelapse.h"
+#endif
 #include "core/io/undo_tiles.h"
 #include "studio/brush_preview.h"
 #include "studio/canvas_view.h"
@@ -58,11 +60,13 @@ class MainWindow : public QMainWindow {
   bool open_from(const QString& path);
   bool export_png(const QString& path);
   bool export_maps(const QString& height_path, const QString& normal_path);
-  /// Relief exports (core/io/relief_export.h, the CLI's defaults): the paths not empty are written.
+#if WB_WITH_MEDIA  // src/media: not in a -DWB_MEDIA=OFF build
+  /// Relief exports (media/relief_export.h, the CLI's defaults): the paths not empty are written.
   bool export_relief(const QString& exr_path, const QString& stl_path, const QString& glb_path);
   /// The session's recording replayed on a fresh simulator into an MP4 time-lapse
-  /// (core/io/timelapse.h), with a progress dialog that can cancel.
+  /// (media/timelapse.h), with a progress dialog that can cancel.
   bool export_timelapse(const QString& path, const TimelapseOptions& options = {});
+#endif
   bool save_recording(const QString& path);
   /// A new canvas, primed with `ground` (a smooth ground lays nothing).
   void new_canvas(int width, int height, QColor paper, const CanvasGround& ground = {});

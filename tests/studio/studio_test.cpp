@@ -27,14 +27,16 @@
 #include <QTimer>
 #include <QToolButton>
 
+#if WB_WITH_MEDIA
 #include <ImfChannelList.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
-#include <signal.h>
 extern "C" {
 #include <libavformat/avformat.h>
 }
 #include <tiny_gltf.h>
+#endif
+#include <signal.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -1106,6 +1108,7 @@ class StudioTest : public QObject {
     QVERIFY2(bytes(n) == bytes(n2), "normal maps differ");
   }
 
+#if WB_WITH_MEDIA
   void fileMenuExportsReliefs() {
     // File > Export height (OpenEXR), relief (STL) and relief (glTF): each action asks for a file
     // and writes it with the core's relief writers; the files load back.
@@ -1183,6 +1186,7 @@ class StudioTest : public QObject {
     QVERIFY2(frames >= 3, "frame 0, frames of the stroke, the painting");
   }
 
+#endif
   void recordingReplaysToSameCanvas() {
     // One thread on both sides: the CPU backend's parallel atomic sums make two runs of the same
     // stroke differ (the FLIP step amplifies the rounding), one thread makes a run reproducible.

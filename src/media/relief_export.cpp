@@ -1,4 +1,4 @@
-#include "core/io/relief_export.h"
+#include "media/relief_export.h"
 
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>

@@ -8,12 +8,13 @@
 #include <vector>
 
 #include "core/canvas/tile_store.h"
+#include "core/grid/grid_params.h"
 #include "core/render/renderer.h"
 
 namespace wb {
 
-/// Size of one canvas cell, millimetres (the simulator's length unit).
-inline constexpr double kCellMm = 0.2;
+/// Size of one canvas cell, millimetres: the grid's cell (GridParams::cell_size, metres).
+inline constexpr double kCellMm = double(GridParams{}.cell_size) * 1e3;
 
 /// The paint surface as a triangle mesh over the canvas, decimated where flat. Vertices stand at
 /// the cell centres and on the canvas border (the outer cells' heights carried to the edge), so

@@ -21,7 +21,7 @@
 #include <string>
 
 #include "core/io/png.h"
-#include "core/io/relief_export.h"
+#include "media/relief_export.h"
 
 namespace wb::test {
 namespace {

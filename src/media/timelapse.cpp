@@ -1,4 +1,4 @@
-#include "core/io/timelapse.h"
+#include "media/timelapse.h"
 
 #include <cmath>
 

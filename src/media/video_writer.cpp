@@ -1,4 +1,4 @@
-#include "core/io/video_writer.h"
+#include "media/video_writer.h"
 
 extern "C" {
 #include <libavcodec/avcodec.h>

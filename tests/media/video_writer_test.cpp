@@ -13,7 +13,7 @@ extern "C" {
 #include <string>
 
 #include "core/exec/error.h"
-#include "core/io/video_writer.h"
+#include "media/video_writer.h"
 
 namespace wb::test {
 namespace {

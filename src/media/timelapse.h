@@ -8,7 +8,7 @@
 #include <memory>
 #include <string>
 
-#include "core/io/video_writer.h"
+#include "media/video_writer.h"
 #include "core/render/camera.h"
 #include "core/render/renderer.h"
 #include "core/sim/replay.h"
