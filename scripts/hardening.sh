@@ -25,9 +25,11 @@ if [ "$what" = all ] || [ "$what" = asan ]; then
   export ASAN_OPTIONS="${ASAN_OPTIONS:-halt_on_error=1:abort_on_error=1:detect_stack_use_after_return=0}"
   export UBSAN_OPTIONS="${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}"
   export OMP_WAIT_POLICY="${OMP_WAIT_POLICY:-PASSIVE}"
-  # The whole-stroke checks (label long) run in the main suite only: their kernels run here in the
-  # shorter tests, and under the sanitizers they would take most of CI's time.
-  if (cd "$asan" && ctest --output-on-failure --parallel "$jobs" --timeout 900 --label-exclude long); then
+  # The whole-stroke checks (label long) and the CLI's whole replays (a soak, a bench, a replay
+  # with its progress, image or video) run in the main suite only: their kernels and readers run
+  # here in the shorter tests, and under the sanitizers they would take most of CI's time.
+  if (cd "$asan" && ctest --output-on-failure --parallel "$jobs" --timeout 900 --label-exclude long \
+      -E '^Cli\.(SoakReports|ProgressLines|ReplayWritesImage|ReplayWritesATimeLapse|BenchReports)'); then
     echo "hardening: ASan+UBSan suite passed (build $((built - start)) s, tests $(($(date +%s) - built)) s)"
   else
     echo "hardening: ASan+UBSan suite FAILED"

@@ -802,13 +802,11 @@ bool MainWindow::open_from(const QString& path) {
   return true;
 }
 
-bool MainWindow::export_png(const QString& path) {
+bool MainWindow::run_export(std::function<void(SimThread&)> write) {
   auto done = std::make_shared<std::promise<std::string>>();
-  const std::string file = path.toStdString();
-  sim_->post([done, file](SimThread& s) {
+  sim_->post([done, write = std::move(write)](SimThread& s) {
     try {
-      const Image img = s.canvas_image();
-      write_png8(file, img.rgba.data(), img.width, img.height, 4);
+      write(s);
       done->set_value("");
     } catch (const std::exception& e) {
       done->set_value(user_message(e));
@@ -819,39 +817,27 @@ bool MainWindow::export_png(const QString& path) {
   return err.empty();
 }
 
-bool MainWindow::export_maps(const QString& height_path, const QString& normal_path) {
-  auto done = std::make_shared<std::promise<std::string>>();
-  const std::string hp = height_path.toStdString(), np = normal_path.toStdString();
-  sim_->post([done, hp, np](SimThread& s) {
-    try {
-      TileStore canvas = s.sim().settled_canvas_copy(s.sim().device());
-      write_material_maps(s.sim().device(), canvas, MaterialMapPaths{hp, np, ""});
-      done->set_value("");
-    } catch (const std::exception& e) {
-      done->set_value(user_message(e));
-    }
+bool MainWindow::export_png(const QString& path) {
+  return run_export([file = path.toStdString()](SimThread& s) {
+    const Image img = s.canvas_image();
+    write_png8(file, img.rgba.data(), img.width, img.height, 4);
   });
-  const std::string err = done->get_future().get();
-  if (!err.empty()) QMessageBox::warning(this, "Export failed", QString::fromStdString(err));
-  return err.empty();
+}
+
+bool MainWindow::export_maps(const QString& height_path, const QString& normal_path) {
+  return run_export([hp = height_path.toStdString(), np = normal_path.toStdString()](SimThread& s) {
+    TileStore canvas = s.sim().settled_canvas_copy(s.sim().device());
+    write_material_maps(s.sim().device(), canvas, MaterialMapPaths{hp, np, ""});
+  });
 }
 
 #if WB_WITH_MEDIA
 bool MainWindow::export_relief(const QString& exr_path, const QString& stl_path, const QString& glb_path) {
-  auto done = std::make_shared<std::promise<std::string>>();
-  const ReliefPaths paths{exr_path.toStdString(), stl_path.toStdString(), glb_path.toStdString()};
-  sim_->post([done, paths](SimThread& s) {
-    try {
-      TileStore canvas = s.sim().settled_canvas_copy(s.sim().device());
-      write_relief_exports(s.sim().device(), canvas, paths);
-      done->set_value("");
-    } catch (const std::exception& e) {
-      done->set_value(user_message(e));
-    }
+  return run_export([paths = ReliefPaths{exr_path.toStdString(), stl_path.toStdString(), glb_path.toStdString()}](
+                        SimThread& s) {
+    TileStore canvas = s.sim().settled_canvas_copy(s.sim().device());
+    write_relief_exports(s.sim().device(), canvas, paths);
   });
-  const std::string err = done->get_future().get();
-  if (!err.empty()) QMessageBox::warning(this, "Export failed", QString::fromStdString(err));
-  return err.empty();
 }
 
 bool MainWindow::export_timelapse(const QString& path, const TimelapseOptions& options) {

@@ -8,6 +8,7 @@
 #include <QTimer>
 #include <QUndoStack>
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -111,6 +112,8 @@ class MainWindow : public QMainWindow {
   void rebuild_recent_menu();
   /// Edit > Memory limit: the budget (mem::set_budget), kept in the settings for the next start.
   void ask_memory_limit();
+  /// Runs an export's `write` on the simulation thread and waits for it; a failure is shown.
+  bool run_export(std::function<void(SimThread&)> write);
   bool maybe_save();
   /// Returns when every save in flight has succeeded or failed (and said so).
   void wait_for_saves();

@@ -21,21 +21,17 @@
 #include <string>
 
 #include "core/io/png.h"
+#include "run_cli.h"
 #include "media/relief_export.h"
 
 namespace wb::test {
 namespace {
 
+/// The CLI's output, its exit status in `code`.
 std::string run_cli(const std::string& args, int* code) {
-  const std::string cmd = std::string(WB_CLI_PATH) + " " + args + " 2>&1";
-  std::string out;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return out;
-  char buf[4096];
-  while (fgets(buf, sizeof buf, pipe)) out += buf;
-  const int status = pclose(pipe);
-  *code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return out;
+  const RunResult r = wb::test::run_cli(args);
+  *code = r.exit_code;
+  return r.output;
 }
 
 /// The largest |mesh - height| over every cell centre: each triangle (x, y in cells, heights

@@ -5,10 +5,6 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-extern "C" {
-#include <libavcodec/avcodec.h>
-#include <libavformat/avformat.h>
-}
 
 #include <algorithm>
 #include <cmath>
@@ -20,79 +16,17 @@ extern "C" {
 #include <vector>
 
 #include "core/io/png.h"
+#include "media/decoded_video.h"
+#include "run_cli.h"
 
 namespace wb::test {
 namespace {
 
+/// The CLI's output, its exit status in `code`.
 std::string run_cli(const std::string& args, int* code) {
-  const std::string cmd = std::string(WB_CLI_PATH) + " " + args + " 2>&1";
-  std::string out;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return out;
-  char buf[4096];
-  while (fgets(buf, sizeof buf, pipe)) out += buf;
-  const int status = pclose(pipe);
-  *code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return out;
-}
-
-struct Decoded {
-  AVCodecID codec = AV_CODEC_ID_NONE;
-  int width = 0, height = 0, frames = 0;
-  double duration_s = 0, fps = 0;
-  std::vector<uint8_t> last_rgba;  ///< the last frame, RGBA
-};
-
-Decoded decode(const std::string& path) {
-  Decoded d;
-  AVFormatContext* fmt = nullptr;
-  if (avformat_open_input(&fmt, path.c_str(), nullptr, nullptr) < 0) return d;
-  avformat_find_stream_info(fmt, nullptr);
-  const int si = av_find_best_stream(fmt, AVMEDIA_TYPE_VIDEO, -1, -1, nullptr, 0);
-  if (si < 0) return avformat_close_input(&fmt), d;
-  const AVStream* st = fmt->streams[si];
-  d.codec = st->codecpar->codec_id;
-  d.width = st->codecpar->width;
-  d.height = st->codecpar->height;
-  d.duration_s = st->duration * av_q2d(st->time_base);
-  d.fps = av_q2d(st->avg_frame_rate);
-  const AVCodec* codec = avcodec_find_decoder(d.codec);
-  AVCodecContext* ctx = avcodec_alloc_context3(codec);
-  avcodec_parameters_to_context(ctx, st->codecpar);
-  avcodec_open2(ctx, codec, nullptr);
-  AVPacket* pkt = av_packet_alloc();
-  AVFrame* frame = av_frame_alloc();
-  auto drain = [&] {
-    while (avcodec_receive_frame(ctx, frame) == 0) {
-      ++d.frames;
-      // YUV 4:2:0, BT.601 limited range, to RGBA by the formulas (independent of the writer's swscale).
-      d.last_rgba.assign(size_t(frame->width) * frame->height * 4, 255);
-      if (frame->format != AV_PIX_FMT_YUV420P) continue;
-      for (int y = 0; y < frame->height; ++y)
-        for (int x = 0; x < frame->width; ++x) {
-          const double Y = 1.164 * (frame->data[0][y * frame->linesize[0] + x] - 16.0);
-          const double U = frame->data[1][(y / 2) * frame->linesize[1] + x / 2] - 128.0;
-          const double V = frame->data[2][(y / 2) * frame->linesize[2] + x / 2] - 128.0;
-          const double rgb[3] = {Y + 1.596 * V, Y - 0.813 * V - 0.391 * U, Y + 2.018 * U};
-          for (int c = 0; c < 3; ++c)
-            d.last_rgba[(size_t(y) * frame->width + x) * 4 + c] = uint8_t(std::lround(std::clamp(rgb[c], 0.0, 255.0)));
-        }
-    }
-  };
-  while (av_read_frame(fmt, pkt) >= 0) {
-    if (pkt->stream_index == si) {
-      avcodec_send_packet(ctx, pkt);
-      drain();
-    }
-    av_packet_unref(pkt);
-  }
-  avcodec_send_packet(ctx, nullptr);
-  drain();
-  av_frame_free(&frame);
-  av_packet_free(&pkt);
-  avcodec_free_context(&ctx);
-  avformat_close_input(&fmt);
-  return d;
+  const RunResult r = wb::test::run_cli(args);
+  *code = r.exit_code;
+  return r.output;
 }
 
 }  // namespace
@@ -114,7 +48,7 @@ TEST(Cli, ReplayWritesATimeLapseVideo) {
   std::ifstream f(stats);
   const double sim_time = nlohmann::json::parse(f)["sim_time_s"].get<double>();
 
-  const Decoded d = decode(mp4);
+  const DecodedVideo d = decode_video(mp4);
   const PngPixels p = read_png(png);
   EXPECT_EQ(d.codec, AV_CODEC_ID_H264) << "Debian's libavcodec encodes H.264 with libx264";
   EXPECT_EQ(d.width, p.width + (p.width & 1));
