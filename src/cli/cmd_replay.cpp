@@ -210,6 +210,7 @@ SimConfig replay_config(const ReplayArgs& a, const Stroke& stroke, const Device&
   } else if (stroke.window) {
     cfg.window = Int3{(*stroke.window)[0], (*stroke.window)[1], std::min((*stroke.window)[2], stroke.canvas.depth)};
   }
+  if (stroke.tilt) cfg.params.grid.tilt = *stroke.tilt;  // the canvas's; a parameter file or --set overrides it
   if (!a.params_file.empty()) {
     std::ifstream f(a.params_file);
     WB_REQUIRE(f.good(), "cannot read parameter file '" + a.params_file + "'");
@@ -390,6 +391,8 @@ int run_replay(const ReplayArgs& a) {
         {"step_median", prof.median_ms("sim.step")}};
     j["nonfinite_events"] = nonfinite;
     j["zone_cut_steps"] = sim.counters().zone_cut_steps;
+    j["split_steps"] = sim.counters().split_steps;
+    j["step_parts"] = sim.counters().step_parts;
     j["warnings"] = stroke.warnings;
     write_file_atomic(a.stats, j.dump(2) + "\n");
   }

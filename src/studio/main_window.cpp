@@ -151,6 +151,13 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   // Pen input -> session clock -> simulation thread.
   connect(view_, &CanvasView::penPress, this, [this](PenInput p, double t) {
     carry_brush(false);
+    if (paint_panel_->reload_each_stroke()) {
+      // A clean brush loaded from the selected well; events in the recording, so a replay does the same.
+      StrokeEvent clean;
+      clean.kind = StrokeEventKind::Clean;
+      push_clock(clock_.event(clean));
+      push_clock(clock_.event(dip_event(paint_panel_->current_paint())));
+    }
     push_clock(clock_.press(p, t, wall_now()));
   });
   connect(view_, &CanvasView::penMove, this, [this](PenInput p, double t) { push_clock(clock_.move(p, t, wall_now())); });
@@ -192,6 +199,11 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
     palette_->restart_clock();
   });
   paint_panel_ = new PaintPanel;
+  paint_panel_->set_reload_each_stroke(
+      QSettings(options_.data_dir + "/studio.ini", QSettings::IniFormat).value("reload_each_stroke", true).toBool());
+  connect(paint_panel_, &PaintPanel::reloadToggled, this, [this](bool on) {
+    QSettings(options_.data_dir + "/studio.ini", QSettings::IniFormat).setValue("reload_each_stroke", on);
+  });
   connect(paint_panel_, &PaintPanel::dip, this, [this](PaintLoad p) { dip(p); });
   connect(paint_panel_, &PaintPanel::wipe, this, [this](float f) { wipe(f); });
   connect(paint_panel_, &PaintPanel::clean, this, [this] { clean_brush(); });
@@ -451,6 +463,14 @@ void MainWindow::build_menus() {
 
   QMenu* canvas = menuBar()->addMenu("&Canvas");
   canvas->addAction("&Dry canvas", QKeySequence(Qt::CTRL | Qt::Key_D), this, [this] { dry_canvas(); });
+  canvas->addAction("Easel &tilt\u2026", this, [this] {
+    bool ok = false;
+    const double deg = QInputDialog::getDouble(this, "Easel tilt",
+                                               "Tilt of the canvas from the table, degrees (0 flat, 90 upright on an "
+                                               "easel):\nwet paint runs down the canvas as gravity and its stiffness decide.",
+                                               double(tilt_), 0.0, 90.0, 0, &ok);
+    if (ok) set_tilt(float(deg));
+  });
   canvas->addAction("D&ip brush", QKeySequence(Qt::Key_D), this, [this] { dip(paint_panel_->current_paint()); });
   canvas->addAction("&Wipe brush", QKeySequence(Qt::Key_W), this, [this] { wipe(0.5f); });
   canvas->addAction("&Clean brush", QKeySequence(Qt::Key_C), this, [this] { clean_brush(); });
@@ -511,14 +531,16 @@ void MainWindow::send_event(StrokeEvent e) {
   push_clock(clock_.event(e));
 }
 
-void MainWindow::dip(const PaintLoad& p) {
+StrokeEvent MainWindow::dip_event(const PaintLoad& p) {
   StrokeEvent e;
   e.kind = StrokeEventKind::Dip;
   for (int c = 0; c < 3; ++c) e.ryb[c] = p.ryb[c];
   e.oil = p.oil;
   e.load = p.load;
-  send_event(e);
+  return e;
 }
+
+void MainWindow::dip(const PaintLoad& p) { send_event(dip_event(p)); }
 
 void MainWindow::wipe(float fraction) {
   StrokeEvent e;
@@ -592,6 +614,20 @@ std::optional<std::array<float, 3>> MainWindow::pick_color(QPointF canvas, SimTh
 QString MainWindow::ground_refusal(int width, int height, const CanvasGround& g) const {
   const std::string why = wb::ground_refusal(g, width, height, options_.preset.canvas_depth, GridParams{}.cell_size);
   return why.empty() ? QString() : QString::fromStdString(why) + ". Choose less relief, a smaller canvas or a smooth board.";
+}
+
+void MainWindow::set_tilt(float degrees) {
+  tilt_ = degrees;
+  // The palette stays on the table; the canvas's simulator is made anew with the painting on it.
+  sim_->post([degrees](SimThread& s) {
+    SimConfig c = s.config();
+    c.params.grid.tilt = degrees;
+    s.rebuild(c, true);
+  });
+  clock_.restart();
+  statusBar()->showMessage(degrees > 0.f ? QString("Canvas tilted %1\u00b0 from the table").arg(double(degrees), 0, 'f', 0)
+                                         : QString("Canvas flat on the table"),
+                           5000);
 }
 
 void MainWindow::new_canvas(int width, int height, QColor paper, const CanvasGround& ground) {

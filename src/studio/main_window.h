@@ -71,10 +71,15 @@ class MainWindow : public QMainWindow {
   bool save_recording(const QString& path);
   /// A new canvas, primed with `ground` (a smooth ground lays nothing).
   void new_canvas(int width, int height, QColor paper, const CanvasGround& ground = {});
+  /// The canvas's tilt from the table, degrees in [0, 90] (GridParams::tilt): the canvas's
+  /// simulator is made anew with the painting on it; the palette stays flat.
+  void set_tilt(float degrees);
+  float tilt() const { return tilt_; }
   /// Why a canvas of this size cannot take this ground (too thick for the paint depth, or more
   /// paint than a painting may hold); empty when it can.
   QString ground_refusal(int width, int height, const CanvasGround& ground) const;
   void dip(const PaintLoad& p);
+  static StrokeEvent dip_event(const PaintLoad& p);
   void wipe(float fraction);
   void clean_brush();
   void dry_canvas();
@@ -131,6 +136,7 @@ class MainWindow : public QMainWindow {
   PaintPanel* paint_panel_ = nullptr;
   PalettePanel* palette_ = nullptr;
   bool brush_on_palette_ = false;
+  float tilt_ = 0.f;  ///< the canvas's tilt from the table, degrees
   ViewPanel* view_panel_ = nullptr;
   BrushPreview* brush_preview_ = nullptr;
   QUndoStack* undo_ = nullptr;

@@ -232,6 +232,12 @@ PaintPanel::PaintPanel(QWidget* parent) : QWidget(parent) {
   buttons->addWidget(wipe_b);
   buttons->addWidget(clean_b);
   v->addLayout(buttons);
+  reload_ = new QCheckBox("Reload each stroke");
+  reload_->setChecked(true);
+  reload_->setToolTip("On: each stroke starts with a clean brush loaded from the selected well.\n"
+                      "Off: the brush keeps its paint from stroke to stroke; Dip, Wipe and Clean change it.");
+  v->addWidget(reload_);
+  connect(reload_, &QCheckBox::toggled, this, [this](bool on) { Q_EMIT reloadToggled(on); });
   auto* row = new QHBoxLayout;
   row->addWidget(new QLabel("Brush:"));
   brush_swatch_ = new QLabel;
@@ -247,6 +253,10 @@ PaintPanel::PaintPanel(QWidget* parent) : QWidget(parent) {
   select(0);
   show_brush(ryb_[0], 0.f);
 }
+
+bool PaintPanel::reload_each_stroke() const { return reload_->isChecked(); }
+
+void PaintPanel::set_reload_each_stroke(bool on) { reload_->setChecked(on); }
 
 void PaintPanel::select(int i) {
   current_ = i;

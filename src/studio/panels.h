@@ -12,6 +12,7 @@
 #include "core/brush/brush_spec.h"
 #include "core/io/stroke.h"
 
+class QCheckBox;
 class QComboBox;
 class QDoubleSpinBox;
 class QSpinBox;
@@ -65,11 +66,16 @@ class PaintPanel : public QWidget {
   int well_count() const { return int(wells_.size()); }
   /// Shows the brush's paint: mixed colour (RYB) and load in [0, 1].
   void show_brush(const std::array<float, 3>& ryb, float amount);
+  /// On: every stroke on the canvas starts with a clean brush loaded from the selected well.
+  /// Off: the brush keeps what it carries; Dip, Wipe and Clean change it.
+  bool reload_each_stroke() const;
+  void set_reload_each_stroke(bool on);
 
  Q_SIGNALS:
   void dip(wb::PaintLoad paint);
   void wipe(float fraction);
   void clean();
+  void reloadToggled(bool on);
 
  private:
   void select(int i);
@@ -79,6 +85,7 @@ class PaintPanel : public QWidget {
   QSlider* oil_ = nullptr;
   QSlider* amount_ = nullptr;
   QLabel* brush_swatch_ = nullptr;
+  QCheckBox* reload_ = nullptr;
 };
 
 class ViewPanel : public QWidget {

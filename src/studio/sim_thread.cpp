@@ -153,6 +153,7 @@ void SimThread::begin_recording(bool from_blank) {
   header.brush = config_.brush;
   header.paint = paint_;
   header.ground = ground_;
+  if (config_.params.grid.tilt > 0.f) header.tilt = config_.params.grid.tilt;
   header.paint.reload_on_pen_down = false;  // the studio's brush stays dirty between strokes
   const Vec3 paper = renderer_.params().paper_rgb;
   header.paper_rgb = std::array<float, 3>{paper.x, paper.y, paper.z};

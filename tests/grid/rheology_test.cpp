@@ -220,4 +220,48 @@ TEST_F(RheologyTest, DropSlumpsOnASteepSlopeAndHoldsOnAGentleOne) {
   EXPECT_LT(std::fabs(drop_on_slope(device_, 0.1f)), 0.3f);
 }
 
+namespace {
+/// A bead of paint 2 mm (10 cells) on a side on a bare canvas tilted `tilt` degrees from the
+/// table, left alone 2 s. Returns how far its centre of mass moved down the canvas (+y) and
+/// across it (x), cells.
+std::pair<float, float> bead_on_easel(const Device& device, float oil, float tilt) {
+  TileStore canvas(device, CanvasDims{64, 160, 32});
+  GridParams p;
+  p.tilt = tilt;
+  // Room to run down the canvas; flat, the bead in the middle of the window, whose walls are
+  // as far on every side.
+  Grid g(canvas, p, Int3{32, tilt > 0.f ? 120 : 32, 16}, Int3{0, 0, 0});
+  paint_cells(g, [](int i, int j, int k) { return i >= 11 && i < 21 && j >= 11 && j < 21 && k < 10 ? 1.f : 0.f; }, oil);
+  const GridDims d = g.dims();
+  auto centre = [&] {
+    const auto rho = host_density(g);
+    double m = 0, x = 0, y = 0;
+    for (size_t c = 0; c < rho.size(); ++c) {
+      int i, j, k;
+      d.decompose_cell(int64_t(c), i, j, k);
+      m += rho[c], x += rho[c] * (i + 0.5), y += rho[c] * (j + 0.5);
+    }
+    return std::pair<double, double>(x / m, y / m);
+  };
+  const auto [x0, y0] = centre();
+  for (int s = 0; s < int(std::lround(2.f / p.dt)); ++s) g.step(p.dt);
+  const auto [x1, y1] = centre();
+  std::printf("[ easel ] oil %.1f, canvas tilted %2.0f deg: the bead's centre moved %.2f cells down the canvas, "
+              "%.2f across, in 2 s\n", oil, tilt, y1 - y0, x1 - x0);
+  return {float(y1 - y0), float(x1 - x0)};
+}
+}  // namespace
+
+TEST_F(RheologyTest, OilyPaintRunsDownAnUprightCanvasStiffPaintStays) {
+  // Upright, a 2 mm bead pulls its base with rho0 g h = 20 Pa: far above oily paint's yield stress
+  // (oil 0.9: 0.2 Pa), below stiff paint's (oil 0.1: 135 Pa). Flat, neither moves sideways.
+  EXPECT_GE(bead_on_easel(device_, 0.9f, 90.f).first, 25.f) << "oily paint runs 5 mm down in 2 s";
+  EXPECT_LE(std::fabs(bead_on_easel(device_, 0.1f, 90.f).first), 1.f) << "stiff paint stays within 0.2 mm";
+  for (float oil : {0.9f, 0.1f}) {
+    const auto [down, across] = bead_on_easel(device_, oil, 0.f);
+    EXPECT_LE(std::fabs(down), 0.25f) << oil;
+    EXPECT_LE(std::fabs(across), 0.25f) << oil;
+  }
+}
+
 }  // namespace wb::test

@@ -233,6 +233,27 @@ TEST(StrokeJson, SimulationWindowIsReadCheckedAndKept) {
   EXPECT_THROW(parse_stroke_json(with_window("[4096, 160, 32]"), "w.json"), Error);
 }
 
+TEST(StrokeJson, CanvasTiltIsReadCheckedAndKept) {
+  auto with_tilt = [](const std::string& t) {
+    return R"({"format": "wetbrush-stroke", "version": 1, "canvas": {"width": 512, "height": 512, "tilt": )" + t +
+           R"(}, "samples": [{"t": 0, "x": 10, "y": 10, "pressure": 0.5}]})";
+  };
+  const Stroke st = parse_stroke_json(with_tilt("75"), "t.json");
+  ASSERT_TRUE(st.tilt.has_value());
+  EXPECT_EQ(*st.tilt, 75.f);
+  EXPECT_EQ(parse_stroke_json(stroke_to_json_string(st), "again.json").tilt, st.tilt);
+  EXPECT_FALSE(parse_stroke_json(R"({"format": "wetbrush-stroke", "version": 1, "canvas": {"width": 64, "height": 64},
+      "samples": [{"t": 0, "x": 10, "y": 10, "pressure": 0.5}]})", "flat.json").tilt.has_value());
+  for (const char* bad : {"-5", "91", "\"upright\"", "null"}) {
+    try {
+      parse_stroke_json(with_tilt(bad), "t.json");
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("tilt"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(StrokeJson, SaveLoadRoundTrip) {
   Stroke a = load_stroke(fixture("good/full.json"));
   a.samples[2].x = 123.456789f;  // not a short decimal

@@ -311,6 +311,34 @@ TEST_F(StrokePropertiesTest, SameStrokeAtAnySpeedLaysTheSameLayer) {
   for (double c : cover) EXPECT_GE(c, 0.9);
 }
 
+TEST_F(StrokePropertiesTest, AFlickLaysPaintAlongItsWholePath) {
+  // 2 m/s (10 000 cells/s): the brush sweeps 167 cells a step, more than three times the
+  // 48-cell window. Laid only where the window stood, the paint came in window-wide blocks with
+  // hard edges and gaps between them; each part of a split step now places the window anew
+  // (Simulator::step, docs/GRID.md "Flicks").
+  SimCounters counters;
+  Stroke st;
+  st.speed = 10000.f;
+  st.max_move = 3.f;
+  st.counters = &counters;
+  const std::vector<float> col = paint_stroke(st);
+  const std::vector<double> v = per_length(col);
+  const double cover = coverage(col);
+  // The largest change of the paint per unit length from one column to the next, against the
+  // body's median: a window's edge is a step as deep as the stroke.
+  std::vector<double> body(v.begin() + kBody0, v.begin() + kBody1), jumps;
+  for (int x = kBody0; x + 1 < kBody1; ++x) jumps.push_back(std::fabs(v[size_t(x) + 1] - v[size_t(x)]));
+  std::nth_element(body.begin(), body.begin() + body.size() / 2, body.end());
+  const double median = body[body.size() / 2], worst = *std::max_element(jumps.begin(), jumps.end());
+  std::printf("flick at 2 m/s: coverage %.1f %%, paint per cell of track: median %.2f, largest change between "
+              "columns %.2f; %lld of %lld steps in %lld parts\n",
+              100 * cover, median, worst, (long long)counters.split_steps, (long long)counters.steps,
+              (long long)counters.step_parts);
+  EXPECT_GT(counters.split_steps, 0);
+  EXPECT_GE(cover, 0.95) << "the whole path is painted";
+  EXPECT_LT(worst, 0.5 * median) << "no edge where a window stood";
+}
+
 TEST_F(StrokePropertiesTest, ConstantSpeedLeavesNoStepPattern) {
   // 60 mm/s: a step moves the brush 5 cells, so a deposit made per step would repeat every 5
   // cells along the track. Over the 80-cell body that is bin 16 of the spectrum of the paint

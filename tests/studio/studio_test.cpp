@@ -16,6 +16,7 @@
 #include <QMenuBar>
 #include <QFile>
 #include <QMessageBox>
+#include <QSettings>
 #include <QOpenGLContext>
 #include <QOpenGLWidget>
 #include <QProcess>
@@ -744,6 +745,7 @@ class StudioTest : public QObject {
     // (docs/STUDIO.md "Palette").
     w_->new_canvas(kW, kH, QColor(240, 235, 225));
     w_->settle();
+    w_->paint_panel()->set_reload_each_stroke(false);  // the brush keeps the palette's mix
     PalettePanel* pal = w_->palette();
     on_thread(*pal->sim(), [](SimThread& s) {
       s.write_canvas([](TileStore& c) { c.clear(); });
@@ -850,8 +852,71 @@ class StudioTest : public QObject {
     QVERIFY2(pp->well_ryb(1) == got, "picking bare canvas leaves the well");
   }
 
+  void easelTiltGoesIntoTheSimulationAndTheRecording() {
+    // Canvas > Easel tilt: the canvas's simulator turns its gravity (grid, particles, bristles)
+    // with the canvas, and the recording keeps the tilt, so a replay paints on the same easel.
+    grid_only_canvas(false);
+    w_->set_tilt(90.f);
+    w_->settle();
+    const SimConfig c = on_sim(*w_, [](SimThread& s) { return s.sim().config(); });
+    QCOMPARE(c.params.grid.tilt, 90.f);
+    QVERIFY(c.params.particles.gravity.y > 49000.f && std::fabs(c.params.particles.gravity.z) < 1.f);
+    const float palette_tilt = on_thread(*w_->palette()->sim(), [](SimThread& s) { return s.sim().config().params.grid.tilt; });
+    QCOMPARE(palette_tilt, 0.f);
+    stroke(40.f, 0.6f);
+    const QString rec = dir_->path() + "/easel.json";
+    QVERIFY(w_->save_recording(rec));
+    const Stroke st = load_stroke(rec.toStdString());
+    QVERIFY(st.tilt.has_value());
+    QCOMPARE(*st.tilt, 90.f);
+    w_->set_tilt(0.f);
+    w_->settle();
+    QCOMPARE(on_sim(*w_, [](SimThread& s) { return s.sim().config().params.grid.tilt; }), 0.f);
+  }
+
+  void reloadEachStrokeLoadsTheSelectedWell() {
+    // On (the default): every stroke paints the selected well's colour, whatever the brush held;
+    // off: the brush keeps its paint from stroke to stroke. The choice is kept in studio.ini.
+    grid_only_canvas(false);
+    PaintPanel* pp = w_->paint_panel();
+    QVERIFY(pp->reload_each_stroke());
+    const std::array<float, 3> blue{0.05f, 0.1f, 0.9f}, yellow{0.05f, 0.9f, 0.05f}, red{0.9f, 0.1f, 0.05f};
+    const auto wet = [&] {
+      return on_sim(*w_, [](SimThread& s) {
+        TileStore c = s.sim().settled_canvas_copy(Device{});
+        return wet_pigment(c);
+      });
+    };
+    const auto near = [](Vec3 a, const std::array<float, 3>& b) {
+      return std::max({std::fabs(a.x - b[0]), std::fabs(a.y - b[1]), std::fabs(a.z - b[2])});
+    };
+    pp->set_well_ryb(pp->current_well(), blue);
+    stroke(30.f, 0.6f);
+    const auto [first, m1] = wet();
+    w_->dry_canvas();
+    w_->settle();
+    pp->set_well_ryb(pp->current_well(), yellow);
+    stroke(60.f, 0.6f);
+    const auto [second, m2] = wet();
+    w_->dry_canvas();
+    w_->settle();
+    pp->set_reload_each_stroke(false);
+    pp->set_well_ryb(pp->current_well(), red);
+    stroke(90.f, 0.6f);
+    const auto [third, m3] = wet();
+    qInfo("reload on: blue stroke RYB %.2f %.2f %.2f (%.1f cells), yellow %.2f %.2f %.2f (%.1f); off, red well: "
+          "%.2f %.2f %.2f (%.1f)",
+          first.x, first.y, first.z, m1, second.x, second.y, second.z, m2, third.x, third.y, third.z, m3);
+    QVERIFY(m1 > 1.0 && m2 > 1.0 && m3 > 1.0);
+    QVERIFY2(near(first, blue) < 0.05f, "the first stroke paints the well");
+    QVERIFY2(near(second, yellow) < 0.05f, "reloaded: the yellow well, none of the blue");
+    QVERIFY2(near(third, yellow) < 0.1f, "not reloaded: the brush's yellow, not the red well");
+    QVERIFY(!QSettings(dir_->path() + "/data/studio.ini", QSettings::IniFormat).value("reload_each_stroke").toBool());
+  }
+
   void brushPreviewShowsTheBrushAndItsPaint() {
     grid_only_canvas(false);
+    w_->paint_panel()->set_reload_each_stroke(false);  // the dip's fill, not the well's
     BrushPreview* bp = w_->brush_preview();
     const auto wait_for = [&](const std::function<bool()>& ok) {
       QElapsedTimer t;
@@ -1196,6 +1261,7 @@ class StudioTest : public QObject {
       return n;
     });
     grid_only_canvas(false);
+    w_->paint_panel()->set_reload_each_stroke(false);  // a dirty brush: the dip and the wipe are the events
     PaintLoad red = w_->paint_panel()->current_paint();
     red.ryb[0] = 0.9f, red.ryb[1] = 0.1f, red.ryb[2] = 0.f;
     w_->dip(red);

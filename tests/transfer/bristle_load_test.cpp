@@ -75,6 +75,35 @@ TEST_F(BristleLoadTest, DipMixesIntoWhatIsThere) {
   EXPECT_NEAR(load.to_host().pigment_r[0], 0.f, 1e-6f);
 }
 
+// The share x_j the well reaches is replaced by the well's paint, then the sample is topped up;
+// the rest of its paint stays, and the brush's mass changes only by the top-up.
+TEST_F(BristleLoadTest, DipReplacesTheShareTheWellReaches) {
+  TransferParams prm;
+  BristleLoad load(device_, 4, prm);
+  const Vec3 red(1.f, 0.f, 0.f), blue(0.f, 0.f, 1.f);
+  load.fill(paint(red, 0.2f, 1.f));
+  BristleLoadHost h = load.to_host();
+  h.m[1] *= 0.5f, h.m[3] *= 0.5f;  // half-empty samples
+  load.from_host(h);
+  load.set_dip_exchange({0.f, 0.f, 0.6f, 0.6f});
+  const double added = load.dip(paint(blue, 0.6f, 1.f));
+  EXPECT_NEAR(added, prm.M_max, 1e-6 * prm.M_max) << "two half-empty samples topped up";
+  h = load.to_host();
+  const float M = prm.M_max;
+  EXPECT_NEAR(h.m[0], M, 1e-6f * M);
+  EXPECT_EQ(h.pigment_r[0], 1.f) << "a full sample the well does not reach keeps its paint";
+  EXPECT_NEAR(h.pigment_b[1], color_mix(red, blue, 0.5f, 0.5f).z, 1e-5f) << "topped up only";
+  const Vec3 c2 = color_mix(red, blue, 0.4f, 0.6f);  // full, 0.6 of it replaced
+  EXPECT_NEAR(h.pigment_r[2], c2.x, 1e-5f);
+  EXPECT_NEAR(h.pigment_b[2], c2.z, 1e-5f);
+  EXPECT_NEAR(h.oil[2], 0.4f * 0.2f + 0.6f * 0.6f, 1e-5f);
+  const Vec3 c3 = color_mix(red, blue, 0.2f, 0.8f);  // half full: 0.3 replaced, 0.5 added
+  EXPECT_NEAR(h.pigment_b[3], c3.z, 1e-5f);
+  for (float m : h.m) EXPECT_NEAR(m, M, 1e-6f * M);
+  EXPECT_THROW(load.set_dip_exchange({0.f, 0.f, 1.5f, 0.f}), Error);
+  EXPECT_THROW(load.set_dip_exchange({0.f}), Error);
+}
+
 TEST_F(BristleLoadTest, WipeRemovesTheFractionAndCleanEmpties) {
   TransferParams prm;
   BristleLoad load(device_, 500, prm);

@@ -173,4 +173,26 @@ BristleLayout build_bristle_layout(const BrushSpec& spec) {
   return L;
 }
 
+std::vector<float> dip_exposure(const BristleLayout& L, int S, float depth) {
+  const int V = L.per_bristle;
+  std::vector<float> out(size_t(L.bristles) * size_t(S), 0.f);
+  if (L.bristles == 0 || V < 2 || S < 2 || !(depth > 0.f)) return out;
+  float lowest = 0.f, half_x = 0.f, half_y = 0.f;
+  for (const Vec3& p : L.rest) lowest = std::min(lowest, p.z);
+  for (const Vec3& r : L.root) half_x = std::max(half_x, std::fabs(r.x)), half_y = std::max(half_y, std::fabs(r.y));
+  for (int k = 0; k < L.bristles; ++k) {
+    const Vec3 r = L.root[size_t(k)];
+    const float ex = half_x > 0.f ? r.x / half_x : 0.f, ey = half_y > 0.f ? r.y / half_y : 0.f;
+    const float outer = 1.f / 3.f + (2.f / 3.f) * std::min(1.f, std::sqrt(ex * ex + ey * ey));
+    for (int j = 0; j < S; ++j) {
+      const float sp = float(j) * float(V - 1) / float(S - 1);
+      const int i = std::min(int(sp), V - 2);
+      const float u = sp - float(i);
+      const float z = L.rest[size_t(k) * V + i].z * (1.f - u) + L.rest[size_t(k) * V + i + 1].z * u;
+      out[size_t(k) * S + j] = outer * std::clamp(1.f - (z - lowest) / depth, 0.f, 1.f);
+    }
+  }
+  return out;
+}
+
 }  // namespace wb

@@ -26,6 +26,13 @@ struct BristleLayout {
 /// Validates the spec (throws wb::Error naming the field) and builds its bristles.
 BristleLayout build_bristle_layout(const BrushSpec& spec);
 
+/// How much of each bristle sample's paint a dip reaches, in [0, 1], per sample
+/// (k * samples_per_bristle + j, j = 0 at the root): the brush pushed `depth` cells into a pile
+/// of paint tip first, in its rest pose. Linear in the sample's height above the tuft's lowest
+/// tip (1 there, 0 at `depth`) times the bristle's exposure in the tuft (1 on its outline, a
+/// third on its axis, by the root's elliptic radius). docs/TRANSFER.md "Dipping".
+std::vector<float> dip_exposure(const BristleLayout& layout, int samples_per_bristle, float depth);
+
 /// Length profile of the shape at a root (x across the width, in [-width/2, width/2]),
 /// as a fraction of spec.length: 1 for most shapes; oval for filbert; linear for angular.
 float shape_length_profile(BrushShape shape, float x, float width);

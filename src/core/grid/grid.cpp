@@ -49,7 +49,9 @@ void advect_vel_d(const Device& d, GridView g, const float* u, const float* v, c
   WB_REQUIRE(g.extent, "grid advection: the velocity's extent is not set");
   WB_DISPATCH(d, grid_advect_velocity(g, u, v, w, dt));
 }
-void gravity_d(const Device& d, GridView g, float* ph, float g_dt) { WB_DISPATCH(d, grid_gravity(g, ph, g_dt)); }
+void gravity_d(const Device& d, GridView g, float* ph, float g_dt, float g_dt_y) {
+  WB_DISPATCH(d, grid_gravity(g, ph, g_dt, g_dt_y));
+}
 void mu_d(const Device& d, GridView g, JointOil oil, HerschelBulkley s, HerschelBulkley o, float m, float* mu) {
   WB_DISPATCH(d, grid_effective_viscosity(g, oil, s, o, m, mu));
 }
@@ -141,6 +143,7 @@ void check_params(const GridParams& p) {
   WB_REQUIRE(p.viscosity_max_iterations >= 0 && p.viscosity_max_iterations <= 10000,
              "grid: viscosity_max_iterations must be in [0, 10000]");
   WB_REQUIRE(p.gravity >= 0.f && p.gravity <= 1e6f, "grid: gravity must be in [0, 1e6] cells/s^2");
+  WB_REQUIRE(p.tilt >= 0.f && p.tilt <= 90.f, "grid: the canvas tilt must be in [0, 90] degrees");
   WB_REQUIRE(p.liquid_threshold > 0.f && p.liquid_threshold <= 1.f, "grid: liquid_threshold must be in (0, 1]");
   WB_REQUIRE(p.dry_rate >= 0.f && p.dry_rate <= 1000.f, "grid: dry_rate must be in [0, 1000] /s");
   WB_REQUIRE(p.dry_threshold > 0.f && p.dry_threshold <= 1.f, "grid: dry_threshold must be in (0, 1]");
@@ -496,7 +499,8 @@ void Grid::add_external_forces(float dt) {
   for (int c = 0; c < 3; ++c)
     mem::copy_on_device(device(), vel_pre_[c].data(), v.vel[c], size_t(g.faces(c)) * sizeof(float));
   if (params_.gravity <= 0.f) return;
-  gravity_d(device(), view(), cell_tmp_.data(), params_.gravity * dt);
+  const Vec3 gv = params_.gravity_vector();
+  gravity_d(device(), view(), cell_tmp_.data(), -gv.z * dt, gv.y * dt);
 }
 
 void Grid::apply_viscosity(float dt) {

@@ -223,7 +223,7 @@ class Grid {
                         int32_t* halo, int64_t* counts, int32_t* below);                                             \
   void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst, bool reads);   \
   void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt);                  \
-  void grid_gravity(GridView g, float* ph, float g_dt);                                                              \
+  void grid_gravity(GridView g, float* ph, float g_dt, float g_dt_y);                                                            \
   void grid_effective_viscosity(GridView g, JointOil oil, HerschelBulkley stiff, HerschelBulkley oily, float m,    \
                                 float* mu);                                                                          \
   void grid_viscous_flags(GridView g, uint32_t* flag);                                                               \

@@ -347,7 +347,7 @@ void grid_advect_velocity(GridView g, const float* u, const float* v, const floa
   });
 }
 
-void grid_gravity(GridView g, float* ph, float g_dt) {
+void grid_gravity(GridView g, float* ph, float g_dt, float g_dt_y) {
   const GridDims d = g.d;
   // Hydrostatic head of each liquid cell: contiguous liquid cells from it to the surface.
   const GridExtent* e = g.extent;
@@ -370,7 +370,7 @@ void grid_gravity(GridView g, float* ph, float g_dt) {
     face_cells(d, c, i, j, k, a, b, ha, hb);
     const bool la = ha && g.cls[a] == kCellLiquid, lb = hb && g.cls[b] == kCellLiquid;
     if (!la && !lb) return;
-    g.vel[c][f] += gravity_face_impulse(c, la, lb, la ? ph[a] : 0.f, lb ? ph[b] : 0.f, g_dt);
+    g.vel[c][f] += gravity_face_impulse(c, la, lb, la ? ph[a] : 0.f, lb ? ph[b] : 0.f, g_dt, g_dt_y);
   });
 }
 

@@ -2,6 +2,9 @@
 // One POD, passed by value to the stage drivers. Units: lengths in canvas cells
 // (1 cell = 0.2 mm), velocities in cells/s, time in s.
 #pragma once
+#include <cmath>
+
+#include "core/math/vec.h"
 
 namespace wb {
 
@@ -71,6 +74,17 @@ struct GridParams {
   /// Applied with its hydrostatic pressure split off per column (docs/GRID.md), so resting paint
   /// feels no net force whatever the solver's accuracy; what is left is held by the yield stress.
   float gravity = 49050.f;
+  /// The canvas's tilt from the horizontal, degrees: 0 flat on a table, 90 upright on an easel.
+  /// Gravity splits into g cos(tilt) across the canvas (-z, its hydrostatic part split off per
+  /// column) and g sin(tilt) in the canvas plane along +y, down the easel (the top view's rows
+  /// grow downwards); the particles and the bristles feel the same vector (gravity_vector).
+  /// Default 0, range [0, 90]. docs/GRID.md "The canvas on an easel".
+  float tilt = 0.f;
+  /// Gravity in the canvas frame, cells/s^2: (0, g sin(tilt), -g cos(tilt)).
+  Vec3 gravity_vector() const {
+    const float a = tilt * (3.14159265f / 180.f);
+    return Vec3(0.f, gravity * std::sin(a), -gravity * std::cos(a));
+  }
 
   // --- cell classes ---
   /// Density (volume fraction) at and above which a cell is liquid in the projection.

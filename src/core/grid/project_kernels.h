@@ -185,10 +185,13 @@ WB_HD WB_INLINE float extrapolated_face_velocity(const GridView& g, int c, int i
 /// surface, so its gradient cancels gravity exactly inside every resting liquid column)
 /// subtracted: -g dt e_z + (p_h(a) - p_h(b)) e_c. What is left (unsupported paint, columns of
 /// different heights) is resisted by the paint's viscosity, which holds it below the yield
-/// stress (rheology.h).
-WB_HD WB_INLINE float gravity_face_impulse(int c, bool la, bool lb, float ph_a, float ph_b, float g_dt) {
+/// stress (rheology.h). On a tilted canvas g_dt is the part across it (g cos(tilt) dt) and
+/// g_dt_y the part down its plane (g sin(tilt) dt, +y): nothing balances that one at rest but
+/// the yield stress and the canvas's grip through the viscosity.
+WB_HD WB_INLINE float gravity_face_impulse(int c, bool la, bool lb, float ph_a, float ph_b, float g_dt, float g_dt_y) {
   float f = (la ? ph_a : 0.f) - (lb ? ph_b : 0.f);
   if (c == 2) f -= g_dt;
+  if (c == 1) f += g_dt_y;
   return f;
 }
 

@@ -45,6 +45,9 @@ struct Stroke {
   CanvasDims canvas{};
   std::optional<std::array<float, 3>> paper_rgb;  ///< paper colour, linear RGB in [0, 1]
   std::optional<CanvasGround> ground;             ///< the canvas's priming (ground.h); unset: bare
+  /// The canvas's tilt from the horizontal, degrees in [0, 90] (GridParams::tilt); unset: the
+  /// replayer's parameters (flat on a table by default).
+  std::optional<float> tilt;
   BrushSpec brush{};
   PaintLoad paint{};
   std::vector<PenSample> samples;

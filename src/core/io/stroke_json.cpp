@@ -147,6 +147,8 @@ void validate_stroke(const Stroke& st) {
   WB_REQUIRE(st.max_move_per_substep >= 0.1f && st.max_move_per_substep <= 100.f,
              src + ": simulation.max_move_per_substep is outside [0.1, 100]");
   WB_REQUIRE(st.max_substeps >= 1 && st.max_substeps <= 1024, src + ": simulation.max_substeps is outside [1, 1024]");
+  WB_REQUIRE(!st.tilt || (std::isfinite(*st.tilt) && *st.tilt >= 0.f && *st.tilt <= 90.f),
+             src + ": canvas.tilt is outside [0, 90] degrees");
   WB_REQUIRE(st.lead_in >= 0 && st.lead_in <= 5 && st.lead_out >= 0 && st.lead_out <= 5,
              src + ": simulation.lead_in / lead_out must lie in [0, 5] seconds");
   for (size_t i = 0; i < st.samples.size(); ++i) {
@@ -231,6 +233,7 @@ Stroke parse_stroke_json(std::string_view text, const std::string& source) {
       c.fail("canvas " + std::to_string(st.canvas.width) + " x " + std::to_string(st.canvas.height) + " has more than " +
              std::to_string(kMaxCanvasCells) + " cells (16384 x 16384): refused");
     if (c.has("paper_rgb")) st.paper_rgb = c.triple("paper_rgb", 0.0, 1.0);
+    if (c.has("tilt")) st.tilt = float(c.number("tilt", 0.0, 90.0));
     if (c.has("ground")) {
       st.ground = ground_from_json(root.at("canvas").at("ground"), source, "canvas.ground");
       const std::string why =
@@ -281,6 +284,7 @@ std::string stroke_to_json_string(const Stroke& st) {
     canvas["paper_rgb"] = {float_for_json((*st.paper_rgb)[0]), float_for_json((*st.paper_rgb)[1]),
                            float_for_json((*st.paper_rgb)[2])};
   if (st.ground) canvas["ground"] = ground_to_json(*st.ground);
+  if (st.tilt) canvas["tilt"] = float_for_json(*st.tilt);
   const json paint = {{"ryb", {float_for_json(st.paint.ryb[0]), float_for_json(st.paint.ryb[1]), float_for_json(st.paint.ryb[2])}},
                       {"oil", float_for_json(st.paint.oil)},
                       {"load", float_for_json(st.paint.load)},

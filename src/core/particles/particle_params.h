@@ -26,6 +26,7 @@ struct ParticleParams {
   /// PIC weight of the velocity update (FLIP weight 1 - gamma). Default 0.8, range [0, 1]. Table 1, Eq. 11.
   float gamma = 0.8f;
   /// Gravity, cells/s^2, canvas frame (z up). Default 9.81 m/s^2 = 49050 cells/s^2 down, range |g| in [0, 49050]. Eq. 9.
+  /// The Simulator sets it from the grid's (GridParams::gravity_vector: magnitude and canvas tilt).
   Vec3 gravity = Vec3(0.f, 0.f, -49050.f);
   /// Height of the canvas surface (solid floor), cells. Default 0. Eq. 8 (d_k).
   float floor_z = 0.f;

@@ -41,6 +41,8 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
     : config_(config), profiler_(config.device), ws_(config.device) {
   const Device& d = config_.device;
   d.activate();
+  // One gravity for the paint, the particles and the bristles: the grid's, tilted with the canvas.
+  config_.params.particles.gravity = config_.params.grid.gravity_vector();
   // A run too large for the machine or the budget is refused here, before its first large
   // allocation; the particle store may grow into what the rest leaves.
   const int64_t particle_limit = check_memory(plan_memory(config_), config_, config_.params.particles.max_particles);
@@ -52,6 +54,10 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
   // This brush's bristles hold in proportion to their volume (Eq. 12's M_max).
   const TransferParams tp = config_.params.transfer.for_bristle_radius(config_.brush.bristle_radius);
   load_ = std::make_unique<BristleLoad>(d, brush_->sample_count(), tp);
+  std::vector<float> exchange = dip_exposure(brush_->layout(), config_.brush.samples_per_bristle,
+                                             tp.dip_depth * config_.brush.length);
+  for (float& x : exchange) x *= tp.dip_exchange;
+  load_->set_dip_exchange(exchange);
   transfer_ = std::make_unique<Transfer>(d, tp);
   const GridDims g = grid_->dims();
   auto cells = [&](DeviceBuffer<float>& b) {
@@ -358,11 +364,9 @@ Int3 Simulator::place_window(const std::array<float, 4>& before, const std::arra
   const float x0 = std::min(before[0], after[0]), x1 = std::max(before[1], after[1]);
   const float y0 = std::min(before[2], after[2]), y1 = std::max(before[3], after[3]);
   const Int3 n = grid_->window().dims();
-  const TransferParams& tp = config_.params.transfer;
-  const float block_error = float(tp.distance_block) * std::sqrt(3.f);
-  const float room = 0.5f * std::min(float(n.x) - (x1 - x0), float(n.y) - (y1 - y0)) - float(kKeepRim) -
-                     tp.return_margin - block_error - 0.5f * float(config_.params.grid.window_snap);
+  const float room = 0.5f * std::min(float(n.x) - (x1 - x0), float(n.y) - (y1 - y0)) - window_margin();
   const float D0 = config_.params.particles.D0;
+  const float block_error = float(config_.params.transfer.distance_block) * std::sqrt(3.f);
   const float floor_D0 = std::min(D0, transfer_->params().absorb_range() + block_error);
   zone_D0_ = std::clamp(room, floor_D0, D0);
   zone_room = room - floor_D0;
@@ -459,8 +463,52 @@ ParticleOverlay Simulator::particle_overlay() {
   return o;
 }
 
+float Simulator::window_margin() const {
+  const TransferParams& tp = config_.params.transfer;
+  return float(kKeepRim) + tp.return_margin + float(tp.distance_block) * std::sqrt(3.f) +
+         0.5f * float(config_.params.grid.window_snap);
+}
+
+int Simulator::parts_of_step(const BrushPose* poses, int substeps) const {
+  // The swept contact lays paint from where each sample was to where it is, inside the window
+  // (place_window centres it on the samples' box over the step). A sweep longer than the window
+  // holds beside the brush would be laid in window-sized blocks with gaps where the window stood:
+  // the step is cut into parts, each placing the window anew. The sweep is the pen's, known here
+  // (the tips' point of each pose); the brush's own extent is the samples' box of the last step.
+  const float L = config_.brush.length;
+  Vec3 lo = footprint_centre(brush_->pose(), L), hi = lo;
+  for (int i = 0; i < substeps; ++i) {
+    const Vec3 c = footprint_centre(poses[i], L);
+    lo = Vec3(std::min(lo.x, c.x), std::min(lo.y, c.y), 0.f), hi = Vec3(std::max(hi.x, c.x), std::max(hi.y, c.y), 0.f);
+  }
+  const float sweep = std::max(hi.x - lo.x, hi.y - lo.y);
+  const Int3 n = grid_->window().dims();
+  const float side = float(std::min(n.x, n.y));
+  const float brush = std::max(box_[1] - box_[0], box_[3] - box_[2]);
+  // The window is centred on the samples' box over the part within half a snap. A quarter of
+  // the room is kept for the bristles' lag behind the pen, which changes most as a flick speeds
+  // up; a brush too large for its window still moves a quarter window a part.
+  const float fits = std::max(0.75f * (side - brush - float(config_.params.grid.window_snap)), 0.25f * side);
+  return std::clamp(int(std::ceil(sweep / fits)), 1, substeps);
+}
+
 void Simulator::step(const BrushPose* pen_poses, int substeps, float dt) {
   WB_REQUIRE(substeps >= 1 && dt > 0.f && std::isfinite(dt), "Simulator::step: bad sub-step count or dt");
+  const int parts = parts_of_step(pen_poses, substeps);
+  if (parts > 1) ++counters_.split_steps, counters_.step_parts += parts;
+  ++counters_.steps;
+  counters_.substeps += substeps;
+  // Sub-steps are even in time: each part takes its share of them and of dt.
+  const int64_t cut = counters_.zone_cut_steps;
+  for (int p = 0, first = 0; p < parts; ++p) {
+    const int last = int((int64_t(substeps) * (p + 1)) / parts);
+    step_part(pen_poses + first, last - first, dt * float(last - first) / float(substeps));
+    first = last;
+  }
+  counters_.zone_cut_steps = cut + (counters_.zone_cut_steps > cut ? 1 : 0);  // steps, not parts
+}
+
+void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
   // The pen's poses measure the brush from the bare canvas (pose_from_pen); the brush meets the
   // dried paint under it first, so they are raised by its top (docs/TRANSFER.md "Scumble").
   lifted_.assign(pen_poses, pen_poses + substeps);
@@ -541,8 +589,6 @@ void Simulator::step(const BrushPose* pen_poses, int substeps, float dt) {
     books_.record(rec, record_census(rec));
   }
   clamp_particles_to_canvas();
-  ++counters_.steps;
-  counters_.substeps += substeps;
   last_dt_ = dt;
   counters_.particles_max = std::max(counters_.particles_max, particles_.size());
 }
@@ -582,6 +628,7 @@ void Simulator::brush_stage(const BrushPose* poses, int substeps, float dt) {
   DragField drag{win.velocity(0).data(), win.velocity(1).data(), win.velocity(2).data(), win.paint().density.data(),
                  n.x, n.y, n.z, o.x, o.y, o.z, config_.params.bristle_drag};
   BrushEnvironment env;
+  env.gravity = config_.params.particles.gravity;
   env.drag = config_.params.bristle_drag > 0.f ? &drag : nullptr;
   env.solid = solid_field();
   brush_->step(poses, substeps, dt, env);

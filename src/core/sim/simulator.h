@@ -47,6 +47,10 @@ struct SimCounters {
   /// Steps whose particle zone, at D0's floor, did not fit the window's kept box around the
   /// samples (the brush is too large for its window: Simulator::place_window).
   int64_t zone_cut_steps = 0;
+  /// Steps whose brush swept farther than the window holds, simulated in parts (step()), and
+  /// the parts they took in all.
+  int64_t split_steps = 0;
+  int64_t step_parts = 0;
   /// The least room seen for D0 around the samples, cells (negative: the zone was cut).
   float zone_room_min = 1e30f;
   /// Particles returned to the grid because the window moved off them (deposit_leaving_particles):
@@ -95,7 +99,9 @@ class Simulator {
 
   /// One time step of length dt (Figure 4): the brush runs `substeps` sub-steps ending at
   /// poses[0..substeps), then the paint (window, particles, joint fields, grid, FLIP/PIC,
-  /// transfer) runs once over the whole step.
+  /// transfer) runs once over the whole step. A brush sweeping farther in the step than the
+  /// window can hold around it (a flick) is simulated in as many parts of the step as keep each
+  /// part's sweep inside the window, its sub-steps shared among them (docs/GRID.md "Flicks").
   void step(const BrushPose* poses, int substeps, float dt);
   void step(const BrushPose& pose, float dt) { step(&pose, 1, dt); }
   /// Puts the brush at rest at `pose` (a new stroke after a lift, or a teleport).
@@ -198,6 +204,13 @@ class Simulator {
   /// the D0 that keeps the particle zone inside its kept box; `zone_room` is the room left for
   /// the zone at D0's floor, cells (negative: the window cuts it).
   Int3 place_window(const std::array<float, 4>& before, const std::array<float, 4>& after, float& zone_room);
+  /// What the window keeps around the samples' box on each side, cells: the kept rim, the
+  /// particles' return margin, the distance blocks' error and half a snap.
+  float window_margin() const;
+  /// How many parts of a step keep each part's sweep of the brush inside the window (step()).
+  int parts_of_step(const BrushPose* poses, int substeps) const;
+  /// One part of a step: step() in full for the poses' sub-steps.
+  void step_part(const BrushPose* pen_poses, int substeps, float dt);
 
   SimConfig config_;
   Profiler profiler_;

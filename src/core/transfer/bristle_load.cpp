@@ -14,8 +14,9 @@
 namespace wb {
 namespace {
 
-void d_dip(const Device& d, BristleLoadView l, Vec3 ryb, float oil, float level, int replace, float* added) {
-  WB_DISPATCH(d, transfer_load_dip(l, ryb, oil, level, replace, added));
+void d_dip(const Device& d, BristleLoadView l, const float* exchange, Vec3 ryb, float oil, float level, int replace,
+           float* added) {
+  WB_DISPATCH(d, transfer_load_dip(l, exchange, ryb, oil, level, replace, added));
 }
 void d_scale(const Device& d, BristleLoadView l, float keep, float* removed) {
   WB_DISPATCH(d, transfer_load_scale(l, keep, removed));
@@ -74,9 +75,17 @@ double BristleLoad::dip(const PaintLoad& paint) { return load(paint, false, "Bri
 double BristleLoad::load(const PaintLoad& paint, bool replace, const char* what) {
   validate(paint, what);
   if (count_ == 0) return 0.0;
-  d_dip(device_, view(), Vec3(paint.ryb[0], paint.ryb[1], paint.ryb[2]), paint.oil, paint.load, replace ? 1 : 0,
-        scratch_.data());
+  d_dip(device_, view(), exchange_.empty() ? nullptr : exchange_.data(), Vec3(paint.ryb[0], paint.ryb[1], paint.ryb[2]),
+        paint.oil, paint.load, replace ? 1 : 0, scratch_.data());
   return reduce_sum(device_, scratch_.data(), count_, ws_);
+}
+
+void BristleLoad::set_dip_exchange(const std::vector<float>& x) {
+  WB_REQUIRE(int64_t(x.size()) == count_, "BristleLoad::set_dip_exchange: one value a sample");
+  for (float v : x) WB_REQUIRE(std::isfinite(v) && v >= 0.f && v <= 1.f, "BristleLoad::set_dip_exchange: values in [0, 1]");
+  exchange_.set_device(device_);
+  exchange_.resize(x.size());
+  exchange_.copy_from_host(x.data(), x.size());
 }
 
 double BristleLoad::wipe(float fraction) {
@@ -90,7 +99,7 @@ double BristleLoad::wipe(float fraction) {
 double BristleLoad::clean() {
   if (count_ == 0) return 0.0;
   // A fill with nothing: no load, no pigment (white), no oil.
-  d_dip(device_, view(), Vec3(0.f, 0.f, 0.f), 0.f, 0.f, 1, scratch_.data());
+  d_dip(device_, view(), nullptr, Vec3(0.f, 0.f, 0.f), 0.f, 0.f, 1, scratch_.data());
   return -reduce_sum(device_, scratch_.data(), count_, ws_);
 }
 

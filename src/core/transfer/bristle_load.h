@@ -58,10 +58,14 @@ class BristleLoad {
   /// Eq. 12 from the last transfer step, M_max before it), colour paint.ryb, oil paint.oil.
   /// Returns the net change of the brush's paint, kg (what entered minus what it replaced).
   double fill(const PaintLoad& paint);
-  /// Dips the brush into a well of `paint` (dirty brush): every sample is topped up to
-  /// paint.load * M'_j with the new paint, mixed into what it holds (Algorithm 2 by mass, oil
-  /// by mass); a sample already above that level keeps its paint unchanged. Returns the kg added.
+  /// Dips the brush into a well of `paint` (dirty brush): the well's paint replaces the share
+  /// x_j (set_dip_exchange) of each sample's paint, then tops the sample up to paint.load * M'_j;
+  /// the old and the new paint mix (Algorithm 2 by mass, oil by mass). The replaced paint stays
+  /// in the well. Returns the net kg the brush gained.
   double dip(const PaintLoad& paint);
+  /// The share x_j in [0, 1] of each sample's paint a dip replaces (dip_exposure times
+  /// TransferParams::dip_exchange); size() values. Until set, a dip only tops up.
+  void set_dip_exchange(const std::vector<float>& x);
   /// Wipes the brush on a rag: removes `fraction` (in [0, 1]) of every sample's load. Returns the kg removed.
   double wipe(float fraction);
   /// Cleans the brush in solvent: no load, no pigment, no oil. Returns the kg removed.
@@ -97,6 +101,7 @@ class BristleLoad {
   Device device_;
   int64_t count_ = 0;
   DeviceBuffer<float> scratch_;
+  DeviceBuffer<float> exchange_;  ///< x_j of dip(); empty: a dip only tops up
   Workspace ws_;  ///< reduction scratch of fill / dip / wipe / clean, kept between calls
 };
 

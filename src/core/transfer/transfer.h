@@ -303,7 +303,8 @@ void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadVi
                             TransferParams prm, float dry_threshold);                                               \
   void transfer_product(const float* a, const float* b, float* out, int64_t n);                                   \
   void transfer_load_brightness(BristleLoadView load, float* out);                                                 \
-  void transfer_load_dip(BristleLoadView load, Vec3 ryb, float oil, float level, int replace, float* added);       \
+  void transfer_load_dip(BristleLoadView load, const float* exchange, Vec3 ryb, float oil, float level, int replace, \
+                         float* added);                                                                        \
   void transfer_load_scale(BristleLoadView load, float keep, float* removed);
 
 namespace cpu {

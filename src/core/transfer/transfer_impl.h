@@ -560,7 +560,8 @@ void transfer_load_brightness(BristleLoadView load, float* out) {
   });
 }
 
-void transfer_load_dip(BristleLoadView load, Vec3 ryb, float oil, float level, int replace, float* added) {
+void transfer_load_dip(BristleLoadView load, const float* exchange, Vec3 ryb, float oil, float level, int replace,
+                       float* added) {
   parallel_for(load.count, [=] WB_HD(int64_t j) {
     const float target = level * load.potential[j];
     const float m = load.m[j];
@@ -573,18 +574,23 @@ void transfer_load_dip(BristleLoadView load, Vec3 ryb, float oil, float level, i
       added[j] = target - m;
       return;
     }
-    const float add = target - m;
-    if (!(add > 0.f)) {
+    // The well's paint replaces the share x of the sample's paint that the pile reaches, then
+    // tops it up to the asked level; the rest of the old paint stays (docs/TRANSFER.md "Dipping").
+    const float m0 = maxf(m, 0.f);
+    const float x = exchange ? exchange[j] : 0.f;
+    const float keep = (1.f - x) * m0;
+    const float take = x * m0 + maxf(target - m0, 0.f);
+    if (!(take > 0.f)) {
       added[j] = 0.f;
       return;
     }
-    const Vec3 c = color_mix(Vec3(load.pigment_r[j], load.pigment_y[j], load.pigment_b[j]), ryb, maxf(m, 0.f), add);
+    const Vec3 c = color_mix(Vec3(load.pigment_r[j], load.pigment_y[j], load.pigment_b[j]), ryb, keep, take);
     load.pigment_r[j] = c.x;
     load.pigment_y[j] = c.y;
     load.pigment_b[j] = c.z;
-    load.oil[j] = (maxf(m, 0.f) * load.oil[j] + add * oil) / (maxf(m, 0.f) + add);
-    load.m[j] = target;
-    added[j] = target - m;
+    load.oil[j] = (keep * load.oil[j] + take * oil) / (keep + take);
+    load.m[j] = keep + take;
+    added[j] = keep + take - m;
   });
 }
 

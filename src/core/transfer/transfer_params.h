@@ -62,6 +62,18 @@ struct TransferParams {
   /// [0, 1]; 0 gives the paper's model (paint leaves only through Eq. 13).
   float split = 0.5f;
 
+  // --- dipping (beyond the paper: docs/TRANSFER.md "Dipping") ---
+  /// How deep the brush is pushed into a well of paint on the palette, tip first, as a share of
+  /// its bristles' length: samples within this height of the tuft's lowest tip go into the pile.
+  /// Default 0.5 (the painter's rule: load no more than half the bristles, never up to the
+  /// ferrule). Range [0, 1].
+  float dip_depth = 0.5f;
+  /// Share of a sample's paint that the pile's paint replaces at the tip of an outer bristle,
+  /// where the pile is all that touches it: pushing the tuft in scrapes its outside and tip and
+  /// presses the new paint in. Less higher up (linearly to 0 at dip_depth) and towards the tuft's
+  /// axis (a third there). Default 1, range [0, 1]; 0 only tops up (the paper's dirty brush).
+  float dip_exchange = 1.f;
+
   // --- bristle <-> particle (§5.1) ---
   /// Most particles one sample absorbs per step. Default 8, range [0, 1024]. §5.1 ("a limit on
   /// the maximum number of particles that can be absorbed or emitted by a sample per time step").
