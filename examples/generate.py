@@ -123,26 +123,48 @@ def scumble():
           s, events, window=(192, 192, 32))
 
 
+def two_strokes_then_rest(y1, y2, rest_at, rest, pressure, dip):
+    """A flat brush's short stroke along y1, a clean and a dip of `dip` (ryb, oil) while it moves to
+    y2, a stroke along y2, then the brush held up at `rest_at` for `rest` s so that both rest inside
+    the active window. Returns the samples and the events."""
+    s = stroke(0.0, line((460, y1), (560, y1)), 0.8, pressure, tilt=(15, 0))
+    t = s[-1]["t"]
+    s += hover(t, (560, y1), (460, y2), 0.3)
+    s += stroke(round(t + 0.3, 4), line((460, y2), (560, y2)), 0.8, pressure, tilt=(15, 0))
+    t3 = s[-1]["t"]
+    s += hover(t3, (560, y2), rest_at, 0.3)
+    s += hover(round(t3 + 0.3, 4), rest_at, rest_at, rest)
+    events = [{"type": "clean", "t": round(t + 0.1, 4)},
+              {"type": "dip", "t": round(t + 0.15, 4), "ryb": dip[0], "oil": dip[1], "load": 1.0}]
+    return s, events
+
+
 def stiff_and_oily():
     # Rheology (docs/GRID.md): the same flat brush and colour, one short stroke of stiff paint
     # (oil 0.1) and one of oily paint (oil 0.8) beside it, then the brush held up between them for
     # 1 s so that both rest inside the active window: the stiff stroke keeps its ridges, the oily
     # one levels.
-    s = stroke(0.0, line((460, 490), (560, 490)), 0.8, 0.6, tilt=(15, 0))
-    t = s[-1]["t"]
-    s += hover(t, (560, 490), (460, 535), 0.3)
-    t2 = round(t + 0.3, 4)
-    s += stroke(t2, line((460, 535), (560, 535)), 0.8, 0.6, tilt=(15, 0))
-    t3 = s[-1]["t"]
-    s += hover(t3, (560, 535), (510, 512), 0.3)
-    s += hover(round(t3 + 0.3, 4), (510, 512), (510, 512), 0.7)
-    events = [{"type": "clean", "t": round(t + 0.1, 4)},
-              {"type": "dip", "t": round(t + 0.15, 4), "ryb": [0.85, 0.3, 0.05], "oil": 0.8, "load": 1.0}]
+    s, events = two_strokes_then_rest(490, 535, (510, 512), 0.7, 0.6, ([0.85, 0.3, 0.05], 0.8))
     write("stiff-and-oily.json",
           "Stiff and oily paint side by side: a flat brush lays a short stroke of stiff paint (oil 0.1) at y 490 "
           "and one of oily paint (oil 0.8) at y 535, then rests above them for 1 s.",
           {"shape": "flat"}, {"ryb": [0.85, 0.3, 0.05], "oil": 0.1, "load": 1.0, "reload_on_pen_down": False},
           s, events, window=(192, 192, 32))
+
+
+def easel():
+    # The canvas upright on an easel (docs/GRID.md "The canvas on an easel"): the same flat brush
+    # lays a short thick stroke of oily paint (oil 0.6) and one of stiff paint (oil 0.1) across
+    # the canvas, then rests beside them for 1.5 s: the oily paint runs down the canvas (+y), the
+    # stiff paint holds.
+    s, events = two_strokes_then_rest(480, 440, (510, 470), 1.5, 0.7, ([0.1, 0.2, 0.8], 0.1))
+    canvas = {"width": 1024, "height": 1024, "depth": 64, "paper_rgb": [0.96, 0.94, 0.89], "tilt": 90}
+    write("easel.json",
+          "On an easel: the canvas upright (canvas.tilt 90), a flat brush lays a stroke of oily orange paint "
+          "(oil 0.6) at y 480 and one of stiff blue paint (oil 0.1) above it at y 440, then rests beside them "
+          "for 1.5 s: the oily paint runs down the canvas, the stiff paint holds.",
+          {"shape": "flat"}, {"ryb": [0.85, 0.3, 0.05], "oil": 0.6, "load": 1.0, "reload_on_pen_down": False},
+          s, events, canvas=canvas, window=(192, 192, 32))
 
 
 def flat_streaks():
@@ -186,3 +208,4 @@ if __name__ == "__main__":
     cross_wet()
     scumble()
     stiff_and_oily()
+    easel()

@@ -264,4 +264,49 @@ TEST_F(RheologyTest, OilyPaintRunsDownAnUprightCanvasStiffPaintStays) {
   }
 }
 
+namespace {
+/// A layer about a cell thick (0.2 mm) with grooves across x two cells apart (columns of 0.7 and
+/// 1.3 cells), left alone `seconds`. Returns the grooves' depth after over before (the mean
+/// difference between neighbouring columns) and the relative change of the paint's mass.
+std::pair<double, double> grooves_at_rest(const Device& device, float oil, float seconds) {
+  TileStore canvas(device, CanvasDims{64, 32, 16});
+  GridParams p;
+  Grid g(canvas, p, Int3{48, 16, 8}, Int3{0, 0, 0});
+  const auto column = [](int i) { return i % 2 ? 1.3f : 0.7f; };
+  paint_cells(g, [&](int i, int, int k) { return k == 0 ? std::min(1.f, column(i)) : (k == 1 ? std::max(0.f, column(i) - 1.f) : 0.f); },
+              oil);
+  const GridDims d = g.dims();
+  auto depth = [&] {
+    const auto rho = host_density(g);
+    double sum = 0, mass = 0;
+    int n = 0;
+    for (int j = 4; j < 12; ++j)
+      for (int i = 8; i < 40; ++i, ++n) {
+        double a = 0, b = 0;
+        for (int k = 0; k < d.nz; ++k) a += rho[size_t(d.cell(i, j, k))], b += rho[size_t(d.cell(i + 1, j, k))];
+        sum += std::fabs(a - b);
+      }
+    for (float r : rho) mass += r;
+    return std::pair<double, double>(sum / n, mass);
+  };
+  const auto [before, m0] = depth();
+  for (int s = 0; s < int(std::lround(seconds / p.dt)); ++s) g.step(p.dt);
+  const auto [after, m1] = depth();
+  std::printf("[ film ] oil %.2f: grooves 2 cells apart in a layer a cell thick keep %.1f %% of their depth after "
+              "%.0f s; mass %+.2g\n", oil, 100 * after / before, seconds, (m1 - m0) / m0);
+  return {after / before, (m1 - m0) / m0};
+}
+}  // namespace
+
+TEST_F(RheologyTest, ThinOilyPaintLevelsStiffPaintKeepsItsGrooves) {
+  // Paint thinner than a cell has no pressure across a groove in the grid; as a film it levels
+  // where gravity's stress at its base passes the yield stress (oil 0.95: 0.15 Pa).
+  const auto [oily, oily_mass] = grooves_at_rest(device_, 0.95f, 2.f);
+  EXPECT_LE(oily, 0.5) << "oil-rich paint levels";
+  EXPECT_LE(std::fabs(oily_mass), 1e-5);
+  const auto [stiff, stiff_mass] = grooves_at_rest(device_, 0.1f, 10.f);
+  EXPECT_GE(stiff, 0.9) << "stiff paint keeps its grooves";
+  EXPECT_LE(std::fabs(stiff_mass), 1e-5);
+}
+
 }  // namespace wb::test

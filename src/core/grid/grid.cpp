@@ -49,6 +49,19 @@ void advect_vel_d(const Device& d, GridView g, const float* u, const float* v, c
   WB_REQUIRE(g.extent, "grid advection: the velocity's extent is not set");
   WB_DISPATCH(d, grid_advect_velocity(g, u, v, w, dt));
 }
+void film_columns_d(const Device& d, GridDims g, const GridExtent* e, PaintWindowView pw, BristleField br,
+                    const float* pd, float dry, float film_max, float* col) {
+  WB_DISPATCH(d, grid_film_columns(g, e, pw, br, pd, dry, film_max, col));
+}
+void film_flux_d(const Device& d, GridDims g, const float* col, FilmFlow f, float* qx, float* qy) {
+  WB_DISPATCH(d, grid_film_flux(g, col, f, qx, qy));
+}
+void film_update_d(const Device& d, GridDims g, const float* col, const float* qx, const float* qy, float* next) {
+  WB_DISPATCH(d, grid_film_update(g, col, qx, qy, next));
+}
+void film_write_d(const Device& d, GridDims g, PaintWindowView pw, const float* col) {
+  WB_DISPATCH(d, grid_film_write(g, pw, col));
+}
 void gravity_d(const Device& d, GridView g, float* ph, float g_dt, float g_dt_y) {
   WB_DISPATCH(d, grid_gravity(g, ph, g_dt, g_dt_y));
 }
@@ -144,6 +157,7 @@ void check_params(const GridParams& p) {
              "grid: viscosity_max_iterations must be in [0, 10000]");
   WB_REQUIRE(p.gravity >= 0.f && p.gravity <= 1e6f, "grid: gravity must be in [0, 1e6] cells/s^2");
   WB_REQUIRE(p.tilt >= 0.f && p.tilt <= 90.f, "grid: the canvas tilt must be in [0, 90] degrees");
+  WB_REQUIRE(p.film_max >= 0.f && p.film_max <= 8.f, "grid: film_max must be in [0, 8] cells");
   WB_REQUIRE(p.liquid_threshold > 0.f && p.liquid_threshold <= 1.f, "grid: liquid_threshold must be in (0, 1]");
   WB_REQUIRE(p.dry_rate >= 0.f && p.dry_rate <= 1000.f, "grid: dry_rate must be in [0, 1000] /s");
   WB_REQUIRE(p.dry_threshold > 0.f && p.dry_threshold <= 1.f, "grid: dry_threshold must be in (0, 1]");
@@ -273,6 +287,10 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   const size_t all_faces = size_t(g.nu() + g.nv() + g.nw());
   face_tmp_.set_device(d);
   face_tmp_.resize(all_faces);
+  for (auto& b : film_) {
+    b.set_device(d);
+    b.resize(size_t(kFilmFields) * size_t(g.nx) * size_t(g.ny));
+  }
   for (auto* b : {&visc_idx_, &visc_list_}) {
     b->set_device(d);
     b->resize(all_faces);
@@ -640,6 +658,33 @@ void Grid::dry(float dt) {
   window_.canvas().advance_drying(double(params_.dry_rate) * double(dt));
 }
 
+void Grid::flow_film(float dt) {
+  WB_PROFILE_SCOPE("grid.film");
+  if (params_.film_max <= 0.f || params_.gravity <= 0.f) return;
+  const GridDims g = dims();
+  // Explicit sub-steps: the film's diffusivity rho0 g h^3 / (3 K) is largest for the thickest film
+  // of the runniest paint; dt <= cell^2 / (4 D) keeps the explicit step stable. Known here, no wait.
+  const float cell = params_.cell_size, rho0 = params_.rho0;
+  const float g_si = params_.gravity * cell;  // cells/s^2 -> m/s^2
+  const float h = params_.film_max * cell;
+  const float D = rho0 * g_si * h * h * h / (3.f * std::min(params_.consistency_oily, params_.consistency_stiff));
+  const int substeps = std::clamp(int(std::ceil(dt * 4.f * D / (cell * cell))), 1, 64);
+  const Vec3 gv = params_.gravity_vector();
+  FilmFlow f{params_.yield_stress_stiff, params_.consistency_stiff, params_.yield_stress_oily, params_.consistency_oily,
+             rho0 * -gv.z * cell, rho0 * gv.y * cell, cell, dt / float(substeps)};
+  float* qx = face_tmp_.data();
+  float* qy = qx + int64_t(g.nx + 1) * g.ny;
+  // The columns are read from the cells once, flow in their own planes, and are written back once.
+  film_columns_d(device(), g, extent_.data(), window_.paint().view(), bristles_, particle_density_,
+                 params_.dry_threshold, params_.film_max, film_[0].data());
+  int cur = 0;
+  for (int s = 0; s < substeps; ++s, cur = 1 - cur) {
+    film_flux_d(device(), g, film_[cur].data(), f, qx, qy);
+    film_update_d(device(), g, film_[cur].data(), qx, qy, film_[1 - cur].data());
+  }
+  film_write_d(device(), g, window_.paint().view(), film_[cur].data());
+}
+
 void Grid::step(float dt, const std::function<void()>& after_advection) {
   WB_PROFILE_SCOPE("grid.step");
   WB_REQUIRE(dt > 0.f && dt <= 0.1f, "Grid::step: dt must be in (0, 0.1] s");
@@ -656,6 +701,7 @@ void Grid::step(float dt, const std::function<void()>& after_advection) {
     apply_viscosity(dt);
     project(dt);
   });
+  flow_film(dt);
   dry(dt);  // the window's paint, whatever the extent
 }
 

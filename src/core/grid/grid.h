@@ -195,6 +195,8 @@ class Grid {
   }
   /// The layers holding paint or particles now, or liquid before the advection: extent_.
   void find_extent();
+  /// Thin films (GridParams::film_max): their lubrication flow over dt, in explicit sub-steps.
+  void flow_film(float dt);
   /// The maxima of grid_column_tops (paint and particles above `trace`) into advect_max_'s six
   /// slots from `slot`: the paint's top, the joint top, then x, -x, y, -y of the joint columns.
   void column_maxima(float trace, int slot);
@@ -202,6 +204,7 @@ class Grid {
   /// paint below layer top.
   void advect_paint(float dt, const int reach[3], int top);
   PaintWindow paint_tmp_;
+  DeviceBuffer<float> film_[2];  ///< flow_film's columns (FilmField planes), this sub-step's and the next
   SolverScratch scratch_;
   Workspace ws_;
   GridStats stats_;
@@ -223,6 +226,11 @@ class Grid {
                         int32_t* halo, int64_t* counts, int32_t* below);                                             \
   void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst, bool reads);   \
   void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt);                  \
+  void grid_film_columns(GridDims d, const GridExtent* e, PaintWindowView pw, BristleField br,                    \
+                         const float* particle_density, float dry_threshold, float film_max, float* col);         \
+  void grid_film_flux(GridDims d, const float* col, FilmFlow f, float* qx, float* qy);                            \
+  void grid_film_update(GridDims d, const float* col, const float* qx, const float* qy, float* next);            \
+  void grid_film_write(GridDims d, PaintWindowView pw, const float* col);                                         \
   void grid_gravity(GridView g, float* ph, float g_dt, float g_dt_y);                                                            \
   void grid_effective_viscosity(GridView g, JointOil oil, HerschelBulkley stiff, HerschelBulkley oily, float m,    \
                                 float* mu);                                                                          \

@@ -87,6 +87,22 @@ struct GridExtent {
   int32_t dirty_box[4];    ///< the columns holding liquid at the last step (x0, x1, y0, y1)
 };
 
+/// What a thin film's flow needs (Grid::flow_film): the paint's end members, gravity across the
+/// canvas and down it (Pa per m of slope, Pa/m), the cell (m) and the sub-step (s).
+struct FilmFlow {
+  float tau_y_stiff, K_stiff, tau_y_oily, K_oily;  ///< Pa, Pa s (GridParams, oil 0 and 1)
+  float rho_g_cos;  ///< rho0 g cos(tilt): the pressure gradient per unit slope of the surface, Pa/m
+  float rho_g_sin;  ///< rho0 g sin(tilt): the pull down the canvas (+y), Pa/m
+  float cell;       ///< m
+  float dt;         ///< s
+};
+
+/// Per film column in Grid::flow_film's scratch: the film's thickness (cells; negative where the
+/// column is no film), the top of what it lies on (cells), the first layer above that, its
+/// mass-weighted oil, pigment and dryness, and the paint that crossed its faces over the step
+/// (cells; 0: its cells stay as they are): kFilmFields planes of nx * ny.
+enum FilmField : int { kFilmH, kFilmBase, kFilmAbove, kFilmOil, kFilmR, kFilmY, kFilmB, kFilmDry, kFilmMoved, kFilmFields };
+
 /// The oil fraction of the joint paint (§4.3: grid and particles) in a cell, mass-weighted: the
 /// paint near the bristles is mostly particles, and a cell liquid by its particles alone has the
 /// rheology of their paint, not of the grid's empty cell (oil 0, the stiffest).

@@ -2,6 +2,7 @@
 // source (grid_cpu.cpp, grid_cuda.cu). Each function is one or two launches over
 // cells or faces; the physics is in advect_/viscosity_/project_kernels.h.
 #pragma once
+#include "core/color/ryb.h"
 #include "core/exec/atomics.h"
 #include "core/exec/parallel_for.h"
 #include "core/grid/advect_kernels.h"
@@ -371,6 +372,129 @@ void grid_gravity(GridView g, float* ph, float g_dt, float g_dt_y) {
     const bool la = ha && g.cls[a] == kCellLiquid, lb = hb && g.cls[b] == kCellLiquid;
     if (!la && !lb) return;
     g.vel[c][f] += gravity_face_impulse(c, la, lb, la ? ph[a] : 0.f, lb ? ph[b] : 0.f, g_dt, g_dt_y);
+  });
+}
+
+// --- thin films (docs/GRID.md "Thin films") --------------------------------------------------
+
+void grid_film_columns(GridDims d, const GridExtent* e, PaintWindowView pw, BristleField br,
+                       const float* particle_density, float dry_threshold, float film_max, float* col) {
+  const int64_t n = int64_t(d.nx) * d.ny;
+  parallel_for(n, [=] WB_HD(int64_t c) {
+    const int i = int(c % d.nx), j = int(c / d.nx);
+    col[kFilmH * n + c] = -1.f;
+    col[kFilmMoved * n + c] = 0.f;
+    if (e && (i < e->x0 || i >= e->x1 || j < e->y0 || j >= e->y1)) return;  // no paint there
+    int above = 0;
+    const float base = column_solid_top(pw, c, dry_threshold, 0.f, above);
+    float h = 0.f, oil = 0.f, r = 0.f, y = 0.f, b = 0.f, dry = 0.f;
+    bool touched = false;
+    for (int k = above; k < (e ? e->layers : d.nz); ++k) {
+      const int64_t id = int64_t(k) * n + c;
+      const float rho = pw.density[id];
+      touched |= (br.psi && br.psi[id] > 0.f) || (particle_density && particle_density[id] > 0.f);
+      h += rho, oil += rho * pw.oil[id], dry += rho * pw.dryness[id];
+      r += rho * pw.pigment_r[id], y += rho * pw.pigment_y[id], b += rho * pw.pigment_b[id];
+    }
+    const float w = h > 0.f ? 1.f / h : 0.f;
+    // The bristles and the particles' paint are the grid's and the transfer's business; a bare
+    // column is a film of nothing that paint may flow onto.
+    col[kFilmH * n + c] = (h <= film_max && !touched) ? h : -1.f;
+    col[kFilmBase * n + c] = base;
+    col[kFilmAbove * n + c] = float(above);
+    col[kFilmOil * n + c] = oil * w, col[kFilmDry * n + c] = dry * w;
+    col[kFilmR * n + c] = r * w, col[kFilmY * n + c] = y * w, col[kFilmB * n + c] = b * w;
+  });
+}
+
+/// Thickness (cells) a film face carries in a sub-step from column a to b (negative: b to a).
+/// A gravity-driven Bingham film (Liu & Mei, J. Fluid Mech. 207, 505, 1989): with the driving
+/// gradient G (Pa/m) the base's shear stress is G h; below the yield stress nothing flows; above it
+/// the paint shears below the plug's height Y = h - tau_y / G and the flux is G Y^2 (3h - Y) / (6 K),
+/// the upwind column's h, tau_y and K (n taken as 1: the oily paint that flows is nearly Newtonian).
+/// At most a quarter of the upwind film leaves through one face a sub-step (it has four).
+WB_HD WB_INLINE float film_face(const float* col, int64_t n, int64_t a, int64_t b, float pull, const FilmFlow& f) {
+  const float ha = col[kFilmH * n + a], hb = col[kFilmH * n + b];
+  if (ha < 0.f || hb < 0.f) return 0.f;
+  const float slope = (col[kFilmBase * n + b] + hb) - (col[kFilmBase * n + a] + ha);  // cells per cell
+  const float G = f.rho_g_cos * slope - pull;  // dp/ds along a -> b, Pa/m: the paint flows down it
+  const int64_t u = G > 0.f ? b : a;
+  const float hu = col[kFilmH * n + u];
+  const float Gm = fabsf(G), h = hu * f.cell;
+  const HerschelBulkley hb_u = rheology_at_oil(col[kFilmOil * n + u], HerschelBulkley{f.tau_y_stiff, f.K_stiff, 0.5f},
+                                               HerschelBulkley{f.tau_y_oily, f.K_oily, 1.f});
+  if (!(Gm * h > hb_u.tau_y)) return 0.f;
+  const float Y = h - hb_u.tau_y / Gm;
+  const float q = Gm * Y * Y * (3.f * h - Y) / (6.f * hb_u.K);  // m^2/s
+  const float t = minf(q * f.dt / (f.cell * f.cell), 0.25f * hu);
+  return G > 0.f ? -t : t;
+}
+
+void grid_film_flux(GridDims d, const float* col, FilmFlow f, float* qx, float* qy) {
+  const int64_t n = int64_t(d.nx) * d.ny;
+  // qx[j (nx + 1) + i]: between columns (i - 1, j) and (i, j); qy[j nx + i]: (i, j - 1) and (i, j).
+  // The window's own edges carry nothing.
+  parallel_for(int64_t(d.nx + 1) * d.ny, [=] WB_HD(int64_t e) {
+    const int i = int(e % (d.nx + 1)), j = int(e / (d.nx + 1));
+    qx[e] = (i == 0 || i == d.nx) ? 0.f : film_face(col, n, int64_t(j) * d.nx + i - 1, int64_t(j) * d.nx + i, 0.f, f);
+  });
+  parallel_for(int64_t(d.nx) * (d.ny + 1), [=] WB_HD(int64_t e) {
+    const int i = int(e % d.nx), j = int(e / d.nx);
+    qy[e] = (j == 0 || j == d.ny) ? 0.f
+                                  : film_face(col, n, int64_t(j - 1) * d.nx + i, int64_t(j) * d.nx + i, f.rho_g_sin, f);
+  });
+}
+
+void grid_film_update(GridDims d, const float* col, const float* qx, const float* qy, float* next) {
+  const int64_t n = int64_t(d.nx) * d.ny;
+  parallel_for(n, [=] WB_HD(int64_t c) {
+    for (int p = 0; p < kFilmFields; ++p) next[p * n + c] = col[p * n + c];
+    const float h = col[kFilmH * n + c];
+    if (h < 0.f) return;
+    const int i = int(c % d.nx), j = int(c / d.nx);
+    // Signed inflow through each face and the column it comes from.
+    const float in[4] = {qx[int64_t(j) * (d.nx + 1) + i], -qx[int64_t(j) * (d.nx + 1) + i + 1], qy[int64_t(j) * d.nx + i],
+                         -qy[int64_t(j + 1) * d.nx + i]};
+    const int64_t from[4] = {c - 1, c + 1, c - d.nx, c + d.nx};
+    float out = 0.f, gain = 0.f;
+    for (int s = 0; s < 4; ++s) out += in[s] < 0.f ? -in[s] : 0.f, gain += in[s] > 0.f ? in[s] : 0.f;
+    if (out == 0.f && gain == 0.f) return;
+    // What stays, then each inflow with its column's paint (Algorithm 2 by mass; oil and dryness by mass).
+    float m = h - out;
+    Vec3 p(col[kFilmR * n + c], col[kFilmY * n + c], col[kFilmB * n + c]);
+    float oil = m * col[kFilmOil * n + c], dry = m * col[kFilmDry * n + c];
+    for (int s = 0; s < 4; ++s) {
+      if (!(in[s] > 0.f)) continue;
+      const int64_t o = from[s];
+      p = color_mix(p, Vec3(col[kFilmR * n + o], col[kFilmY * n + o], col[kFilmB * n + o]), m, in[s]);
+      oil += in[s] * col[kFilmOil * n + o], dry += in[s] * col[kFilmDry * n + o];
+      m += in[s];
+    }
+    const float w = m > 0.f ? 1.f / m : 0.f;
+    next[kFilmH * n + c] = m;
+    next[kFilmR * n + c] = p.x, next[kFilmY * n + c] = p.y, next[kFilmB * n + c] = p.z;
+    next[kFilmOil * n + c] = oil * w, next[kFilmDry * n + c] = dry * w;
+    next[kFilmMoved * n + c] = col[kFilmMoved * n + c] + out + gain;
+  });
+}
+
+void grid_film_write(GridDims d, PaintWindowView pw, const float* col) {
+  const int64_t n = int64_t(d.nx) * d.ny;
+  parallel_for(n, [=] WB_HD(int64_t c) {
+    if (!(col[kFilmMoved * n + c] > 0.f)) return;
+    // The film is laid again from the first layer over what it lies on, full cells first.
+    float left = col[kFilmH * n + c];
+    const Vec3 p(col[kFilmR * n + c], col[kFilmY * n + c], col[kFilmB * n + c]);
+    const float oil = col[kFilmOil * n + c], dry = col[kFilmDry * n + c];
+    for (int k = int(col[kFilmAbove * n + c]); k < d.nz; ++k) {
+      const int64_t id = int64_t(k) * n + c;
+      const float rho = minf(left, 1.f);
+      left -= rho;
+      const bool paint = rho > 0.f;
+      pw.density[id] = rho;
+      pw.pigment_r[id] = paint ? p.x : 0.f, pw.pigment_y[id] = paint ? p.y : 0.f, pw.pigment_b[id] = paint ? p.z : 0.f;
+      pw.oil[id] = paint ? oil : 0.f, pw.dryness[id] = paint ? dry : 0.f;
+    }
   });
 }
 

@@ -80,6 +80,12 @@ struct GridParams {
   /// grow downwards); the particles and the bristles feel the same vector (gravity_vector).
   /// Default 0, range [0, 90]. docs/GRID.md "The canvas on an easel".
   float tilt = 0.f;
+  /// Wet paint at most this thick in a column (cells, above the dried paint or the canvas) that
+  /// no bristle and no particle touches flows as a thin film: lubrication flow of the column's
+  /// thickness under gravity, the Herschel-Bulkley paint's yield stress as a plug (docs/GRID.md
+  /// "Thin films"). The grid's projection cannot level paint thinner than a cell: a groove in
+  /// it has no pressure across it. Default 2 (0.4 mm), range [0, 8]; 0 turns the film off.
+  float film_max = 2.f;
   /// Gravity in the canvas frame, cells/s^2: (0, g sin(tilt), -g cos(tilt)).
   Vec3 gravity_vector() const {
     const float a = tilt * (3.14159265f / 180.f);
