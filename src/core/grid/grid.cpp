@@ -53,11 +53,8 @@ void film_columns_d(const Device& d, GridDims g, const GridExtent* e, PaintWindo
                     const float* pd, float dry, float film_max, float* col) {
   WB_DISPATCH(d, grid_film_columns(g, e, pw, br, pd, dry, film_max, col));
 }
-void film_flux_d(const Device& d, GridDims g, const float* col, FilmFlow f, float* qx, float* qy) {
-  WB_DISPATCH(d, grid_film_flux(g, col, f, qx, qy));
-}
-void film_update_d(const Device& d, GridDims g, const float* col, const float* qx, const float* qy, float* next) {
-  WB_DISPATCH(d, grid_film_update(g, col, qx, qy, next));
+void film_update_d(const Device& d, GridDims g, const float* col, FilmFlow f, float* next) {
+  WB_DISPATCH(d, grid_film_update(g, col, f, next));
 }
 void film_write_d(const Device& d, GridDims g, PaintWindowView pw, const float* col) {
   WB_DISPATCH(d, grid_film_write(g, pw, col));
@@ -672,16 +669,11 @@ void Grid::flow_film(float dt) {
   const Vec3 gv = params_.gravity_vector();
   FilmFlow f{params_.yield_stress_stiff, params_.consistency_stiff, params_.yield_stress_oily, params_.consistency_oily,
              rho0 * -gv.z * cell, rho0 * gv.y * cell, cell, dt / float(substeps)};
-  float* qx = face_tmp_.data();
-  float* qy = qx + int64_t(g.nx + 1) * g.ny;
   // The columns are read from the cells once, flow in their own planes, and are written back once.
   film_columns_d(device(), g, extent_.data(), window_.paint().view(), bristles_, particle_density_,
                  params_.dry_threshold, params_.film_max, film_[0].data());
   int cur = 0;
-  for (int s = 0; s < substeps; ++s, cur = 1 - cur) {
-    film_flux_d(device(), g, film_[cur].data(), f, qx, qy);
-    film_update_d(device(), g, film_[cur].data(), qx, qy, film_[1 - cur].data());
-  }
+  for (int s = 0; s < substeps; ++s, cur = 1 - cur) film_update_d(device(), g, film_[cur].data(), f, film_[1 - cur].data());
   film_write_d(device(), g, window_.paint().view(), film_[cur].data());
 }
 

@@ -228,8 +228,7 @@ class Grid {
   void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt);                  \
   void grid_film_columns(GridDims d, const GridExtent* e, PaintWindowView pw, BristleField br,                    \
                          const float* particle_density, float dry_threshold, float film_max, float* col);         \
-  void grid_film_flux(GridDims d, const float* col, FilmFlow f, float* qx, float* qy);                            \
-  void grid_film_update(GridDims d, const float* col, const float* qx, const float* qy, float* next);            \
+  void grid_film_update(GridDims d, const float* col, FilmFlow f, float* next);                                    \
   void grid_film_write(GridDims d, PaintWindowView pw, const float* col);                                         \
   void grid_gravity(GridView g, float* ph, float g_dt, float g_dt_y);                                                            \
   void grid_effective_viscosity(GridView g, JointOil oil, HerschelBulkley stiff, HerschelBulkley oily, float m,    \

@@ -430,32 +430,21 @@ WB_HD WB_INLINE float film_face(const float* col, int64_t n, int64_t a, int64_t 
   return G > 0.f ? -t : t;
 }
 
-void grid_film_flux(GridDims d, const float* col, FilmFlow f, float* qx, float* qy) {
-  const int64_t n = int64_t(d.nx) * d.ny;
-  // qx[j (nx + 1) + i]: between columns (i - 1, j) and (i, j); qy[j nx + i]: (i, j - 1) and (i, j).
-  // The window's own edges carry nothing.
-  parallel_for(int64_t(d.nx + 1) * d.ny, [=] WB_HD(int64_t e) {
-    const int i = int(e % (d.nx + 1)), j = int(e / (d.nx + 1));
-    qx[e] = (i == 0 || i == d.nx) ? 0.f : film_face(col, n, int64_t(j) * d.nx + i - 1, int64_t(j) * d.nx + i, 0.f, f);
-  });
-  parallel_for(int64_t(d.nx) * (d.ny + 1), [=] WB_HD(int64_t e) {
-    const int i = int(e % d.nx), j = int(e / d.nx);
-    qy[e] = (j == 0 || j == d.ny) ? 0.f
-                                  : film_face(col, n, int64_t(j - 1) * d.nx + i, int64_t(j) * d.nx + i, f.rho_g_sin, f);
-  });
-}
-
-void grid_film_update(GridDims d, const float* col, const float* qx, const float* qy, float* next) {
+void grid_film_update(GridDims d, const float* col, FilmFlow f, float* next) {
   const int64_t n = int64_t(d.nx) * d.ny;
   parallel_for(n, [=] WB_HD(int64_t c) {
     for (int p = 0; p < kFilmFields; ++p) next[p * n + c] = col[p * n + c];
     const float h = col[kFilmH * n + c];
     if (h < 0.f) return;
     const int i = int(c % d.nx), j = int(c / d.nx);
-    // Signed inflow through each face and the column it comes from.
-    const float in[4] = {qx[int64_t(j) * (d.nx + 1) + i], -qx[int64_t(j) * (d.nx + 1) + i + 1], qy[int64_t(j) * d.nx + i],
-                         -qy[int64_t(j + 1) * d.nx + i]};
+    // Signed inflow through each face and the column it comes from. Both columns of a face
+    // compute its transfer from the same values, bit for bit, so what one gains the other loses;
+    // the window's own edges carry nothing.
     const int64_t from[4] = {c - 1, c + 1, c - d.nx, c + d.nx};
+    const float in[4] = {i > 0 ? film_face(col, n, from[0], c, 0.f, f) : 0.f,
+                         i + 1 < d.nx ? -film_face(col, n, c, from[1], 0.f, f) : 0.f,
+                         j > 0 ? film_face(col, n, from[2], c, f.rho_g_sin, f) : 0.f,
+                         j + 1 < d.ny ? -film_face(col, n, c, from[3], f.rho_g_sin, f) : 0.f};
     float out = 0.f, gain = 0.f;
     for (int s = 0; s < 4; ++s) out += in[s] < 0.f ? -in[s] : 0.f, gain += in[s] > 0.f ? in[s] : 0.f;
     if (out == 0.f && gain == 0.f) return;
