@@ -74,7 +74,6 @@ class MainWindow : public QMainWindow {
   /// The canvas's tilt from the table, degrees in [0, 90] (GridParams::tilt): the canvas's
   /// simulator is made anew with the painting on it; the palette stays flat.
   void set_tilt(float degrees);
-  float tilt() const { return tilt_; }
   /// Why a canvas of this size cannot take this ground (too thick for the paint depth, or more
   /// paint than a painting may hold); empty when it can.
   QString ground_refusal(int width, int height, const CanvasGround& ground) const;

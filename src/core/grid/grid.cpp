@@ -154,7 +154,7 @@ void check_params(const GridParams& p) {
              "grid: viscosity_max_iterations must be in [0, 10000]");
   WB_REQUIRE(p.gravity >= 0.f && p.gravity <= 1e6f, "grid: gravity must be in [0, 1e6] cells/s^2");
   WB_REQUIRE(p.tilt >= 0.f && p.tilt <= 90.f, "grid: the canvas tilt must be in [0, 90] degrees");
-  WB_REQUIRE(p.film_max >= 0.f && p.film_max <= 8.f, "grid: film_max must be in [0, 8] cells");
+  WB_REQUIRE(p.film_max >= 0.f && p.film_max <= 4.f, "grid: film_max must be in [0, 4] cells");
   WB_REQUIRE(p.liquid_threshold > 0.f && p.liquid_threshold <= 1.f, "grid: liquid_threshold must be in (0, 1]");
   WB_REQUIRE(p.dry_rate >= 0.f && p.dry_rate <= 1000.f, "grid: dry_rate must be in [0, 1000] /s");
   WB_REQUIRE(p.dry_threshold > 0.f && p.dry_threshold <= 1.f, "grid: dry_threshold must be in (0, 1]");
@@ -665,7 +665,7 @@ void Grid::flow_film(float dt) {
   const float g_si = params_.gravity * cell;  // cells/s^2 -> m/s^2
   const float h = params_.film_max * cell;
   const float D = rho0 * g_si * h * h * h / (3.f * std::min(params_.consistency_oily, params_.consistency_stiff));
-  const int substeps = std::clamp(int(std::ceil(dt * 4.f * D / (cell * cell))), 1, 64);
+  const int substeps = std::max(1, int(std::ceil(dt * 4.f * D / (cell * cell))));
   const Vec3 gv = params_.gravity_vector();
   FilmFlow f{params_.yield_stress_stiff, params_.consistency_stiff, params_.yield_stress_oily, params_.consistency_oily,
              rho0 * -gv.z * cell, rho0 * gv.y * cell, cell, dt / float(substeps)};

@@ -84,7 +84,8 @@ struct GridParams {
   /// no bristle and no particle touches flows as a thin film: lubrication flow of the column's
   /// thickness under gravity, the Herschel-Bulkley paint's yield stress as a plug (docs/GRID.md
   /// "Thin films"). The grid's projection cannot level paint thinner than a cell: a groove in
-  /// it has no pressure across it. Default 2 (0.4 mm), range [0, 8]; 0 turns the film off.
+  /// it has no pressure across it. Default 2 (0.4 mm), range [0, 4] (its explicit sub-steps grow as
+  /// the cube: 7 a 1/60 s step at 2 cells, 56 at 4); 0 turns the film off.
   float film_max = 2.f;
   /// Gravity in the canvas frame, cells/s^2: (0, g sin(tilt), -g cos(tilt)).
   Vec3 gravity_vector() const {

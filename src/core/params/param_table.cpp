@@ -81,7 +81,7 @@ std::vector<ParamInfo> build_table() {
       WB_PARAM(grid.viscosity_max_iterations, "Viscous solve iterations", "", "", 0, 10000,
                "Most conjugate-gradient iterations of the viscosity solve per step (0 = no viscosity)"),
       WB_PARAM(grid.gravity, "Gravity", "cells/s^2", "Eq. 2", 0, 1e6, "Gravity on the grid paint (down)"),
-      WB_PARAM(grid.film_max, "Thin film", "cells", "", 0, 8,
+      WB_PARAM(grid.film_max, "Thin film", "cells", "", 0, 4,
                "Wet paint at most this thick, away from the bristles, flows as a film under gravity (0: off)"),
       WB_PARAM(grid.tilt, "Canvas tilt", "degrees", "", 0, 90,
                "0: flat on a table; 90: upright on an easel (gravity pulls the paint down the canvas, +y)"),
