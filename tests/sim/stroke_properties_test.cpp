@@ -484,6 +484,107 @@ TEST_F(StrokePropertiesTest, FlatPulledBroadsideLeavesBristleStreaks) {
   EXPECT_GE(ridges, 4) << "distinct ridges across the stroke";
 }
 
+/// The grooves of a thin broadside layer: the small flat pulled broadside, 16 mm at 60 mm/s,
+/// in paint of `oil`, lifted over the stroke's end and left `rest` seconds in a window holding
+/// the whole canvas. The depth is the RMS of the across-stroke profile (the body's columns
+/// averaged) less its 5-row running mean, over the rows of the body; at the lift and after.
+struct Grooves {
+  double before = 0, after = 0;                ///< the grooves along the stroke, cells RMS
+  double ridges_before = 0, ridges_after = 0;  ///< the ridges across it (the along profile's), cells RMS
+  double thickness = 0;                        ///< the body's mean, cells
+};
+
+/// RMS of v[i0, i1) less its 5-sample running mean.
+double high_pass_rms(const std::vector<double>& v, int i0, int i1) {
+  double sq = 0;
+  for (int i = i0; i < i1; ++i) {
+    double run = 0;
+    for (int k = -2; k <= 2; ++k) run += v[size_t(i + k)] / 5.0;
+    sq += (v[size_t(i)] - run) * (v[size_t(i)] - run);
+  }
+  return i1 > i0 ? std::sqrt(sq / (i1 - i0)) : 0.0;
+}
+
+Grooves broadside_grooves_at_rest(const Device& device, const SimConfig& scene, BrushSpec brush, float oil, float rest) {
+  constexpr int W = 128, H = 64;
+  constexpr float y0 = 32.f, xa = 24.f, xb = 104.f, speed = 300.f, pressure = 0.5f;
+  SimConfig c = scene;
+  c.canvas = CanvasDims{W, H, 16};
+  c.window = Int3{W, H, 16};
+  c.brush = brush;
+  auto pose = [&](float x, float p, bool down = true) {
+    PenSample s;
+    s.x = x, s.y = y0, s.pressure = p, s.tilt_x = 20.f, s.twist = 90.f, s.down = down;
+    return pose_from_pen(s, c.brush);
+  };
+  Simulator sim(c, pose(xa, 0.f, false));
+  PaintLoad paint;
+  paint.ryb[0] = 0.9f, paint.ryb[1] = 0.1f, paint.ryb[2] = 0.05f;
+  paint.oil = oil;
+  sim.load_paint(paint);
+  for (int i = 1; i <= 6; ++i) sim.step(pose(xa, pressure * float(i) / 6.f), kDt);
+  const int substeps = int(std::ceil(speed * kDt / 2.f));
+  std::vector<BrushPose> poses(static_cast<size_t>(substeps));
+  for (float x = xa; x < xb; x += speed * kDt) {
+    for (int k = 0; k < substeps; ++k)
+      poses[size_t(k)] = pose(std::min(xb, x + speed * kDt * float(k + 1) / float(substeps)), pressure);
+    sim.step(poses.data(), substeps, kDt);
+  }
+  const BrushPose lifted = pose(xb, 0.f, false);
+  for (int i = 0; i < 6; ++i) sim.step(lifted, kDt);
+  // Grooves and ridges over the body: its middle half along, the rows over 30 % of the thickest.
+  const int x0 = int(xa + 0.25f * (xb - xa)), x1 = int(xa + 0.75f * (xb - xa));
+  const auto measure = [&](double& grooves, double& ridges, double* thickness) {
+    sim.settle();  // the window's paint onto the canvas
+    PaintWindow w(device, Int3{W, H, 16});
+    sim.canvas().gather(w);
+    const auto f = w.to_host();
+    std::vector<double> col(size_t(W) * H, 0.0), across(H, 0.0), along(W, 0.0);
+    for (int z = 0; z < 16; ++z)
+      for (size_t id = 0; id < col.size(); ++id) col[id] += f[0][size_t(z) * col.size() + id];
+    for (int y = 0; y < H; ++y)
+      for (int x = x0; x < x1; ++x) across[size_t(y)] += col[size_t(y) * W + x] / double(x1 - x0);
+    const double peak = *std::max_element(across.begin(), across.end());
+    int ya = H, yb = -1;
+    for (int y = 0; y < H; ++y)
+      if (across[size_t(y)] > 0.3 * peak) ya = std::min(ya, y), yb = std::max(yb, y);
+    for (int y = ya; y <= yb; ++y)
+      for (int x = 0; x < W; ++x) along[size_t(x)] += col[size_t(y) * W + x] / double(yb - ya + 1);
+    grooves = high_pass_rms(across, ya + 2, yb - 1);
+    ridges = high_pass_rms(along, x0, x1);
+    if (thickness) {
+      double mean = 0;
+      for (int y = ya; y <= yb; ++y) mean += across[size_t(y)] / double(yb - ya + 1);
+      *thickness = mean;
+    }
+  };
+  Grooves g;
+  measure(g.before, g.ridges_before, &g.thickness);
+  for (int i = 0, n = int(std::lround(rest / kDt)); i < n; ++i) sim.step(lifted, kDt);
+  measure(g.after, g.ridges_after, nullptr);
+  EXPECT_LT(std::abs(sim.books().max_drift()), 1e-4);
+  EXPECT_EQ(sim.counters().nonfinite_events, 0);
+  std::printf("broadside in oil %.2f, body %.2f cells thick: grooves %.4f cells deep at the lift, %.4f after %.0f s at "
+              "rest (%.1f %%); ridges across the track %.4f, %.4f\n", oil, g.thickness, g.before, g.after, rest,
+              100.0 * g.after / g.before, g.ridges_before, g.ridges_after);
+  return g;
+}
+
+TEST_F(StrokePropertiesTest, ThinOilyStrokeLevelsAtRestStiffKeepsItsGrooves) {
+  // The levelling property on a painted stroke (docs/GRID.md "Thin films"): a layer about a cell
+  // thick, its bristle grooves a fraction of a cell deep.
+  const Grooves oily = broadside_grooves_at_rest(device_, small_config(), small_flat(), 0.95f, 2.f);
+  EXPECT_GE(oily.thickness, 0.4);
+  EXPECT_LE(oily.thickness, 2.0) << "a layer about one cell thick";
+  EXPECT_GT(oily.before, 0.01) << "the stroke leaves grooves";
+  EXPECT_LE(oily.after, 0.5 * oily.before) << "oil-rich paint levels";
+  EXPECT_LE(oily.ridges_after, oily.ridges_before) << "the rest does not roughen the layer";
+  const Grooves stiff = broadside_grooves_at_rest(device_, small_config(), small_flat(), 0.1f, 10.f);
+  EXPECT_GT(stiff.before, 0.01);
+  EXPECT_GE(stiff.after, 0.9 * stiff.before) << "stiff paint keeps its grooves";
+  EXPECT_GE(stiff.ridges_after, 0.9 * stiff.ridges_before);
+}
+
 TEST_F(StrokePropertiesTest, HybridPaintKeepsMoreDetailThanGridOnly) {
   // Fig. 7a/b: the same 50 mm broadside stroke of the default flat with particles near the
   // bristles (the hybrid) and without (grid-only). Detail: the high-pass energy of the exported
