@@ -14,6 +14,10 @@
 
 namespace wb {
 namespace {
+/// The bound of the distance field's error, cells: ±block·√3 (docs/TRANSFER.md "Distance to the
+/// bristles"), which every margin kept for D0 allows for.
+float distance_error(const TransferParams& tp) { return float(tp.distance_block) * std::sqrt(3.f); }
+
 /// Rim of the window, cells, where paint is always grid paint (transfer_env): wider than a
 /// particle moving with a fast stroke (480 cells/s) travels in one 1/60 s step, so that one
 /// leaving the window is caught in the rim rather than clamped to the wall.
@@ -22,8 +26,6 @@ constexpr int kKeepRim = 8;
 constexpr int kKeepRimTop = 3;
 /// An empty keep box: every particle goes to the grid (settle, grid-only paint).
 KeepBox nowhere() { return KeepBox::of(Int3{}, Int3{}); }
-}  // namespace
-namespace {
 
 /// Where the bristles meet the canvas: the rest tip under the handle (the ground's disc).
 Vec3 footprint_centre(const BrushPose& pose, float length) {
@@ -366,8 +368,7 @@ Int3 Simulator::place_window(const std::array<float, 4>& before, const std::arra
   const Int3 n = grid_->window().dims();
   const float room = 0.5f * std::min(float(n.x) - (x1 - x0), float(n.y) - (y1 - y0)) - window_margin();
   const float D0 = config_.params.particles.D0;
-  const float block_error = float(config_.params.transfer.distance_block) * std::sqrt(3.f);
-  const float floor_D0 = std::min(D0, transfer_->params().absorb_range() + block_error);
+  const float floor_D0 = std::min(D0, transfer_->params().absorb_range() + distance_error(config_.params.transfer));
   zone_D0_ = std::clamp(room, floor_D0, D0);
   zone_room = room - floor_D0;
   return grid_->window().origin_for(Vec3(0.5f * (x0 + x1), 0.5f * (y0 + y1), 0.f), config_.params.grid.window_snap);
@@ -465,8 +466,7 @@ ParticleOverlay Simulator::particle_overlay() {
 
 float Simulator::window_margin() const {
   const TransferParams& tp = config_.params.transfer;
-  return float(kKeepRim) + tp.return_margin + float(tp.distance_block) * std::sqrt(3.f) +
-         0.5f * float(config_.params.grid.window_snap);
+  return float(kKeepRim) + tp.return_margin + distance_error(tp) + 0.5f * float(config_.params.grid.window_snap);
 }
 
 int Simulator::parts_of_step(const BrushPose* poses, int substeps) const {
