@@ -200,7 +200,7 @@ TEST_F(GridParticleTest, CandidateSplitSetsTheParticlesACellGives) {
     prm.candidate_split = split;
     Transfer t(device_, prm);
     ParticleStore p(device_);
-    TransferEnv env = env_for(w, 1.f);  // the bristle's own cells and their neighbours
+    TransferEnv env = env_for(w, 4.f);  // within a distance block of the bristle (the field's resolution)
     const double before = w.total_density(ws_) * prm.cell_mass();
     t.update_distance(s.view(), env);
     TransferRecord rec;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "core/exec/algorithms.h"
 #include "core/exec/dispatch.h"
@@ -14,6 +15,13 @@
 namespace wb {
 
 namespace {
+/// The paint's stiff (oil 0) and oily (oil 1) end members, which every oil interpolates
+/// (rheology_at_oil): the viscosity's and the film's one source.
+std::pair<HerschelBulkley, HerschelBulkley> paint_end_members(const GridParams& p) {
+  return {HerschelBulkley{p.yield_stress_stiff, p.consistency_stiff, p.flow_index_stiff},
+          HerschelBulkley{p.yield_stress_oily, p.consistency_oily, p.flow_index_oily}};
+}
+
 // One wrapper per backend driver: the only place that switches on the device.
 void classify_d(const Device& d, GridView g, PaintWindowView pw, BristleField br, const float* pd, CanvasDims cd,
                 float lt, float dt) {
@@ -498,8 +506,7 @@ void Grid::find_extent() {
 
 void Grid::rheology() {
   WB_PROFILE_SCOPE("grid.rheology");
-  const HerschelBulkley stiff{params_.yield_stress_stiff, params_.consistency_stiff, params_.flow_index_stiff};
-  const HerschelBulkley oily{params_.yield_stress_oily, params_.consistency_oily, params_.flow_index_oily};
+  const auto [stiff, oily] = paint_end_members(params_);
   const PaintWindow& paint = window_.paint();
   const JointOil oil{paint.density.data(), paint.oil.data(), particle_density_, particle_oil_};
   mu_d(device(), view(), oil, stiff, oily, params_.regularisation, mu_.data());
@@ -664,11 +671,11 @@ void Grid::flow_film(float dt) {
   const float cell = params_.cell_size, rho0 = params_.rho0;
   const float g_si = params_.gravity * cell;  // cells/s^2 -> m/s^2
   const float h = params_.film_max * cell;
-  const float D = rho0 * g_si * h * h * h / (3.f * std::min(params_.consistency_oily, params_.consistency_stiff));
+  const auto [stiff, oily] = paint_end_members(params_);
+  const float D = rho0 * g_si * h * h * h / (3.f * std::min(oily.K, stiff.K));
   const int substeps = std::max(1, int(std::ceil(dt * 4.f * D / (cell * cell))));
   const Vec3 gv = params_.gravity_vector();
-  FilmFlow f{params_.yield_stress_stiff, params_.consistency_stiff, params_.yield_stress_oily, params_.consistency_oily,
-             rho0 * -gv.z * cell, rho0 * gv.y * cell, cell, dt / float(substeps)};
+  FilmFlow f{stiff, oily, rho0 * -gv.z * cell, rho0 * gv.y * cell, cell, dt / float(substeps)};
   // The columns are read from the cells once, flow in their own planes, and are written back once.
   film_columns_d(device(), g, extent_.data(), window_.paint().view(), bristles_, particle_density_,
                  params_.dry_threshold, params_.film_max, film_[0].data());

@@ -87,10 +87,17 @@ struct GridExtent {
   int32_t dirty_box[4];    ///< the columns holding liquid at the last step (x0, x1, y0, y1)
 };
 
+/// The Herschel–Bulkley parameters of one paint: tau = tau_y + K gamma_dot^n above the yield stress.
+struct HerschelBulkley {
+  float tau_y;  ///< yield stress, Pa
+  float K;      ///< consistency, Pa s^n
+  float n;      ///< flow index (< 1: shear-thinning)
+};
+
 /// What a thin film's flow needs (Grid::flow_film): the paint's end members, gravity across the
 /// canvas and down it (Pa per m of slope, Pa/m), the cell (m) and the sub-step (s).
 struct FilmFlow {
-  float tau_y_stiff, K_stiff, tau_y_oily, K_oily;  ///< Pa, Pa s (GridParams, oil 0 and 1)
+  HerschelBulkley stiff, oily;  ///< the paint's end members (Grid::paint_end_members)
   float rho_g_cos;  ///< rho0 g cos(tilt): the pressure gradient per unit slope of the surface, Pa/m
   float rho_g_sin;  ///< rho0 g sin(tilt): the pull down the canvas (+y), Pa/m
   float cell;       ///< m

@@ -421,8 +421,7 @@ WB_HD WB_INLINE float film_face(const float* col, int64_t n, int64_t a, int64_t 
   const int64_t u = G > 0.f ? b : a;
   const float hu = col[kFilmH * n + u];
   const float Gm = fabsf(G), h = hu * f.cell;
-  const HerschelBulkley hb_u = rheology_at_oil(col[kFilmOil * n + u], HerschelBulkley{f.tau_y_stiff, f.K_stiff, 0.5f},
-                                               HerschelBulkley{f.tau_y_oily, f.K_oily, 1.f});
+  const HerschelBulkley hb_u = rheology_at_oil(col[kFilmOil * n + u], f.stiff, f.oily);
   if (!(Gm * h > hb_u.tau_y)) return 0.f;
   const float Y = h - hb_u.tau_y / Gm;
   const float q = Gm * Y * Y * (3.f * h - Y) / (6.f * hb_u.K);  // m^2/s

@@ -11,13 +11,6 @@
 
 namespace wb {
 
-/// The Herschel–Bulkley parameters of one paint: tau = tau_y + K gamma_dot^n above the yield stress.
-struct HerschelBulkley {
-  float tau_y;  ///< yield stress, Pa
-  float K;      ///< consistency, Pa s^n
-  float n;      ///< flow index (< 1: shear-thinning)
-};
-
 /// Paint of oil fraction `oil` between the stiff (oil 0) and oily (oil 1) end members: tau_y and K
 /// interpolate geometrically (they span decades), n linearly.
 WB_HD WB_INLINE HerschelBulkley rheology_at_oil(float oil, HerschelBulkley stiff, HerschelBulkley oily) {

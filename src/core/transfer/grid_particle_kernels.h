@@ -246,13 +246,28 @@ struct DistanceBlocks {
     if (i < 0 || j < 0 || k < 0 || i >= bx || j >= by || k >= bz) return -1;
     return index(i, j, k);
   }
-  /// Distance from the block of window position q to the bristles, cells (block-centre
-  /// to block-centre, so within +-block*sqrt(3) of the true distance); huge when none.
+  /// Distance from window position q to the bristles, cells: the block centres' distances
+  /// (exact between block centres, so within +-block*sqrt(3) of the true distance) interpolated
+  /// trilinearly, so that the D0 front moves with the brush cell by cell, not a block at a time
+  /// (a block's one value laid ribs a block apart along slow strokes, docs/TRANSFER.md); huge
+  /// outside the field or with no bristle in it.
   WB_HD float distance(Vec3 q) const {
-    const int64_t b = block_of(q);
-    if (b < 0) return 1e30f;
-    const float v = d2[b];
-    return v >= kFarDistance2 ? 1e30f : sqrtf(v) * float(block);
+    if (block_of(q) < 0) return 1e30f;
+    const float inv = 1.f / float(block);
+    const float fx = q.x * inv - 0.5f + float(margin), fy = q.y * inv - 0.5f + float(margin),
+                fz = q.z * inv - 0.5f + float(margin);
+    const int i0 = imin(imax(int(floorf(fx)), 0), bx - 2), j0 = imin(imax(int(floorf(fy)), 0), by - 2),
+              k0 = imin(imax(int(floorf(fz)), 0), bz - 2);
+    const float tx = fminf(fmaxf(fx - float(i0), 0.f), 1.f), ty = fminf(fmaxf(fy - float(j0), 0.f), 1.f),
+                tz = fminf(fmaxf(fz - float(k0), 0.f), 1.f);
+    float d = 0.f;
+    for (int c = 0; c < 8; ++c) {
+      const int di = c & 1, dj = (c >> 1) & 1, dk = c >> 2;
+      const float v = d2[index(i0 + di, j0 + dj, k0 + dk)];
+      if (v >= kFarDistance2) return 1e30f;
+      d += (di ? tx : 1.f - tx) * (dj ? ty : 1.f - ty) * (dk ? tz : 1.f - tz) * sqrtf(v);
+    }
+    return d * float(block);
   }
   /// Within D0 of the bristles; nothing is near when D0 is 0 (grid-only paint, Fig. 7).
   WB_HD bool near(Vec3 q) const { return D0 > 0.f && distance(q) <= D0; }
