@@ -401,7 +401,7 @@ TEST_F(StrokePropertiesTest, SlowAndEasedStrokesLeaveNoRibs) {
   // "Ribs on slow strokes"). At 5, 15 and 40 mm/s and from rest, round and flat (broadside), in a
   // window the particle zone fits: the strongest peak of the body's thickness spectrum over the
   // median of periods 2-20 cells. Measured over runs: 1.5-3.2x at 15 and 40 mm/s and from rest;
-  // at 5 mm/s, at the distance block's period (4 cells), 2.6-4.5x round and 6.1-11.3x flat, which
+  // at 5 mm/s, at the distance block's period (4 cells), 2.6-5.8x round and 6.1-11.3x flat, which
   // the bounds below hold to what they are until the block marking goes (the docs).
   struct Case {
     const char* name;
