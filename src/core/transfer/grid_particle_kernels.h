@@ -248,9 +248,9 @@ struct DistanceBlocks {
   }
   /// Distance from window position q to the bristles, cells: the block centres' distances
   /// (exact between block centres, so within +-block*sqrt(3) of the true distance) interpolated
-  /// trilinearly, so that the D0 front moves with the brush cell by cell, not a block at a time
-  /// (a block's one value laid ribs a block apart along slow strokes, docs/TRANSFER.md); huge
-  /// outside the field or with no bristle in it.
+  /// trilinearly, so the D0 front has no block's steps in space. It still steps a block in time
+  /// as samples enter the next block (the marking is per block): the ribs along slow strokes
+  /// (docs/TRANSFER.md "Ribs on slow strokes"). Huge outside the field or with no bristle in it.
   WB_HD float distance(Vec3 q) const {
     if (block_of(q) < 0) return 1e30f;
     const float inv = 1.f / float(block);
