@@ -91,7 +91,7 @@ build="$here/build-gpu"
 # not fit the 64 MiB the GPU machine takes; nothing measured there uses them.
 cmake -S "$here" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DWB_CUDA=ON \
   -DCMAKE_CUDA_COMPILER=/usr/local/cuda/bin/nvcc -DCMAKE_CUDA_ARCHITECTURES="$arch" \
-  -DWB_BUILD_STUDIO=ON -DWB_MEDIA=OFF -DCMAKE_BUILD_RPATH='$ORIGIN' >/dev/null
+  -DWB_BUILD_STUDIO=ON -DWB_MEDIA=OFF -DWB_PYTHON=OFF -DCMAKE_BUILD_RPATH='$ORIGIN' >/dev/null
 cmake --build "$build" -j"$(nproc)" --target wetbrush wetbrush_tests wetbrush_bench wetbrush-studio
 # Libraries from the toolchain and Debian packages; glibc's own and the driver's stay behind.
 copy_libs "$build/bin" "$build"/bin/wetbrush "$build"/bin/wetbrush_tests "$build"/bin/wetbrush_bench

@@ -15,7 +15,10 @@ WB_PACKAGES=(cmake ninja-build g++ pkg-config libgtest-dev libgmock-dev libbench
   zstd
   # What a painting becomes (docs/FORMATS.md): the float height map (OpenEXR), the glTF relief
   # (tinygltf) and the time-lapse video (FFmpeg's libraries; H.264 through Debian's libx264).
-  libopenexr-dev libtinygltf-dev libavcodec-dev libavformat-dev libswscale-dev libavutil-dev)
+  libopenexr-dev libtinygltf-dev libavcodec-dev libavformat-dev libswscale-dev libavutil-dev
+  # The Python module (python/, docs/PYTHON.md): Debian's Python headers, pybind11, and NumPy
+  # and pytest for its tests.
+  python3-dev pybind11-dev python3-numpy python3-pytest)
 
 # The libFuzzer runs only (scripts/hardening.sh fuzz): clang with libFuzzer and its OpenMP.
 WB_FUZZ_PACKAGES=(clang libclang-rt-dev libomp-dev)

@@ -17,7 +17,7 @@ if [ "$what" = all ] || [ "$what" = asan ]; then
   mkdir -p "$asan"  # its configure log lives inside it, with the other build outputs
   start=$(date +%s)
   cmake -S "$WB_ROOT" -B "$asan" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWB_SANITIZE=ON -DWB_CUDA=OFF \
-    -DWB_BUILD_STUDIO=OFF -DWB_BUILD_TESTS=ON -DWB_BUILD_BENCH=OFF > "$asan/configure.log" 2>&1 ||
+    -DWB_BUILD_STUDIO=OFF -DWB_PYTHON=OFF -DWB_BUILD_TESTS=ON -DWB_BUILD_BENCH=OFF > "$asan/configure.log" 2>&1 ||
     { cat "$asan/configure.log"; exit 1; }
   cmake --build "$asan" --parallel "$jobs"
   built=$(date +%s)

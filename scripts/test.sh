@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs what is missing, checks the install list, builds every product (CLI, tests,
 # benchmarks, studio; CPU and, when nvcc exists, CUDA backends), runs every test and ends with a
-# summary: the products built and the tests per group (core, long, cli, studio). Fails when a test
+# summary: the products built and the tests per group (core, long, cli, studio, python). Fails when a test
 # fails or a group has no test.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
@@ -37,7 +37,7 @@ echo "products built: ${products[*]} (CUDA backend: ${cuda:-OFF})"
 statuses=$(sed -n 's/.*<testcase name="\([^"]*\)".*status="\([^"]*\)".*/\1\t\2/p' "$junit" 2>/dev/null |
   sed 's/&lt;/</g; s/&gt;/>/g; s/&quot;/"/g; s/&apos;/'"'"'/g; s/&amp;/\&/g' || true)
 total_pass=0 total_fail=0 total_skip=0
-for group in core long cli studio; do
+for group in core long cli studio python; do
   # One awk over the statuses and the group's names: no reader that stops early, so no SIGPIPE
   # for the writer under pipefail however many tests there are.
   read -r n pass fail skip < <(ctest -N -L "^${group}\$" | sed -n 's/^ *Test *#[0-9]*: //p' |

@@ -6,8 +6,7 @@
 #include <memory>
 
 #include "cli/commands.h"
-#include "core/io/document.h"
-#include "core/io/material_maps.h"
+#include "core/session/session.h"
 #if WB_WITH_MEDIA
 #include "media/relief_export.h"
 #endif
@@ -51,17 +50,18 @@ void register_export(CLI::App& app) {
     WB_REQUIRE(o->relief.base_mm > 0.0 && o->relief.base_mm <= 1000.0, "export: --base-mm must be in (0, 1000]");
     WB_REQUIRE(o->relief.error_mm >= 0.0 && o->relief.error_mm <= 100.0, "export: --error-mm must be in [0, 100]");
 #endif
-    const Device device = resolve_device(o->device);
-    Painting p = load_painting(o->painting, device);
+    SimConfig base;
+    base.device = resolve_device(o->device);
+    const std::unique_ptr<Session> session = Session::open(o->painting, base);
     if (!o->height.empty() || !o->normal.empty() || !o->albedo.empty()) {
-      const double scale = write_material_maps(device, p.canvas, MaterialMapPaths{o->height, o->normal, o->albedo});
+      const double scale = session->export_maps(MaterialMapPaths{o->height, o->normal, o->albedo});
       if (!o->height.empty())
         std::printf("wrote %s (height = value / %.4f cells; 1 cell = 0.2 mm)\n", o->height.c_str(), scale);
       for (const std::string* f : {&o->normal, &o->albedo})
         if (!f->empty()) std::printf("wrote %s\n", f->c_str());
     }
 #if WB_WITH_MEDIA
-    const ReliefStats s = write_relief_exports(device, p.canvas, ReliefPaths{o->exr, o->stl, o->glb}, o->relief);
+    const ReliefStats s = write_relief_exports(*session, ReliefPaths{o->exr, o->stl, o->glb}, o->relief);
     if (!o->exr.empty()) std::printf("wrote %s (height in mm, float)\n", o->exr.c_str());
     if (!o->stl.empty())
       std::printf("wrote %s (%zu triangles, %.1f mm3 with a %.2f mm base)\n", o->stl.c_str(), s.stl.triangles,

@@ -27,7 +27,7 @@
 #endif
 #include "core/params/param_table.h"
 #include "core/render/renderer.h"
-#include "core/sim/replay.h"
+#include "core/session/session.h"
 
 namespace wb::cli {
 namespace {
@@ -197,20 +197,15 @@ void report_bench(const ReplayArgs& a, const Simulator& sim, const Stroke& strok
 
 /// The simulator's configuration for a stroke and the command's options.
 SimConfig replay_config(const ReplayArgs& a, const Stroke& stroke, const Device& device) {
-  SimConfig cfg;
-  cfg.device = device;
-  cfg.canvas = stroke.canvas;
-  cfg.brush = stroke.brush;
+  SimConfig cfg = stroke_config(stroke, device);
   cfg.particles = !a.grid_only;
   if (!a.window.empty()) {
     WB_REQUIRE(a.window.size() == 3 && a.window[0] >= 16 && a.window[1] >= 16 && a.window[2] >= 8 &&
                    a.window[0] <= 1024 && a.window[1] <= 1024 && a.window[2] <= 256,
                "--window takes X,Y,Z cells (16..1024, 16..1024, 8..256)");
     cfg.window = Int3{a.window[0], a.window[1], std::min(a.window[2], stroke.canvas.depth)};
-  } else if (stroke.window) {
-    cfg.window = Int3{(*stroke.window)[0], (*stroke.window)[1], std::min((*stroke.window)[2], stroke.canvas.depth)};
   }
-  if (stroke.tilt) cfg.params.grid.tilt = *stroke.tilt;  // the canvas's; a parameter file or --set overrides it
+  // The stroke's tilt and paper are set; a parameter file or --set overrides them.
   if (!a.params_file.empty()) {
     std::ifstream f(a.params_file);
     WB_REQUIRE(f.good(), "cannot read parameter file '" + a.params_file + "'");
@@ -239,12 +234,10 @@ int run_replay(const ReplayArgs& a) {
   }
   const SimConfig cfg = replay_config(a, stroke, device);
 
-  StrokePlayer player(stroke);
-  Simulator sim(cfg, player.pose_at(player.t_begin()));
-  Replay replay(sim, player);
-  Renderer renderer(device);
-  renderer.params() = cfg.params.render;
-  if (stroke.paper_rgb) renderer.params().paper_rgb = Vec3((*stroke.paper_rgb)[0], (*stroke.paper_rgb)[1], (*stroke.paper_rgb)[2]);
+  Session session(cfg, start_pose(stroke));
+  session.begin_replay(stroke);
+  const Simulator& sim = session.sim();
+  const Replay& replay = *session.replay();
   const CanvasRect& r = replay.region();
   const Camera camera = Camera::top_region(float(r.x0), float(r.y0), float(r.width), float(r.height), 1.f);
 
@@ -257,7 +250,7 @@ int run_replay(const ReplayArgs& a) {
                                                 TimelapseOptions{a.fps, a.speed, a.video_camera == "oblique"});
     if (!video->video().fallback_note().empty())
       std::fprintf(stderr, "wetbrush: warning: %s\n", video->video().fallback_note().c_str());
-    video->begin(renderer, sim.canvas());
+    video->begin(session);
   }
 #endif
 
@@ -267,10 +260,11 @@ int run_replay(const ReplayArgs& a) {
   SolveLog solve;
   // The bench times every other step whole, its stages untimed: on CUDA the stages' scopes wait
   // for the device at their ends, which lengthens the step they break up (profile.h).
-  if (a.bench) sim.profiler().set_outermost(true);
-  while (replay.advance()) {
+  Profiler& profiler = session.sim().profiler();
+  if (a.bench) profiler.set_outermost(true);
+  while (session.advance()) {
     const int64_t done = replay.steps_done();
-    if (a.bench) sim.profiler().set_outermost(!sim.profiler().outermost());
+    if (a.bench) profiler.set_outermost(!profiler.outermost());
     if (a.bench) {
       solve.iterations.push_back(sim.grid().stats().viscosity_iterations);
       solve.residual.push_back(sim.grid().stats().viscosity_residual);
@@ -280,8 +274,7 @@ int run_replay(const ReplayArgs& a) {
     if (!a.frames_dir.empty() && done % a.every == 0) {
       char name[64];
       std::snprintf(name, sizeof name, "/frame_%06lld.png", static_cast<long long>(done));
-      const ParticleOverlay overlay = sim.particle_overlay();
-      const Image img = renderer.render(sim.canvas(), camera, sim.live_window(), &overlay);
+      const Image img = session.render(camera);
       write_png8(a.frames_dir + name, img.rgba.data(), img.width, img.height, 4);
     }
     char detail[128];
@@ -289,7 +282,7 @@ int run_replay(const ReplayArgs& a) {
                   static_cast<long long>(sim.particles().size()));
 #if WB_WITH_MEDIA
     if (video) {
-      video->after_step(renderer, sim, replay.sim_time());
+      video->after_step(session, replay.sim_time());
       std::snprintf(detail, sizeof detail, "%.2f s simulated  %lld particles  %lld video frames", replay.sim_time(),
                     static_cast<long long>(sim.particles().size()), static_cast<long long>(video->video().frames()));
     }
@@ -305,12 +298,12 @@ int run_replay(const ReplayArgs& a) {
   const int64_t particles_final = sim.particles().size();
 
   // The stroke is over: particles settle into the grid and the canvas holds the painting.
-  sim.settle();
+  session.settle();
   double render_ms = 0.0;
   Image painting;
   if (!a.image.empty() || !a.save.empty()) {
     const auto tr = std::chrono::steady_clock::now();
-    painting = renderer.render(sim.canvas(), camera);
+    painting = session.render(camera);
     render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tr).count();
   }
   if (!a.image.empty()) write_png8(a.image, painting.rgba.data(), painting.width, painting.height, 4);
@@ -318,7 +311,7 @@ int run_replay(const ReplayArgs& a) {
   if (video) {
     // The top view's last frame is the image -o writes, when it was rendered.
     const bool same = video->camera().kind == CameraKind::Top && !painting.rgba.empty();
-    video->finish(renderer, sim.canvas(), same ? &painting : nullptr);
+    video->finish(session, same ? &painting : nullptr);
     const VideoWriter& v = video->video();
     if (!a.quiet)
       std::printf("wrote %s: %lld frames at %d fps (%.2f s), %dx%d, %s\n", a.video.c_str(),
@@ -330,14 +323,10 @@ int run_replay(const ReplayArgs& a) {
     const auto img = replay.brush_image();
     write_png8(a.brush_image, img.data(), r.width, r.height, 3);
   }
-  if (!a.save.empty()) {
-    const Image full = renderer.render(sim.canvas(), Camera::top(sim.canvas().dims()));
-    save_painting(a.save, sim.canvas(), full,
-                  // The stroke file's name only: a painting records no path of the machine that made it.
-                  nlohmann::json{{"generator", "wetbrush replay"},
-                                 {"stroke", std::filesystem::path(a.strokes).filename().string()},
-                                 {"device", device.to_string()}});
-  }
+  if (!a.save.empty())
+    // The stroke file's name only: a painting records no path of the machine that made it.
+    session.save(a.save, {{"generator", "wetbrush replay"},
+                          {"stroke", std::filesystem::path(a.strokes).filename().string()}});
 
   const Profiler& prof = sim.profiler();
   const PaintBooks& books = sim.books();
@@ -465,23 +454,23 @@ int run_soak(const SoakArgs& s) {
       a.device = s.device;
       Run r{cycle, i, 0, 0, 0, 0, 0, 0, 0, 0};
       {
-        const SimConfig cfg = replay_config(a, strokes[i], device);
-        StrokePlayer player(strokes[i]);
-        Simulator sim(cfg, player.pose_at(player.t_begin()));
-        Replay replay(sim, player);
+        Session session(replay_config(a, strokes[i], device), start_pose(strokes[i]));
+        session.begin_replay(strokes[i]);
+        const Replay& replay = *session.replay();
         std::vector<double> ms;
         Progress progress(true, s.progress_every);
         const std::string what = "cycle " + std::to_string(cycle) + "  " + s.strokes[i];
         for (;;) {
           const auto ts = std::chrono::steady_clock::now();
-          if (!replay.advance()) break;
+          if (!session.advance()) break;
           ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - ts).count());
           char detail[64];
           std::snprintf(detail, sizeof detail, "%.0f s into the soak", elapsed());
           progress.step(replay.steps_done(), replay.step_count(), what, detail);
         }
         progress.finish();
-        sim.settle();
+        session.settle();
+        const Simulator& sim = session.sim();
         r.steps = int64_t(ms.size());
         if (!ms.empty()) {
           std::nth_element(ms.begin(), ms.begin() + ms.size() / 2, ms.end());

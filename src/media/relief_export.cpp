@@ -451,4 +451,9 @@ ReliefStats write_relief_exports(const Device& device, TileStore& canvas, const 
   return stats;
 }
 
+ReliefStats write_relief_exports(Session& session, const ReliefPaths& paths, const ReliefOptions& options) {
+  TileStore canvas = session.canvas_copy(session.device());
+  return write_relief_exports(session.device(), canvas, paths, options);
+}
+
 }  // namespace wb

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/canvas/tile_store.h"
+#include "core/session/session.h"
 #include "core/grid/grid_params.h"
 #include "core/render/renderer.h"
 
@@ -78,5 +79,7 @@ struct ReliefStats {
 /// Throws wb::Error naming the file on a failure.
 ReliefStats write_relief_exports(const Device& device, TileStore& canvas, const ReliefPaths& paths,
                                  const ReliefOptions& options = {});
+/// The same for a session's painting at rest (`wetbrush export`, the studio's File > Export).
+ReliefStats write_relief_exports(Session& session, const ReliefPaths& paths, const ReliefOptions& options = {});
 
 }  // namespace wb

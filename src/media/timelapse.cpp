@@ -24,39 +24,32 @@ TimelapseRecorder::TimelapseRecorder(const std::string& path, const CanvasRect& 
 
 TimelapseRecorder::~TimelapseRecorder() = default;
 
-void TimelapseRecorder::begin(Renderer& renderer, TileStore& canvas) { video_->add_frame(renderer.render(canvas, camera_)); }
+void TimelapseRecorder::begin(Session& session) { video_->add_frame(session.render(camera_)); }
 
-void TimelapseRecorder::after_step(Renderer& renderer, Simulator& sim, double sim_time) {
+void TimelapseRecorder::after_step(Session& session, double sim_time) {
   // Multiples of the interval, not a running sum, so a replay of T simulated seconds gives
   // 2 + floor(T * fps / speed) frames whatever its step size.
-  for (; sim_time >= double(next_) * options_.speed / options_.fps - 1e-9; ++next_) {
-    const ParticleOverlay overlay = sim.particle_overlay();
-    video_->add_frame(renderer.render(sim.canvas(), camera_, sim.live_window(), &overlay));
-  }
+  for (; sim_time >= double(next_) * options_.speed / options_.fps - 1e-9; ++next_) video_->add_frame(session.render(camera_));
 }
 
-void TimelapseRecorder::finish(Renderer& renderer, TileStore& canvas, const Image* painting) {
-  video_->add_frame(painting ? *painting : renderer.render(canvas, camera_));
+void TimelapseRecorder::finish(Session& session, const Image* painting) {
+  video_->add_frame(painting ? *painting : session.render(camera_));
   video_->finish();
 }
 
-int64_t write_timelapse(const Stroke& stroke, const SimConfig& config, const RenderParams& render,
-                        const std::string& path, const TimelapseOptions& options,
-                        const std::function<bool(int64_t done, int64_t total)>& progress) {
-  StrokePlayer player(stroke);
-  Simulator sim(config, player.pose_at(player.t_begin()));
-  Replay replay(sim, player);
-  Renderer renderer(config.device);
-  renderer.params() = render;
-  if (stroke.paper_rgb) renderer.params().paper_rgb = Vec3((*stroke.paper_rgb)[0], (*stroke.paper_rgb)[1], (*stroke.paper_rgb)[2]);
+int64_t write_timelapse(const Stroke& stroke, const SimConfig& config, const std::string& path,
+                        const TimelapseOptions& options, const std::function<bool(int64_t done, int64_t total)>& progress) {
+  Session session(config, start_pose(stroke));
+  session.begin_replay(stroke);
+  const Replay& replay = *session.replay();
   TimelapseRecorder rec(path, replay.region(), stroke.canvas.depth, options);
-  rec.begin(renderer, sim.canvas());
-  while (replay.advance()) {
-    rec.after_step(renderer, sim, replay.sim_time());
+  rec.begin(session);
+  while (session.advance()) {
+    rec.after_step(session, replay.sim_time());
     if (progress && !progress(replay.steps_done(), replay.step_count())) WB_THROW(path + ": time-lapse cancelled");
   }
-  sim.settle();
-  rec.finish(renderer, sim.canvas());
+  session.settle();
+  rec.finish(session);
   return rec.video().frames();
 }
 

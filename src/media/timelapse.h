@@ -11,7 +11,7 @@
 #include "media/video_writer.h"
 #include "core/render/camera.h"
 #include "core/render/renderer.h"
-#include "core/sim/replay.h"
+#include "core/session/session.h"
 
 namespace wb {
 
@@ -32,13 +32,13 @@ class TimelapseRecorder {
   const VideoWriter& video() const { return *video_; }
 
   /// Frame 0: the canvas before the first step.
-  void begin(Renderer& renderer, TileStore& canvas);
+  void begin(Session& session);
   /// The frames due once the replay has reached `sim_time` seconds (the live window and the
   /// particles drawn as the painter sees them).
-  void after_step(Renderer& renderer, Simulator& sim, double sim_time);
+  void after_step(Session& session, double sim_time);
   /// The settled painting as the last frame, then the file is written. `painting`, when given,
   /// is that frame already rendered with camera().
-  void finish(Renderer& renderer, TileStore& canvas, const Image* painting = nullptr);
+  void finish(Session& session, const Image* painting = nullptr);
 
  private:
   TimelapseOptions options_;
@@ -47,11 +47,10 @@ class TimelapseRecorder {
   int64_t next_ = 1;  ///< the next frame after frame 0
 };
 
-/// Replays `stroke` on a fresh simulator of `config` and writes its time-lapse to `path`.
+/// Replays `stroke` on a fresh session of `config` and writes its time-lapse to `path`.
 /// `progress` (may be empty) gets the steps done and their total after each step and returns
 /// false to cancel (a wb::Error then, and no file). Returns the frames written.
-int64_t write_timelapse(const Stroke& stroke, const SimConfig& config, const RenderParams& render,
-                        const std::string& path, const TimelapseOptions& options,
+int64_t write_timelapse(const Stroke& stroke, const SimConfig& config, const std::string& path, const TimelapseOptions& options,
                         const std::function<bool(int64_t done, int64_t total)>& progress = {});
 
 }  // namespace wb

@@ -7,9 +7,10 @@
 
 namespace wb::studio {
 
-void FrameCache::reset(CanvasDims dims) {
+void FrameCache::reset(Session& session) {
+  const CanvasDims dims = session.dims();
   dims_ = dims;
-  cache_ = std::make_unique<CanvasImageCache>(renderer_, Camera::top(dims), 32);
+  cache_ = std::make_unique<CanvasImageCache>(session.renderer(), Camera::top(dims), 32);
   std::lock_guard lk(mu_);
   front_ = QImage(dims.width, dims.height, QImage::Format_RGBA8888);
   front_.fill(Qt::black);
@@ -34,20 +35,19 @@ void FrameCache::invalidate_rect(int x0, int y0, int x1, int y1) {
   dirty_y1_ = std::max(dirty_y1_, y1);
 }
 
-bool FrameCache::render(Simulator& sim, bool force) {
+bool FrameCache::render(Session& session, bool force) {
   if (!cache_) return false;
   const double now = wall_now();
   if (!force && now - last_render_ < 1.0 / 30.0) return false;
   last_render_ = now;
   // The brush as it is now (preview, swatch), with every frame and after palette actions.
-  BrushPicture picture = sim.brush_picture();
+  BrushPicture picture = session.sim().brush_picture();
   {
     std::lock_guard lk(mu_);
     picture_ = std::move(picture);
   }
   if (dirty_x1_ < 0) return false;
-  ParticleOverlay overlay = sim.particle_overlay();
-  const Image& img = cache_->update(sim.canvas(), sim.live_window(), &overlay);
+  const Image& img = session.update_image(*cache_);
   // Copy the changed pixels (the marked rectangle grown by the renderer's reach) to the front.
   const int m = 48;
   const QRect r = QRect(QPoint(dirty_x0_ - m, dirty_y0_ - m), QPoint(dirty_x1_ + m, dirty_y1_ + m))
@@ -64,11 +64,10 @@ bool FrameCache::render(Simulator& sim, bool force) {
   return true;
 }
 
-Image FrameCache::canvas_image(Simulator& sim) {
+Image FrameCache::canvas_image(Session& session) {
   if (!cache_) return {};
-  if (dirty_x1_ >= 0) render(sim, true);
-  ParticleOverlay overlay = sim.particle_overlay();
-  return cache_->update(sim.canvas(), sim.live_window(), &overlay);
+  if (dirty_x1_ >= 0) render(session, true);
+  return session.update_image(*cache_);
 }
 
 FrameUpdate FrameCache::take(QImage& canvas) {

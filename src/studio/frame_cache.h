@@ -11,8 +11,7 @@
 #include <mutex>
 #include <vector>
 
-#include "core/render/renderer.h"
-#include "core/sim/simulator.h"
+#include "core/session/session.h"
 
 namespace wb::studio {
 
@@ -24,11 +23,10 @@ struct FrameUpdate {
 
 class FrameCache {
  public:
-  explicit FrameCache(Renderer& renderer) : renderer_(renderer) {}
-
   // --- simulation thread ---
-  /// A canvas of these dimensions: a new image cache and a black front image.
-  void reset(CanvasDims dims);
+  /// A new painting (or one of another size): a new image cache with its renderer and a black
+  /// front image.
+  void reset(Session& session);
   bool ready() const { return cache_ != nullptr; }
   /// The whole canvas must be drawn again (light, paper, a new canvas).
   void invalidate_all();
@@ -40,9 +38,9 @@ class FrameCache {
   /// Re-renders what changed and copies it to the front image, at most 30 times a second unless
   /// `force`; the brush picture and the consumed pen events are taken with it. True when the
   /// front image changed.
-  bool render(Simulator& sim, bool force);
+  bool render(Session& session, bool force);
   /// The whole canvas rendered now (one pixel per cell).
-  Image canvas_image(Simulator& sim);
+  Image canvas_image(Session& session);
 
   // --- UI thread (locked) ---
   /// Copies the pixels changed since the last call into `canvas`; returns their rectangle and
@@ -51,7 +49,6 @@ class FrameCache {
   BrushPicture brush_picture() const;
 
  private:
-  Renderer& renderer_;
   std::unique_ptr<CanvasImageCache> cache_;
   CanvasDims dims_{};
   double last_render_ = 0.0;

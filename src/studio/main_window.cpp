@@ -46,24 +46,13 @@
 namespace wb::studio {
 namespace {
 
-/// Canvas rectangle (cells) covered by the tiles of a diff.
-void diff_rect(const TileDiff& d, int tiles_x, int& x0, int& y0, int& x1, int& y1) {
-  x0 = y0 = 1 << 30;
-  x1 = y1 = -1;
-  for (const TileSnapshot& s : d.before) {
-    const int tx = s.tile_id % tiles_x, ty = s.tile_id / tiles_x;
-    x0 = std::min(x0, tx * kTileSize);
-    y0 = std::min(y0, ty * kTileSize);
-    x1 = std::max(x1, (tx + 1) * kTileSize);
-    y1 = std::max(y1, (ty + 1) * kTileSize);
-  }
-}
-
-/// One whole stroke: undo writes back the tiles as they were, redo as they became.
+/// One whole stroke, whose record the painting's Session keeps: undo writes back the tiles as
+/// they were, redo as they became (Session::undo, Session::redo). The Session's history and this
+/// stack grow and shrink together, a stroke at a time, to the same limit.
 class StrokeCommand : public QUndoCommand {
  public:
-  StrokeCommand(SimThread* sim, std::shared_ptr<TileDiff> diff, std::function<void()> on_change)
-      : QUndoCommand("Stroke"), sim_(sim), diff_(std::move(diff)), on_change_(std::move(on_change)) {}
+  StrokeCommand(SimThread* sim, std::function<void()> on_change)
+      : QUndoCommand("Stroke"), sim_(sim), on_change_(std::move(on_change)) {}
   void undo() override { apply(false); }
   void redo() override {
     if (first_) {  // the stroke is already on the canvas
@@ -75,18 +64,10 @@ class StrokeCommand : public QUndoCommand {
 
  private:
   void apply(bool after) {
-    auto d = diff_;
-    sim_->post([d, after](SimThread& s) {
-      s.restart_recording(false);
-      s.write_canvas([&](TileStore& canvas) { after ? d->apply_after(canvas) : d->apply_before(canvas); });
-      int x0, y0, x1, y1;
-      diff_rect(*d, s.sim().canvas().tiles_x(), x0, y0, x1, y1);
-      s.invalidate_rect(x0, y0, x1, y1);
-    });
+    sim_->post([after](SimThread& s) { s.undo_stroke(after); });
     on_change_();
   }
   SimThread* sim_;
-  std::shared_ptr<TileDiff> diff_;
   std::function<void()> on_change_;
   bool first_ = true;
 };
@@ -120,7 +101,7 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   cfg.params.transfer.candidate_split = q.candidate_split;
   RenderParams rp;
   rp.ao_rays = q.ao_rays;
-  sim_ = std::make_unique<SimThread>(cfg, rp);
+  sim_ = std::make_unique<SimThread>(cfg, rp, kUndoLimit);
 
   view_ = new CanvasView(options_.view);
   view_->set_frame_source([s = sim_.get()](QImage& img) { return s->take_frame(img); });
@@ -133,8 +114,8 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   undo_ = new QUndoStack(this);
   undo_->setUndoLimit(kUndoLimit);
   connect(undo_, &QUndoStack::cleanChanged, this, [this] { update_title(); });
-  connect(sim_.get(), &SimThread::strokeFinished, this, [this](std::shared_ptr<TileDiff> diff) {
-    undo_->push(new StrokeCommand(sim_.get(), std::move(diff), [this] { clock_.restart(); }));
+  connect(sim_.get(), &SimThread::strokeFinished, this, [this] {
+    undo_->push(new StrokeCommand(sim_.get(), [this] { clock_.restart(); }));
     autosave_due_ = true;
     idle_save_timer_.start();
   });
@@ -476,7 +457,7 @@ void MainWindow::build_menus() {
   canvas->addAction("&Clean brush", QKeySequence(Qt::Key_C), this, [this] { clean_brush(); });
   canvas->addAction("Clean &palette", this, [this] {
     palette_->sim()->post([](SimThread& s) {
-      s.write_canvas([](TileStore& c) { c.clear(); });
+      s.session().clear();
       s.invalidate_all();
     });
   });
@@ -585,7 +566,7 @@ std::optional<std::array<float, 3>> MainWindow::pick_color(QPointF canvas, SimTh
   std::future<std::optional<Vec3>> result = done->get_future();
   from->post([done, x, y](SimThread& s) {
     try {
-      done->set_value(s.renderer().pigment_at(s.sim().canvas(), x, y, s.sim().live_window()));
+      done->set_value(s.session().pick(x, y));
     } catch (...) {
       done->set_exception(std::current_exception());
     }
@@ -637,7 +618,6 @@ void MainWindow::new_canvas(int width, int height, QColor paper, const CanvasGro
     c.canvas.width = width;
     c.canvas.height = height;
     s.renderer().params().paper_rgb = rgb;
-    s.set_ground(std::nullopt);
     s.rebuild(c, false);
     if (ground.weave != Weave::Smooth) s.prime(ground);
     s.restart_recording(true);
@@ -675,11 +655,13 @@ bool MainWindow::write_snapshot(const QString& path, bool wait, bool user_save) 
   // The palette at rest, copied on its own thread; posted with the canvas's snapshot, so the
   // canvas's thread waits for it only behind what was asked of the palette before (a carry of
   // the brush that the canvas's thread itself serves first).
-  auto palette_copy = std::make_shared<std::promise<std::shared_ptr<TileStore>>>();
-  std::shared_future<std::shared_ptr<TileStore>> palette = palette_copy->get_future().share();
+  using Snapshot = std::shared_ptr<const PaintingSnapshot>;
+  auto palette_copy = std::make_shared<std::promise<Snapshot>>();
+  std::shared_future<Snapshot> palette = palette_copy->get_future().share();
   palette_->sim()->post([palette_copy](SimThread& s) {
     try {
-      palette_copy->set_value(std::make_shared<TileStore>(s.sim().settled_canvas_copy(Device{})));
+      const Image unrendered;  // the palette's picture is not saved
+      palette_copy->set_value(std::make_shared<const PaintingSnapshot>(s.session().snapshot({}, &unrendered)));
     } catch (...) {
       palette_copy->set_exception(std::current_exception());
     }
@@ -687,20 +669,13 @@ bool MainWindow::write_snapshot(const QString& path, bool wait, bool user_save) 
   sim_->post([done, file, from_blank, palette](SimThread& s) {
     try {
       // The paint at rest, with what is in flight now; the simulation goes on unchanged.
-      auto copy = std::make_shared<TileStore>(s.sim().settled_canvas_copy(Device{}));
-      std::shared_ptr<TileStore> pal = palette.get();
-      auto image = std::make_shared<Image>(s.canvas_image());
-      const Vec3 paper = s.renderer().params().paper_rgb;
-      nlohmann::json meta = {{"generator", "wetbrush-studio"},
-                             {"brush", brush_to_json(s.config().brush)},
-                             {"paper_rgb", {paper.x, paper.y, paper.z}},
-                             {"ground", s.ground() ? ground_to_json(*s.ground()) : nlohmann::json(nullptr)},
-                             {"recording_from_blank", from_blank}};
-      QThreadPool::globalInstance()->start([done, file, copy, image, meta, pal] {
+      const Image image = s.canvas_image();
+      auto snap = std::make_shared<const PaintingSnapshot>(
+          s.session().snapshot({{"generator", "wetbrush-studio"}, {"recording_from_blank", from_blank}}, &image));
+      Snapshot pal = palette.get();
+      QThreadPool::globalInstance()->start([done, file, snap, pal] {
         try {
-          SaveOptions options;
-          if (pal->allocated_tiles() > 0) options.palette = pal.get();
-          save_painting(file, *copy, *image, meta, options);
+          write_painting(file, *snap, pal.get());
           done->set_value("");
         } catch (const std::exception& e) {
           done->set_value(user_message(e));
@@ -778,46 +753,19 @@ bool MainWindow::open_from(const QString& path) {
   PalettePanel* palette = palette_;
   sim_->post([done, dims, file, palette](SimThread& s) {
     try {
-      Painting p = load_painting(file, s.sim().device());
-      if (p.palette) {
-        // The painting's palette replaces the one on the desk (its own size, if it was saved
-        // with another preset's).
-        auto pal = std::make_shared<TileStore>(std::move(*p.palette));
-        palette->sim()->post([pal, palette](SimThread& ps) {
-          if (!(ps.config().canvas == pal->dims())) {
-            SimConfig c = ps.config();
-            c.canvas = pal->dims();
-            ps.rebuild(c, false);
-            const int w = c.canvas.width, h = c.canvas.height;
-            QMetaObject::invokeMethod(palette, [palette, w, h] { palette->set_canvas_size(w, h); }, Qt::QueuedConnection);
-          }
-          ps.write_canvas([&](TileStore& canvas) { canvas.copy_from(*pal); });
-          ps.invalidate_all();
-        });
-      }
-      if (p.metadata.contains("paper_rgb") && p.metadata["paper_rgb"].is_array() && p.metadata["paper_rgb"].size() == 3)
-        s.renderer().params().paper_rgb =
-            Vec3(p.metadata["paper_rgb"][0].get<float>(), p.metadata["paper_rgb"][1].get<float>(),
-                 p.metadata["paper_rgb"][2].get<float>());
-      // The ground is in the volume already; the painting records what it is (for recordings).
-      // A ground entry this build cannot read costs the recordings their ground, not the painting.
-      std::optional<CanvasGround> ground;
-      if (p.metadata.contains("ground") && p.metadata["ground"].is_object()) {
-        try {
-          ground = ground_from_json(p.metadata["ground"], file, "metadata.ground");
-        } catch (const Error& e) {
-          std::fprintf(stderr, "wetbrush-studio: warning: %s (the painting opens; recordings from it have no ground)\n",
-                       e.what());
-        }
-      }
-      s.set_ground(ground);
-      SimConfig c = s.config();
-      c.canvas = p.canvas.dims();
-      s.rebuild(c, false);
-      s.write_canvas([&](TileStore& canvas) { canvas.copy_from(p.canvas); });  // on the simulator's device
-      s.restart_recording(false);
-      s.invalidate_all();
-      *dims = c.canvas;
+      s.open(file, false);
+      // The painting's palette replaces the one on the desk (its own size, if it was saved with
+      // another preset's).
+      palette->sim()->post([file, palette](SimThread& ps) {
+        const CanvasDims before = ps.session().dims();
+        if (!ps.open(file, true)) return;
+        const CanvasDims d = ps.session().dims();
+        if (!(d == before))
+          QMetaObject::invokeMethod(palette, [palette, w = d.width, h = d.height] { palette->set_canvas_size(w, h); },
+                                    Qt::QueuedConnection);
+      });
+      const CanvasDims c{s.session().dims()};
+      *dims = c;
       done->set_value("");
     } catch (const std::exception& e) {
       done->set_value(user_message(e));
@@ -862,8 +810,7 @@ bool MainWindow::export_png(const QString& path) {
 
 bool MainWindow::export_maps(const QString& height_path, const QString& normal_path) {
   return run_export([hp = height_path.toStdString(), np = normal_path.toStdString()](SimThread& s) {
-    TileStore canvas = s.sim().settled_canvas_copy(s.sim().device());
-    write_material_maps(s.sim().device(), canvas, MaterialMapPaths{hp, np, ""});
+    s.session().export_maps(MaterialMapPaths{hp, np, ""});
   });
 }
 
@@ -871,8 +818,7 @@ bool MainWindow::export_maps(const QString& height_path, const QString& normal_p
 bool MainWindow::export_relief(const QString& exr_path, const QString& stl_path, const QString& glb_path) {
   return run_export([paths = ReliefPaths{exr_path.toStdString(), stl_path.toStdString(), glb_path.toStdString()}](
                         SimThread& s) {
-    TileStore canvas = s.sim().settled_canvas_copy(s.sim().device());
-    write_relief_exports(s.sim().device(), canvas, paths);
+    write_relief_exports(s.session(), paths);
   });
 }
 
@@ -889,12 +835,13 @@ bool MainWindow::export_timelapse(const QString& path, const TimelapseOptions& o
   config.canvas = rec.canvas;
   config.brush = rec.brush;
   if (rec.window) config.window = Int3{(*rec.window)[0], (*rec.window)[1], std::min((*rec.window)[2], rec.canvas.depth)};
+  config.params.render = render;
   std::atomic<int64_t> done{0}, total{1};
   std::atomic<bool> cancel{false};
   const std::string file = path.toStdString();
   auto job = std::async(std::launch::async, [&]() -> std::string {
     try {
-      write_timelapse(rec, config, render, file, options, [&](int64_t d, int64_t t) {
+      write_timelapse(rec, config, file, options, [&](int64_t d, int64_t t) {
         done = d, total = std::max<int64_t>(t, 1);
         return !cancel.load();
       });

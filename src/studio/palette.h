@@ -10,16 +10,12 @@
 #include <memory>
 #include <vector>
 
+#include "core/session/session.h"
 #include "studio/canvas_view.h"
 #include "studio/pen_clock.h"
 #include "studio/sim_thread.h"
 
 namespace wb::studio {
-
-/// Puts a dab of wet `paint` on the canvas, a dome `radius` cells across its half and
-/// `height` cells high at its middle, on whatever paint is there (mixed by mass where they share
-/// a cell). Touches only the tiles under the dab.
-void put_paint_dab(TileStore& canvas, float cx, float cy, float radius, float height, const PaintLoad& paint);
 
 class PalettePanel : public QWidget {
   Q_OBJECT

@@ -8,18 +8,10 @@
 
 #include "core/color/ryb.h"
 #include "core/exec/error.h"
-#include "core/io/undo_tiles.h"
 #include "core/sim/replay.h"
 
 namespace wb::studio {
 namespace {
-
-/// Where a new simulator's brush waits: above the middle of the canvas.
-BrushPose rest_pose(const SimConfig& config) {
-  BrushPose rest;
-  rest.position = Vec3(config.canvas.width * 0.5f, config.canvas.height * 0.5f, config.brush.length * 1.5f);
-  return rest;
-}
 
 /// Adds the time since `since` to `bucket`; returns now.
 double lap(double& bucket, double since) {
@@ -30,9 +22,8 @@ double lap(double& bucket, double since) {
 
 }  // namespace
 
-SimThread::SimThread(const SimConfig& config, const RenderParams& render, QObject* parent)
-    : QObject(parent), config_(config), renderer_(config.device) {
-  renderer_.params() = render;
+SimThread::SimThread(const SimConfig& config, const RenderParams& render, int undo_levels, QObject* parent)
+    : QObject(parent), config_(config), render_(render), undo_levels_(undo_levels) {
   status_.device = config.device.to_string();
   // The simulator and the first full render are built on the worker: a big canvas must not
   // hold up the window.
@@ -103,41 +94,63 @@ FrameUpdate SimThread::take_frame(QImage& canvas) { return frames_.take(canvas);
 
 void SimThread::rebuild(const SimConfig& config, bool keep_canvas) {
   // Finish the old time line on the old simulator first.
-  if (sim_ && !failed_) drain();
+  if (doc_ && !failed_) drain();
   finish_stroke();
-  // The new simulator first: one the memory cannot hold is refused while the old one, and its
-  // painting, stay.
-  std::unique_ptr<Simulator> next = std::make_unique<Simulator>(config, rest_pose(config));
-  std::unique_ptr<Simulator> old = std::move(sim_);
-  const bool same_dims = old && old->canvas().dims() == config.canvas;
-  config_ = config;
-  sim_ = std::move(next);
-  carried_paint_ = false;  // a new brush is clean: its first stroke loads the well's paint
+  const bool same_dims = doc_ && doc_->dims() == config.canvas;
+  if (doc_) render_ = doc_->renderer().params();  // the view's light and paper as they are now
   // Nothing painted in this recording: a new one from the blank (primed) canvas is the same.
   const bool painted = session_.painted();
-  if (keep_canvas && same_dims) {
-    // The paint that was in flight comes too; the old simulator goes, so it settles for good,
-    // and its canvas is copied on the device.
-    old->settle();
-    write_canvas([&](TileStore& canvas) {
-      if (old->device() == config.device) {
-        canvas.copy_from(old->canvas());
-      } else {
-        for (int id : old->canvas().allocated_tile_ids()) canvas.write_tile(old->canvas().read_tile(id));
-      }
-    });
+  const bool same_session = keep_canvas && same_dims;
+  if (same_session) {
+    // The paint that was in flight comes too (Session::reconfigure settles it); a configuration
+    // the memory cannot hold is refused while the old one, and its painting, stay.
+    doc_->reconfigure(config);
   } else {
-    write_canvas([](TileStore&) {});
+    auto next = std::make_unique<Session>(config, undo_levels_);
+    doc_ = std::move(next);
   }
-  old.reset();
-  restart_recording(session_.from_blank() && !(keep_canvas && same_dims && painted));
-  if (!frames_.ready() || !same_dims) frames_.reset(config.canvas);
+  doc_->renderer().params() = render_;
+  config_ = config;
+  carried_paint_ = false;  // a new brush is clean: its first stroke loads the well's paint
+  restart_recording(session_.from_blank() && !(same_session && painted));
+  if (!same_session) frames_.reset(*doc_);  // the image cache draws with the new session's renderer
   {
     std::lock_guard lk(status_mu_);
     status_.device = config.device.to_string();
   }
   invalidate_all();
   render(true);
+}
+
+bool SimThread::open(const std::string& path, bool palette) {
+  if (doc_ && !failed_) drain();
+  finish_stroke();
+  // The painting opens with the brush in the painter's hand (the brush panel's).
+  Session::OpenOptions o;
+  o.undo_levels = palette ? 0 : undo_levels_;
+  o.palette = palette;
+  o.its_brush = false;
+  std::unique_ptr<Session> next = Session::open(path, config_, o);
+  if (!next) return false;
+  if (doc_) render_ = doc_->renderer().params();
+  // The studio's view keeps its light and its paper is the painting's.
+  const Vec3 paper = next->renderer().params().paper_rgb;
+  doc_ = std::move(next);
+  render_.paper_rgb = paper;
+  doc_->renderer().params() = render_;
+  config_ = doc_->config();
+  carried_paint_ = false;
+  restart_recording(false);
+  frames_.reset(*doc_);
+  invalidate_all();
+  render(true);
+  return true;
+}
+
+void SimThread::undo_stroke(bool redo) {
+  restart_recording(false);
+  if (const std::optional<CanvasRect> r = redo ? doc_->redo() : doc_->undo())
+    invalidate_rect(r->x0, r->y0, r->x0 + r->width, r->y0 + r->height);
 }
 
 void SimThread::restart_recording(bool from_blank) {
@@ -152,10 +165,10 @@ void SimThread::begin_recording(bool from_blank) {
   header.canvas = config_.canvas;
   header.brush = config_.brush;
   header.paint = paint_;
-  header.ground = ground_;
+  header.ground = doc_ ? doc_->ground() : std::nullopt;
   if (config_.params.grid.tilt > 0.f) header.tilt = config_.params.grid.tilt;
   header.paint.reload_on_pen_down = false;  // the studio's brush stays dirty between strokes
-  const Vec3 paper = renderer_.params().paper_rgb;
+  const Vec3 paper = render_.paper_rgb;
   header.paper_rgb = std::array<float, 3>{paper.x, paper.y, paper.z};
   header.window = std::array<int, 3>{config_.window.x, config_.window.y, config_.window.z};  // the replay's window
   header.dt = kStepDt;
@@ -169,18 +182,18 @@ void SimThread::begin_recording(bool from_blank) {
 BristleLoadHost SimThread::give_brush_paint() {
   drain();
   finish_stroke();
-  BristleLoadHost paint = sim_->brush_paint();
-  sim_->clean();  // the brush leaves: its paint goes with it (the books say so)
+  BristleLoadHost paint = sim().brush_paint();
+  sim().clean();  // the brush leaves: its paint goes with it (the books say so)
   return paint;
 }
 
 void SimThread::receive_brush_paint(const BristleLoadHost& paint) {
   drain();
   finish_stroke();
-  sim_->set_brush_paint(paint);
+  sim().set_brush_paint(paint);
   // The recording goes on from here with the brush as it came (its steps load nothing); a replay
   // of it starts with the carried paint's mean colour, oil and fill on every sample.
-  const PaintLoad carried = sim_->brush_mean_paint(paint_);
+  const PaintLoad carried = sim().brush_mean_paint(paint_);
   const PaintLoad well = paint_;
   paint_ = carried;
   restart_recording(false);
@@ -189,16 +202,8 @@ void SimThread::receive_brush_paint(const BristleLoadHost& paint) {
 }
 
 void SimThread::prime(const CanvasGround& g) {
-  sim_->lay_ground(g, rgb_to_ryb(renderer_.params().paper_rgb));
-  ground_ = g;
-  undo_.reset();
+  doc_->lay_ground(g);
   invalidate_all();
-}
-
-void SimThread::write_canvas(const std::function<void(TileStore&)>& write) {
-  if (!sim_) return;
-  sim_->replace_canvas(write);
-  undo_.reset();
 }
 
 void SimThread::invalidate_all() { frames_.invalidate_all(); }
@@ -207,13 +212,13 @@ void SimThread::invalidate_rect(int x0, int y0, int x1, int y1) { frames_.invali
 
 BrushPicture SimThread::brush_picture() const { return frames_.brush_picture(); }
 
-Image SimThread::canvas_image() { return sim_ ? frames_.canvas_image(*sim_) : Image{}; }
+Image SimThread::canvas_image() { return doc_ ? frames_.canvas_image(*doc_) : Image{}; }
 
 void SimThread::render_oblique(float elevation_deg, int max_width) {
-  if (!sim_) return;
-  const CanvasDims d = sim_->canvas().dims();
+  if (!doc_) return;
+  const CanvasDims d = doc_->dims();
   const float zoom = std::min(1.f, float(max_width) / float(d.width));
-  const Image img = renderer_.render(sim_->canvas(), Camera::oblique(d, elevation_deg, zoom), sim_->live_window());
+  const Image img = doc_->render(Camera::oblique(d, elevation_deg, zoom));
   QImage q(img.width, img.height, QImage::Format_RGBA8888);
   for (int y = 0; y < img.height; ++y) std::memcpy(q.scanLine(y), img.at(0, y), size_t(img.width) * 4);
   Q_EMIT obliqueReady(q);
@@ -221,7 +226,7 @@ void SimThread::render_oblique(float elevation_deg, int max_width) {
 
 void SimThread::drain() {
   SessionStep step;
-  while (!failed_ && sim_ && session_.next_step(step)) run_step(step);
+  while (!failed_ && doc_ && session_.next_step(step)) run_step(step);
 }
 
 void SimThread::run_step(const SessionStep& s) {
@@ -238,19 +243,12 @@ void SimThread::recover(const std::exception& e) {
   // the simulator, and the canvas returns to where the stroke began: the undo record's "before"
   // of every tile the stroke may have touched (it never reached the others). The paint the brush
   // held goes too; its next stroke loads the well's.
-  const std::vector<TileSnapshot> before = undo_.abandon();
-  std::unique_ptr<Simulator> old = std::move(sim_);
   try {
-    sim_ = std::make_unique<Simulator>(config_, rest_pose(config_));
-    write_canvas([&](TileStore& canvas) {
-      canvas.copy_from(old->canvas());
-      for (const TileSnapshot& t : before) restore_tile(canvas, t);
-    });
-    old.reset();
+    doc_->abandon_stroke();
   } catch (const std::exception& again) {
     // Nothing can be read back from the device (a fault that stays): the last autosave holds the
     // painting, and the studio offers it when it starts again.
-    sim_.reset();
+    doc_.reset();
     failed_ = true;
     const std::string m = "the device failed (" + user_message(e) + ") and the painting cannot be read back from it (" +
                           user_message(again) + "): quit and start the studio again to recover the last autosave";
@@ -277,23 +275,20 @@ void SimThread::recover(const std::exception& e) {
 }
 
 void SimThread::step_once(const SessionStep& s) {
-  Simulator& sim = *sim_;
+  Session& doc = *doc_;
   if (s.first) {
-    sim.reset_brush(session_.player().pose_at(session_.player().t_begin()));
     // A brush carried in from the other canvas keeps its paint, sample by sample.
-    if (!carried_paint_) sim.load_paint(session_.paint());
+    doc.begin_stroke(session_.player().pose_at(session_.player().t_begin()), session_.paint(), carried_paint_);
     carried_paint_ = false;
   }
-  double t = wall_now();
-  undo_.before_step(sim, s.from, s.step.pen);
-  t = lap(times_.undo, t);
-  const Int3 o0 = sim.live_window()->origin();
-  drive_step(sim, session_.player(), s.step, s.events, s.pen_down_edge && session_.paint().reload_on_pen_down, poses_);
+  const double t = wall_now();
+  const Int3 o0 = doc.sim().grid().window().origin();
+  doc.step(session_.player(), s.step, s.events, s.pen_down_edge && session_.paint().reload_on_pen_down);
   for (const StrokeEvent& e : s.events)
     if (e.kind == StrokeEventKind::Dry) invalidate_all();
   lap(times_.step, t);
   // Paint changes only inside the active window (where it was and where it moved to).
-  const Int3 o = sim.live_window()->origin(), n = sim.live_window()->dims();
+  const Int3 o = doc.sim().grid().window().origin(), n = doc.config().window;
   invalidate_rect(std::min(o.x, o0.x), std::min(o.y, o0.y), std::max(o.x, o0.x) + n.x, std::max(o.y, o0.y) + n.y);
   session_.step_done(s);
   // The pen events up to the step's end are in the paint now: they go with its next frame.
@@ -307,14 +302,13 @@ void SimThread::step_once(const SessionStep& s) {
 }
 
 void SimThread::finish_stroke() {
-  if (!sim_) return;
-  if (std::shared_ptr<TileDiff> diff = undo_.finish(*sim_)) Q_EMIT strokeFinished(diff);
+  if (doc_ && doc_->end_stroke()) Q_EMIT strokeFinished();
 }
 
 void SimThread::render(bool force) {
-  if (!sim_) return;
+  if (!doc_) return;
   try {
-    if (frames_.render(*sim_, force)) Q_EMIT frameReady();
+    if (frames_.render(*doc_, force)) Q_EMIT frameReady();
   } catch (const std::exception& e) {
     recover(e);  // the device failed between steps: the same as in one
   }
@@ -330,11 +324,11 @@ void SimThread::publish_status(bool force) {
   rate_steps_ = 0;
   rate_t0_ = now;
   last_status_ = now;
-  if (sim_) {
-    const double med = sim_->profiler().median_ms("sim.step");
+  if (doc_) {
+    const double med = sim().profiler().median_ms("sim.step");
     if (med > 0) status_.step_ms = med;
-    sim_->profiler().clear();  // bounded memory over a long session
-    status_.particles = sim_->particle_count();
+    sim().profiler().clear();  // bounded memory over a long session
+    status_.particles = sim().particle_count();
   }
   // The real-time factor of the last second, while the simulation was behind all of it: a
   // simulation that caught up within it kept up, whatever its rate while it ran.
@@ -387,7 +381,7 @@ void SimThread::run() {
     try {
       SessionStep step;
       double tp = t_start;
-      while (n < 64 && wall_now() - t_start < 0.05 && !failed_ && sim_) {
+      while (n < 64 && wall_now() - t_start < 0.05 && !failed_ && doc_) {
         const bool found = session_.next_step(step);
         lap(times_.player, tp);
         if (!found) break;

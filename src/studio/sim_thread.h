@@ -1,5 +1,6 @@
-// The studio's simulation thread: owns the Simulator, the renderer, the session recording and
-// its undo records; its pictures (canvas image, brush picture) are FrameCache's. The UI thread
+// The studio's simulation thread: owns the painting's Session (core/session/session.h: the
+// simulator, the renderer, the undo records, the document) and the session recording; its
+// pictures (canvas image, brush picture) are FrameCache's. The UI thread
 // only enqueues time-stamped pen
 // samples, palette events and commands, and takes the latest rendered pixels; it never waits
 // for a step. Steps run at the fixed dt of the session time line (pen_clock.h) through the
@@ -21,14 +22,11 @@
 #include <thread>
 
 #include "core/io/stroke_player.h"
-#include "core/io/undo_tiles.h"
-#include "core/render/renderer.h"
-#include "core/sim/simulator.h"
+#include "core/session/session.h"
 #include "studio/frame_cache.h"
 #include "studio/pen_clock.h"
 #include "studio/preset.h"
 #include "studio/session.h"
-#include "studio/stroke_undo.h"
 
 namespace wb::studio {
 
@@ -67,7 +65,8 @@ struct SimStatus {
 class SimThread : public QObject {
   Q_OBJECT
  public:
-  SimThread(const SimConfig& config, const RenderParams& render, QObject* parent = nullptr);
+  /// `undo_levels`: strokes the painting's Session keeps for undo (0: none, the palette).
+  SimThread(const SimConfig& config, const RenderParams& render, int undo_levels, QObject* parent = nullptr);
   ~SimThread() override;
 
   // --- called from the UI thread: never block on the simulation ---------------------------
@@ -90,17 +89,20 @@ class SimThread : public QObject {
   bool is_idle() const;
 
   // --- on the simulation thread (inside post()) -----------------------------------------
-  Simulator& sim() { return *sim_; }
-  Renderer& renderer() { return renderer_; }
-  /// Replaces the simulator (new brush or canvas), keeping the canvas' tiles when `keep`.
+  Session& session() { return *doc_; }
+  Simulator& sim() { return doc_->sim(); }
+  Renderer& renderer() { return doc_->renderer(); }
+  /// A new configuration (brush, canvas, parameters): the painting's Session takes it over with
+  /// its canvas when `keep_canvas` and the size holds (Session::reconfigure), else a new one starts.
   void rebuild(const SimConfig& config, bool keep_canvas);
+  /// The painting of `path` replaces this one (its canvas size, brush and paper; Session::open):
+  /// its palette instead when `palette` (false when the file has none).
+  bool open(const std::string& path, bool palette);
+  /// Undoes (or redoes) the last stroke the Session recorded: the time line is simulated to its
+  /// end first, and a new recording starts from the canvas as it is then.
+  void undo_stroke(bool redo);
   /// Starts a new recording (after undo, open, brush change): the next press begins it.
   void restart_recording(bool from_blank);
-  /// Writes the canvas from outside (undo, redo, open, a primed ground) through
-  /// Simulator::replace_canvas: the simulation then holds that canvas alone, paint in flight is
-  /// dropped (it belonged to the canvas that was replaced, and the books say so) and the next
-  /// undo record starts afresh.
-  void write_canvas(const std::function<void(TileStore&)>& write);
   /// Re-renders the whole canvas (light, paper, new canvas).
   void invalidate_all();
   void invalidate_rect(int x0, int y0, int x1, int y1);
@@ -121,19 +123,16 @@ class SimThread : public QObject {
   /// The brush arrives with this paint (give_brush_paint of the other canvas); a new recording
   /// starts, whose first step keeps that paint instead of loading the well's.
   void receive_brush_paint(const BristleLoadHost& paint);
-  /// Primes the blank canvas with `g` in the paper's colour (Simulator::lay_ground); the ground
+  /// Primes the blank canvas with `g` in the paper's colour (Session::lay_ground); the ground
   /// is the canvas's from then on: saved with the painting and with every recording.
   void prime(const CanvasGround& g);
-  /// The canvas's ground as an opened painting records it (nothing is laid).
-  void set_ground(const std::optional<CanvasGround>& g) { ground_ = g; }
-  const std::optional<CanvasGround>& ground() const { return ground_; }
   /// The brush's pose and paint as of the last rendered frame (the preview and the swatch).
   BrushPicture brush_picture() const;
 
  Q_SIGNALS:
   void frameReady();
-  /// One stroke finished: the tiles it changed (undo record).
-  void strokeFinished(std::shared_ptr<wb::TileDiff> diff);
+  /// One stroke finished and the Session keeps its undo record.
+  void strokeFinished();
   void failed(QString message);
   /// The oblique view asked for by render_oblique().
   void obliqueReady(QImage image);
@@ -142,13 +141,13 @@ class SimThread : public QObject {
   void run();
   /// Logs an exception with its source location and tells the window its message.
   void fail(const std::exception& e);
-  bool step_available() { return !failed_ && sim_ && session_.has_step(); }
+  bool step_available() { return !failed_ && doc_ && session_.has_step(); }
   /// One step of the time line; a step that throws (a device fault, a failed allocation) is
   /// recovered from (recover) rather than left half-made.
   void run_step(const SessionStep& step);
   void step_once(const SessionStep& step);
   /// The stroke a step failed in ends: the simulator is made anew on the canvas as it was before
-  /// the stroke, the painter is told, and painting and saving go on.
+  /// the stroke (Session::abandon_stroke), the painter is told, and painting and saving go on.
   void recover(const std::exception& e);
   /// A new time line for the recording, the old one not simulated further.
   void begin_recording(bool from_blank);
@@ -157,10 +156,10 @@ class SimThread : public QObject {
   void publish_status(bool force);
 
   SimConfig config_;
-  std::unique_ptr<Simulator> sim_;
-  Renderer renderer_;
+  RenderParams render_;  ///< the view's render parameters, for every Session made here
+  int undo_levels_ = 0;
+  std::unique_ptr<Session> doc_;  ///< the painting's session
   PaintLoad paint_{};
-  std::optional<CanvasGround> ground_;  ///< the canvas's priming (unset: bare)
   bool carried_paint_ = false;  ///< the brush holds paint carried in: the next recording loads none
   /// After a failed stroke: samples are dropped until the pen comes down after a lift.
   bool dropping_ = false;
@@ -178,11 +177,9 @@ class SimThread : public QObject {
   bool busy_ = false;
 
   SessionTimeline session_;  ///< the time line and its recording
-  std::vector<BrushPose> poses_;
-  StrokeUndo undo_;
 
   // Frames (worker -> UI): the canvas image and the brush picture.
-  FrameCache frames_{renderer_};
+  FrameCache frames_;
 
   mutable std::mutex status_mu_;
   SimStatus status_;

@@ -44,7 +44,7 @@ class DipTest : public SimulatorTest {
   Patch patch(Simulator& sim, int x0, int x1) {
     const CanvasDims d = sim.canvas().dims();
     PaintWindow w(device_, Int3{d.width, d.height, d.depth});
-    sim.canvas().gather(w);
+    SimulatorTestAccess::canvas(sim).gather(w);
     const auto f = w.to_host();  // density, r, y, b, oil, dryness
     Patch p;
     double s[3] = {0, 0, 0};

@@ -48,7 +48,7 @@ class LayerPropertiesTest : public SimulatorTest {
   /// reloads the simulator's window from the canvas.
   static void write_layer(Simulator& sim, const CellFn& cell) {
     const CanvasDims d = sim.canvas().dims();
-    fill_volume(sim.canvas(), 0, 0, d.width, d.height, cell);
+    fill_volume(SimulatorTestAccess::canvas(sim), 0, 0, d.width, d.height, cell);
     SimulatorTestAccess::grid(sim).window().reload();
   }
 
@@ -184,7 +184,7 @@ class LayerPropertiesTest : public SimulatorTest {
   std::vector<std::vector<float>> canvas_fields(Simulator& sim) {
     const CanvasDims d = sim.canvas().dims();
     PaintWindow w(device_, Int3{d.width, d.height, d.depth});
-    sim.canvas().gather(w);
+    SimulatorTestAccess::canvas(sim).gather(w);
     return w.to_host();
   }
 
@@ -241,7 +241,7 @@ TEST_F(LayerPropertiesTest, WhiteBrushCarriesRedPastAWetRedBand) {
   EXPECT_EQ(sim.counters().nonfinite_events, 0);
   const auto f = canvas_fields(sim);
   Renderer renderer(device_);
-  const FloatImage albedo = renderer.render_albedo(sim.canvas());
+  const FloatImage albedo = renderer.render_albedo(SimulatorTestAccess::canvas(sim));
   // Over the track's central band, x in [x0, x1): the paint's red pigment share (red pigment
   // per unit paint, over cells holding paint) and the mean albedo of columns holding at least
   // 0.1 cell of paint.

@@ -105,7 +105,7 @@ TEST_F(SimulatorTest, TheEstimateCoversWhatAStrokeHolds) {
       // The whole canvas rendered, as a replay's picture and a save's are.
       sim.settle();
       Renderer renderer(device_);
-      const Image picture = renderer.render(sim.canvas(), Camera::top(c.canvas));
+      const Image picture = renderer.render(SimulatorTestAccess::canvas(sim), Camera::top(c.canvas));
       EXPECT_EQ(picture.width, c.canvas.width);
     }
     const double peak = double(mem::usage(cuda).peak - held);

@@ -8,7 +8,7 @@
 
 #include "core/io/stroke.h"
 #include "core/io/stroke_player.h"
-#include "core/sim/replay.h"
+#include "core/session/session.h"
 #include "sim/sim_fixture.h"
 
 namespace wb::test {
@@ -42,13 +42,13 @@ class ReplayPauseTest : public SimulatorTest {
   };
 
   Run replay(const Stroke& stroke) const {
-    StrokePlayer player(stroke);
-    Simulator sim(small_config(), player.pose_at(player.t_begin()));
-    Replay r(sim, player);
-    while (r.advance()) {}
-    sim.settle();
+    Session session(small_config(), start_pose(stroke));
+    session.begin_replay(stroke);
+    while (session.advance()) {}
+    session.settle();
+    Simulator& sim = session.sim();
     Run out;
-    out.steps = player.step_count();
+    out.steps = session.replay()->step_count();
     out.simulated = sim.counters().steps;
     out.rests = sim.counters().rests;
     out.rest_seconds = sim.counters().rest_seconds;

@@ -12,6 +12,8 @@ struct SimulatorTestAccess {
   static Grid& grid(Simulator& s) { return *s.grid_; }
   static ParticleStore& particles(Simulator& s) { return s.particles_; }
   static BristleLoad& load(Simulator& s) { return *s.load_; }
+  static TileStore& canvas(Simulator& s) { return s.tiles(); }
+  static PaintWindow* live_window(Simulator& s) { return s.live_window(); }
 };
 }  // namespace wb
 

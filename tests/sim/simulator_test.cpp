@@ -89,13 +89,13 @@ TEST_F(SimulatorTest, SettledCanvasLeavesTheSimulationAsItWasAndReplacedCanvasIs
   stroke(b, 0, 8);
   ASSERT_GT(a.particle_count(), 0) << "paint in flight";
   const int64_t in_flight = a.particle_count();
-  const auto window_before = a.live_window()->to_host();
+  const auto window_before = SimulatorTestAccess::live_window(a)->to_host();
   const ParticleHost particles_before = a.particles().to_host();
   const double canvas_before = a.canvas().total_density();
   const double mass_before = a.census().total();
   const TileStore copy = a.settled_canvas_copy(Device{});
   // Exactly as it was: the window, every particle, the canvas and the books' view of them.
-  EXPECT_EQ(a.live_window()->to_host(), window_before);
+  EXPECT_EQ(SimulatorTestAccess::live_window(a)->to_host(), window_before);
   const ParticleHost particles_after = a.particles().to_host();
   ASSERT_EQ(particles_after.size(), particles_before.size());
   for (size_t k = 0; k < particles_before.size(); ++k) {
@@ -151,7 +151,7 @@ TEST_F(SimulatorTest, PressedLoadedBrushPaintsUnderItsFootprintAndBooksClose) {
   const float reach = 0.5f * c.brush.width + c.brush.length * c.brush.max_press + 4.f;
   double inside = 0.0;
   PaintWindow w(device_, Int3{256, 256, 16});
-  sim.canvas().gather(w);
+  SimulatorTestAccess::canvas(sim).gather(w);
   const auto f = w.to_host();
   for (int z = 0; z < 16; ++z)
     for (int y = 0; y < 256; ++y)
@@ -232,7 +232,7 @@ struct Footprint {
 Footprint footprint_of(Simulator& sim, const Device& device, float min_rho = 0.05f) {
   const CanvasDims d = sim.canvas().dims();
   PaintWindow w(device, Int3{d.width, d.height, d.depth});
-  sim.canvas().gather(w);
+  SimulatorTestAccess::canvas(sim).gather(w);
   const auto f = w.to_host();
   Footprint fp;
   fp.column.assign(size_t(d.width) * d.height, 0.f);

@@ -60,7 +60,7 @@ class SplashTest : public SimulatorTest {
     EXPECT_LT(std::abs(sim.books().max_drift()), 1e-4);
     EXPECT_EQ(sim.counters().nonfinite_events, 0);
     PaintWindow w(device_, Int3{kW, kH, kDepth});
-    sim.canvas().gather(w);
+    SimulatorTestAccess::canvas(sim).gather(w);
     const auto host = w.to_host();
     double total = 0, stray = 0, lid = 0;
     for (int z = 0; z < kDepth; ++z)

@@ -175,7 +175,7 @@ class StrokePropertiesTest : public SimulatorTest {
     EXPECT_LT(std::abs(sim.books().max_drift()), 1e-4);
     EXPECT_EQ(sim.counters().nonfinite_events, 0);
     PaintWindow w(device_, Int3{kW, kH, 16});
-    sim.canvas().gather(w);
+    SimulatorTestAccess::canvas(sim).gather(w);
     const auto host = w.to_host();
     std::vector<float> col(size_t(kW) * kH, 0.f);
     for (int z = 0; z < 16; ++z)
@@ -216,7 +216,7 @@ class StrokePropertiesTest : public SimulatorTest {
     EXPECT_EQ(sim.counters().nonfinite_events, 0);
     EXPECT_EQ(sim.counters().zone_cut_steps, 0);
     PaintWindow w(device_, Int3{S::W, S::H, 32});
-    sim.canvas().gather(w);
+    SimulatorTestAccess::canvas(sim).gather(w);
     const auto f = w.to_host();
     S st;
     st.h.assign(size_t(S::W) * S::H, 0.0);
@@ -598,7 +598,7 @@ Grooves broadside_grooves_at_rest(const Device& device, const SimConfig& scene, 
   const auto measure = [&](double& grooves, double& ridges, double* thickness) {
     sim.settle();  // the window's paint onto the canvas
     PaintWindow w(device, Int3{W, H, 16});
-    sim.canvas().gather(w);
+    SimulatorTestAccess::canvas(sim).gather(w);
     const auto f = w.to_host();
     std::vector<double> col(size_t(W) * H, 0.0), across(H, 0.0), along(W, 0.0);
     for (int z = 0; z < 16; ++z)

@@ -723,7 +723,7 @@ class StudioTest : public QObject {
     w_->new_canvas(kW, kH, paper);
     QVERIFY(w_->open_from(path));
     w_->settle();
-    const auto ground = on_sim(*w_, [](SimThread& s) { return s.ground(); });
+    const auto ground = on_sim(*w_, [](SimThread& s) { return s.session().ground(); });
     QVERIFY2(ground && *ground == linen, "the painting reopens on its linen");
     const Stroke reopened = on_sim(*w_, [](SimThread& s) { return s.recording(); });
     QVERIFY2(reopened.ground && *reopened.ground == linen, "a recording from the reopened painting keeps the ground");
@@ -736,7 +736,7 @@ class StudioTest : public QObject {
     save_painting(odd.toStdString(), blank, Image(kW, kH), {{"ground", {{"weave", "burlap"}}}});
     QVERIFY2(w_->open_from(odd), "a painting with an unreadable ground entry opens");
     w_->settle();
-    QVERIFY(!on_sim(*w_, [](SimThread& s) { return s.ground(); }).has_value());
+    QVERIFY(!on_sim(*w_, [](SimThread& s) { return s.session().ground(); }).has_value());
   }
 
   void paletteMixesPaintAndLoadsTheBrush() {
@@ -748,7 +748,7 @@ class StudioTest : public QObject {
     w_->paint_panel()->set_reload_each_stroke(false);  // the brush keeps the palette's mix
     PalettePanel* pal = w_->palette();
     on_thread(*pal->sim(), [](SimThread& s) {
-      s.write_canvas([](TileStore& c) { c.clear(); });
+      s.session().clear();
       return 0;
     });
     const float pw = float(preset_.palette_width), ph = float(preset_.palette_height);
@@ -829,7 +829,7 @@ class StudioTest : public QObject {
     QVERIFY2(best > 1.f, "the stroke left thick paint");
     // What the renderer shows there (unlit), and the pigment behind it.
     const Vec3 albedo = on_sim(*w_, [&](SimThread& s) {
-      const FloatImage a = s.renderer().render_albedo(s.sim().canvas(), s.sim().live_window());
+      const FloatImage a = s.session().albedo();
       return Vec3(a.at(bx, by, 0), a.at(bx, by, 1), a.at(bx, by, 2));
     });
     QTest::mouseClick(pp->findChildren<QToolButton*>()[1], Qt::LeftButton);

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/color/ryb.h"
 
 namespace wb {
 
@@ -37,15 +36,6 @@ Replay::Replay(Simulator& sim, StrokePlayer& player)
   contacts_.resize(steps);
   stretch_.set_device(sim.device());
   stretch_.resize(steps);
-  // The stroke's canvas is primed as its file says (the paper colour is the primer's).
-  if (const Stroke& st = player_.stroke(); st.ground) {
-    const Vec3 paper = st.paper_rgb ? Vec3((*st.paper_rgb)[0], (*st.paper_rgb)[1], (*st.paper_rgb)[2])
-                                    : sim_.config().params.render.paper_rgb;
-    sim_.lay_ground(*st.ground, rgb_to_ryb(paper));
-  }
-  sim_.reset_brush(player_.pose_at(player_.t_begin()));
-  // A brush that is not refilled at every pen-down carries one load for the whole stroke.
-  if (!player_.stroke().paint.reload_on_pen_down) sim_.load_paint(player_.stroke().paint);
   poses_.reserve(size_t(std::max(1, player_.stroke().max_substeps)));
 }
 
@@ -81,9 +71,8 @@ bool Replay::advance() {
     contacts_.grow_keep(size_t(recorded_) + 1);
     stretch_.grow_keep(size_t(recorded_) + 1);
   }
-  sim_.brush_->mark_contacts_into(trace_.data(), region_.width, region_.height, region_.x0, region_.y0, 1.0f,
-                                  sim_.solid_field(), contacts_.data() + recorded_);
-  sim_.brush_->max_stretch_into(stretch_.data() + recorded_);
+  sim_.mark_brush_contacts(trace_.data(), region_.width, region_.height, region_.x0, region_.y0,
+                           contacts_.data() + recorded_, stretch_.data() + recorded_);
   ++recorded_;
   last_t_ = step.t;
   return true;

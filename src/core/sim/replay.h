@@ -1,6 +1,7 @@
 // Replays a stroke through the simulator: the StrokePlayer gives the steps (poses,
 // sub-steps, pen edges, events), this driver runs them and keeps what a replay reports.
-// Used by `wetbrush replay`, `wetbrush bench` and the tests, so there is one replay path.
+// Session::begin_replay starts the stroke (its ground, the brush, the paint) and drives it, so
+// that `wetbrush replay`, `bench`, the studio's time-lapse, Python and the tests take one path.
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -28,6 +29,7 @@ void drive_step(Simulator& sim, const StrokePlayer& player, const PlayerStep& st
 
 class Replay {
  public:
+  /// Drives `player`'s steps through `sim`, whose stroke has begun (Session::begin_replay).
   Replay(Simulator& sim, StrokePlayer& player);
 
   /// Runs the next player step (all its sub-steps); false when the stroke is over.

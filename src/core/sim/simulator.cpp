@@ -277,6 +277,11 @@ void Simulator::with_settled_canvas(const std::function<void(TileStore&)>& fn) {
   restore();
 }
 
+void Simulator::mark_brush_contacts(int32_t* trace, int w, int h, int ox, int oy, double* count, float* stretch) {
+  brush_->mark_contacts_into(trace, w, h, ox, oy, 1.0f, solid_field(), count);
+  brush_->max_stretch_into(stretch);
+}
+
 TileStore Simulator::settled_canvas_copy(const Device& device) {
   TileStore copy(device, canvas_->dims());
   with_settled_canvas([&](TileStore& c) {

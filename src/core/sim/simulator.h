@@ -83,8 +83,8 @@ class Simulator {
   const SimConfig& config() const { return config_; }
   const Device& device() const { return config_.device; }
   /// The painting. The stages' own objects are private: read them through the const views
-  /// below; what changes them is this class's API (the replay driver and tests aside).
-  TileStore& canvas() { return *canvas_; }
+  /// below; what changes them is this class's API (its Session and tests aside).
+  const TileStore& canvas() const { return *canvas_; }
   const Brush& brush() const { return *brush_; }
   const Grid& grid() const { return *grid_; }
   const ParticleStore& particles() const { return particles_; }
@@ -160,17 +160,23 @@ class Simulator {
   void replace_canvas(const std::function<void(TileStore&)>& write);
   /// Liquid particles in flight.
   int64_t particle_count() const { return particles_.size(); }
-  /// The live window and the particles, for the renderer.
-  PaintWindow* live_window() { return &grid_->window().paint(); }
+  /// The particles in flight, for the renderer.
   ParticleOverlay particle_overlay();
   /// The brush's pose and paint now (a few small copies from the device; for the UI, not per step).
   BrushPicture brush_picture() const;
   /// Dried paint of the canvas as the brush sees it now (views into the current tile pool).
   SolidField solid_field();
+  /// A replay's report, on the device (no host read): the cells of the `w` x `h` trace at
+  /// (ox, oy) that a bristle touches now (within a cell of the canvas or dried paint), their count
+  /// into *count, and the largest relative segment stretch into *stretch.
+  void mark_brush_contacts(int32_t* trace, int w, int h, int ox, int oy, double* count, float* stretch);
 
  private:
-  friend class Replay;               // the contact trace and stretch of the replay's report
+  friend class Session;               // renders the live canvas and window, records undo from the tiles
   friend struct SimulatorTestAccess;  // tests poison and inspect the stages' state (tests/sim)
+  /// The tiles and the live window as the renderer and undo records take them (Session).
+  TileStore& tiles() { return *canvas_; }
+  PaintWindow* live_window() { return &grid_->window().paint(); }
   void brush_stage(const BrushPose* poses, int substeps, float dt);
   void particle_stage(float dt);
   void deposit_leaving_particles(Int3 next_origin);

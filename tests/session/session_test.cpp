@@ -1,0 +1,122 @@
+// wb::Session, the layer the CLI, the studio and Python paint through: a stroke is one undo unit,
+// a saved painting opens again as it was, and what does not fit the session is refused.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "core/exec/error.h"
+#include "core/session/session.h"
+#include "sim/sim_fixture.h"
+
+namespace wb::test {
+namespace {
+
+class SessionTest : public SimulatorTest {
+ protected:
+  /// The paint's total height over the canvas, cells (a map's sum).
+  static double total(const FloatImage& h) {
+    double s = 0.0;
+    for (float v : h.data) s += v;
+    return s;
+  }
+  static double max_difference(const FloatImage& a, const FloatImage& b) {
+    EXPECT_EQ(a.data.size(), b.data.size());
+    double d = 0.0;
+    for (size_t i = 0; i < a.data.size() && i < b.data.size(); ++i) d = std::max(d, double(std::fabs(a.data[i] - b.data[i])));
+    return d;
+  }
+  /// A pressed drag of 30 cells and the lift, through the session's stroke verbs.
+  void paint_stroke(Session& s, float y) {
+    const BrushSpec& b = s.config().brush;
+    PaintLoad once = red();
+    once.reload_on_pen_down = false;  // begin_stroke loads it
+    s.begin_stroke(pose_at(b, 100.f, y, 0.f, false), once);
+    const float dt = 1.f / 60.f;
+    for (int i = 0; i < 10; ++i) {
+      const BrushPose p = pose_at(b, 100.f + 3.f * float(i), y, 0.7f);
+      s.step(&p, 1, dt);
+    }
+    for (int i = 0; i < 4; ++i) {
+      const BrushPose p = pose_at(b, 130.f, y, 0.f, false);
+      s.step(&p, 1, dt);
+    }
+    EXPECT_TRUE(s.end_stroke()) << "the stroke changed the canvas";
+  }
+};
+
+TEST_F(SessionTest, AStrokeIsOneUndoUnitAndRedoPutsItBack) {
+  Session s(small_config(), 4);
+  EXPECT_FALSE(s.can_undo());
+  paint_stroke(s, 100.f);
+  const FloatImage first = s.height_map();
+  paint_stroke(s, 150.f);
+  const FloatImage both = s.height_map();
+  std::printf("paint height summed: first stroke %.1f, both %.1f cells\n", total(first), total(both));
+  ASSERT_GT(total(first), 10.0);
+  ASSERT_GT(total(both), total(first) + 10.0);
+
+  ASSERT_TRUE(s.undo());
+  const double after_undo = max_difference(s.height_map(), first);
+  ASSERT_TRUE(s.undo());
+  const double blank = total(s.height_map());
+  EXPECT_FALSE(s.undo()) << "two strokes, two undos";
+  ASSERT_TRUE(s.redo());
+  ASSERT_TRUE(s.redo());
+  const double after_redo = max_difference(s.height_map(), both);
+  std::printf("undo: %.2e cells from the first stroke's canvas; blank %.2e; redo: %.2e from both\n", after_undo, blank,
+              after_redo);
+  // Tiles are restored as they were stored (16-bit fields): within a quantum of the height.
+  EXPECT_LT(after_undo, 1e-3);
+  EXPECT_LT(blank, 1e-3);
+  EXPECT_LT(after_redo, 1e-3);
+  EXPECT_FALSE(s.redo());
+}
+
+TEST_F(SessionTest, ASavedPaintingOpensWithItsBrushPaperAndPaint) {
+  SimConfig c = small_config();
+  c.params.render.paper_rgb = Vec3(0.8f, 0.7f, 0.6f);
+  Session s(c);
+  PaintLoad blue = red();
+  blue.ryb[0] = 0.05f, blue.ryb[2] = 0.9f;
+  s.put_paint(60.f, 60.f, 10.f, 3.f, blue);
+  const FloatImage h = s.height_map();
+  ASSERT_GT(total(h), 100.0);
+  const std::string path = (std::filesystem::temp_directory_path() / "wb_session_test.ora").string();
+  s.save(path, {{"generator", "SessionTest"}});
+
+  SimConfig base;
+  base.device = device_;
+  const std::unique_ptr<Session> o = Session::open(path, base);
+  std::filesystem::remove(path);
+  EXPECT_TRUE(o->dims() == c.canvas);
+  EXPECT_EQ(o->config().brush.bristles, c.brush.bristles) << "the brush the metadata names";
+  EXPECT_FLOAT_EQ(o->config().brush.length, c.brush.length);
+  EXPECT_NEAR(o->renderer().params().paper_rgb.y, 0.7f, 1e-6f);
+  EXPECT_LT(max_difference(o->height_map(), h), 1e-3);
+  const std::optional<Vec3> at = o->pick(60, 60);
+  ASSERT_TRUE(at.has_value());
+  EXPECT_GT(at->z, 0.8f) << "the dab's blue";
+  EXPECT_FALSE(o->pick(200, 200).has_value()) << "bare canvas";
+}
+
+TEST_F(SessionTest, AStrokeOfAnotherCanvasOrNonsenseIsRefusedWithItsReason) {
+  Session s(small_config());
+  Stroke other;
+  other.canvas = CanvasDims{128, 128, 16};
+  other.source = "other.json";
+  PenSample p;
+  p.x = 10.f, p.y = 10.f;
+  other.samples = {p};
+  try {
+    s.begin_replay(other);
+    FAIL() << "a stroke of another canvas replayed";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("not this session's"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(s.put_paint(10.f, 10.f, std::nanf(""), 1.f, red()), Error);
+  EXPECT_THROW(s.advance(), Error) << "no replay begun";
+}
+
+}  // namespace
+}  // namespace wb::test
