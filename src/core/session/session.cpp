@@ -309,12 +309,9 @@ void Session::begin_replay(const Stroke& stroke) {
 
 bool Session::advance() {
   WB_REQUIRE(replay_ != nullptr, "Session::advance: no replay was begun");
-  if (undo_levels_ > 0 && player_->steps_done() < player_->step_count()) {
-    // The step's reach, from the brush now to where the stroke is a step later.
-    const double t = player_->t_begin() + double(player_->steps_done() + 1) * player_->stroke().dt;
-    capture_before_step(player_->pose_at(std::min(t, player_->t_end())));
-  }
-  if (replay_->advance()) return true;
+  const bool more = undo_levels_ > 0 ? replay_->advance([this](const BrushPose& end) { capture_before_step(end); })
+                                     : replay_->advance();
+  if (more) return true;
   end_stroke();
   return false;
 }

@@ -48,7 +48,7 @@ void drive_step(Simulator& sim, const StrokePlayer& player, const PlayerStep& st
   sim.step(poses.data(), step.substeps, float(step.dt));
 }
 
-bool Replay::advance() {
+bool Replay::advance(const std::function<void(const BrushPose& end)>& before_step) {
   // A pause: the pen in the air for at least kMinRestSeconds more, no event, the paint at rest.
   // It is passed over in one call (Simulator::rest: the particles back into the grid, drying
   // for its length, the brush waiting where the pause ends), so that an hour's pause costs what
@@ -65,6 +65,7 @@ bool Replay::advance() {
   }
   PlayerStep step;
   if (!player_.next(step)) return false;
+  if (before_step) before_step(player_.pose_at(step.t));
   drive_step(sim_, player_, step, step.events, step.pen_down_edge && player_.stroke().paint.reload_on_pen_down, poses_);
   // A bristle is in contact when a sample is within one cell of the canvas or dried paint.
   if (recorded_ == int64_t(contacts_.size())) {  // sized for the player's step count: not reached

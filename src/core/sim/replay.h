@@ -32,8 +32,10 @@ class Replay {
   /// Drives `player`'s steps through `sim`, whose stroke has begun (Session::begin_replay).
   Replay(Simulator& sim, StrokePlayer& player);
 
-  /// Runs the next player step (all its sub-steps); false when the stroke is over.
-  bool advance();
+  /// Runs the next player step (all its sub-steps); false when the stroke is over. `before_step`,
+  /// when given, is told where the brush will be at the step's end just before it runs (after a
+  /// pause passed over: Session's undo records).
+  bool advance(const std::function<void(const BrushPose& end)>& before_step = {});
   int64_t steps_done() const { return player_.steps_done(); }
   int64_t step_count() const { return player_.step_count(); }
   double sim_time() const { return last_t_ - player_.t_begin(); }
