@@ -229,25 +229,19 @@ CanvasRect Session::restore(const TileDiff& d, bool after) {
   return x1 < 0 ? CanvasRect{} : CanvasRect{x0, y0, x1 - x0, y1 - y0};
 }
 
-std::optional<CanvasRect> Session::undo() {
+std::optional<CanvasRect> Session::move_record(std::deque<TileDiff>& from, std::deque<TileDiff>& to, bool after) {
   end_stroke();
-  if (undo_.empty()) return std::nullopt;
-  TileDiff d = std::move(undo_.back());
-  undo_.pop_back();
-  const CanvasRect r = restore(d, false);
-  redo_.push_back(std::move(d));
+  if (from.empty()) return std::nullopt;
+  TileDiff d = std::move(from.back());
+  from.pop_back();
+  const CanvasRect r = restore(d, after);
+  to.push_back(std::move(d));
   return r;
 }
 
-std::optional<CanvasRect> Session::redo() {
-  end_stroke();
-  if (redo_.empty()) return std::nullopt;
-  TileDiff d = std::move(redo_.back());
-  redo_.pop_back();
-  const CanvasRect r = restore(d, true);
-  undo_.push_back(std::move(d));
-  return r;
-}
+std::optional<CanvasRect> Session::undo() { return move_record(undo_, redo_, false); }
+
+std::optional<CanvasRect> Session::redo() { return move_record(redo_, undo_, true); }
 
 void Session::abandon_stroke() {
   replay_.reset();

@@ -165,6 +165,8 @@ class Session {
   void capture_before_step(const BrushPose& to);
   /// Writes a record's tiles (before or after) and returns the rectangle they cover.
   CanvasRect restore(const TileDiff& d, bool after);
+  /// The last record of `from` restored (its tiles after the stroke when `after`) and moved to `to`.
+  std::optional<CanvasRect> move_record(std::deque<TileDiff>& from, std::deque<TileDiff>& to, bool after);
   void reset_undo_records();
   /// Replaces the canvas's tiles (undo, redo, load) and drops what records described the old one.
   void write_canvas(const std::function<void(TileStore&)>& write);
