@@ -31,6 +31,8 @@ products=()
 for p in wetbrush wetbrush_tests wetbrush_bench wetbrush-studio wetbrush_studio_tests; do
   if [ -x "$WB_BUILD/bin/$p" ]; then products+=("$p"); else echo "MISSING product: bin/$p"; ok=0; fi
 done
+if compgen -G "$WB_BUILD/bin/wetbrush.*.so" > /dev/null; then products+=("wetbrush (Python module)")
+else echo "MISSING product: bin/wetbrush.*.so (the Python module)"; ok=0; fi
 cuda=$(sed -n 's/^WB_CUDA:STRING=//p' "$WB_BUILD/CMakeCache.txt")
 echo "products built: ${products[*]} (CUDA backend: ${cuda:-OFF})"
 # Status of every test case from CTest's JUnit file: name<TAB>status (run, fail, notrun, ...).

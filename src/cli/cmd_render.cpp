@@ -14,6 +14,7 @@
 #include "core/io/png.h"
 #include "core/render/renderer.h"
 #include "core/render/test_volumes.h"
+#include "core/session/session.h"
 
 namespace wb::cli {
 
@@ -147,13 +148,18 @@ void register_render(CLI::App& app) {
       std::printf("wrote %s\n", o->out.c_str());
     }
     if (!o->save.empty()) {
-      const Image merged = o->camera == "top" && cam.width == dims.width && cam.height == dims.height && o->zoom == 1.f
-                               ? img
-                               : renderer.render(*canvas, Camera::top(dims));
+      // Saved as every painting is (Session::save), with the view's render parameters.
+      SimConfig cfg;
+      cfg.device = device;
+      cfg.canvas = dims;
+      cfg.window.z = std::min(cfg.window.z, dims.depth);
+      cfg.params.render = p;
+      Session session(cfg);
+      session.load(*canvas);
       // The source file's name only: a painting records no path of the machine that made it.
       const std::string source =
           o->test_volume.empty() ? std::filesystem::path(o->painting).filename().string() : o->test_volume;
-      save_painting(o->save, *canvas, merged, {{"source", source}});
+      session.save(o->save, {{"generator", "wetbrush render"}, {"source", source}});
       std::printf("wrote %s\n", o->save.c_str());
     }
     return 0;

@@ -100,6 +100,29 @@ TEST_F(SessionTest, ASavedPaintingOpensWithItsBrushPaperAndPaint) {
   EXPECT_FALSE(o->pick(200, 200).has_value()) << "bare canvas";
 }
 
+TEST_F(SessionTest, APaintingsUnreadableRecordsCostThoseRecordsNotThePainting) {
+  // A paper out of range and a brush and ground of the wrong kind: the painting opens with the
+  // defaults for them (a warning each), its paint as saved.
+  SimConfig c = small_config();
+  Session s(c);
+  s.put_paint(40.f, 40.f, 6.f, 2.f, red());
+  PaintingSnapshot snap = s.snapshot();
+  snap.metadata["paper_rgb"] = {5.0, 0.0, 0.0};
+  snap.metadata["brush"] = {{"bristles", -3}};
+  snap.metadata["ground"] = {{"weave", "no such weave"}};
+  const std::string path = (std::filesystem::temp_directory_path() / "wb_session_records.ora").string();
+  write_painting(path, snap);
+  SimConfig base;
+  base.device = device_;
+  const std::unique_ptr<Session> o = Session::open(path, base);
+  std::filesystem::remove(path);
+  const Vec3 paper = o->renderer().params().paper_rgb, fallback = SimConfig{}.params.render.paper_rgb;
+  EXPECT_EQ(paper.x, fallback.x);
+  EXPECT_EQ(o->config().brush.bristles, SimConfig{}.brush.bristles);
+  EXPECT_FALSE(o->ground().has_value());
+  EXPECT_LT(max_difference(o->height_map(), s.height_map()), 1e-3);
+}
+
 TEST_F(SessionTest, AStrokeOfAnotherCanvasOrNonsenseIsRefusedWithItsReason) {
   Session s(small_config());
   Stroke other;

@@ -102,25 +102,30 @@ std::unique_ptr<Session> Session::open(const std::string& path, const SimConfig&
   // What the painting records of how it was made; an entry this build cannot read costs that
   // entry (a warning), not the painting.
   auto warn = [&](const Error& e, const char* what) {
-    std::fprintf(stderr, "wetbrush: warning: %s (the painting opens with the default %s)\n", e.what(), what);
+    std::fprintf(stderr, "wetbrush: warning: %s (the painting opens %s)\n", e.what(), what);
   };
   if (options.its_brush && m.contains("brush") && m["brush"].is_object()) {
     try {
       cfg.brush = brush_from_json(m["brush"], path, "metadata.brush");
     } catch (const Error& e) {
-      warn(e, "brush");
+      warn(e, "with the default brush");
     }
   }
-  if (m.contains("paper_rgb") && m["paper_rgb"].is_array() && m["paper_rgb"].size() == 3 &&
-      std::all_of(m["paper_rgb"].begin(), m["paper_rgb"].end(), [](const nlohmann::json& v) { return v.is_number(); }))
-    cfg.params.render.paper_rgb =
-        Vec3(m["paper_rgb"][0].get<float>(), m["paper_rgb"][1].get<float>(), m["paper_rgb"][2].get<float>());
+  if (m.contains("paper_rgb")) {
+    const nlohmann::json& p = m["paper_rgb"];
+    const auto unit = [](const nlohmann::json& v) { return v.is_number() && v.get<double>() >= 0.0 && v.get<double>() <= 1.0; };
+    if (p.is_array() && p.size() == 3 && std::all_of(p.begin(), p.end(), unit))
+      cfg.params.render.paper_rgb = Vec3(p[0].get<float>(), p[1].get<float>(), p[2].get<float>());
+    else
+      std::fprintf(stderr, "wetbrush: warning: %s: metadata.paper_rgb is not three numbers in [0, 1] (the painting "
+                   "opens with the default paper)\n", path.c_str());
+  }
   auto s = std::make_unique<Session>(cfg, options.undo_levels);
   if (m.contains("ground") && m["ground"].is_object()) {
     try {
       s->ground_ = ground_from_json(m["ground"], path, "metadata.ground");
     } catch (const Error& e) {
-      warn(e, "ground record");
+      warn(e, "without its ground record: recordings from it have no ground");
     }
   }
   s->write_canvas([&](TileStore& canvas) { canvas.copy_from(p.canvas); });
@@ -388,10 +393,16 @@ void Session::load(const std::string& path) {
   write_canvas([&](TileStore& canvas) { canvas.copy_from(p.canvas); });
 }
 
-void Session::load(Session& from) {
-  WB_REQUIRE(from.dims() == dims(), "Session::load: the paintings' canvases differ in size");
-  const TileStore copy = from.canvas_copy(device());
-  write_canvas([&](TileStore& canvas) { canvas.copy_from(copy); });
+void Session::load(Session& from) { load(from.canvas_copy(device())); }
+
+void Session::load(const TileStore& from) {
+  WB_REQUIRE(from.dims() == dims(), "Session::load: the canvases differ in size");
+  write_canvas([&](TileStore& canvas) {
+    if (from.device() == device())
+      canvas.copy_from(from);
+    else
+      for (int id : from.allocated_tile_ids()) canvas.write_tile(from.read_tile(id));
+  });
 }
 
 void Session::clear() {

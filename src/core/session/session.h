@@ -152,6 +152,8 @@ class Session {
   void load(const std::string& path);
   /// Takes another session's painting at rest (same size; the palette of an opened painting).
   void load(Session& from);
+  /// Takes a canvas's paint (same size; a built-in test volume of `wetbrush render`).
+  void load(const TileStore& canvas);
   /// A blank canvas (paint in flight dropped; the books say so).
   void clear();
   /// The image `cache` keeps of this painting brought up to date where the paint changed, with
