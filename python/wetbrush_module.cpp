@@ -308,11 +308,65 @@ PYBIND11_MODULE(wetbrush, m) {
       .def("albedo", [](Session& s) { return image_array(s.albedo()); }, "Unlit paint colour a cell, linear RGB.")
       .def(
           "render",
-          [](Session& s, const std::string& camera) {
+          [](Session& s, const std::string& camera, std::optional<std::array<float, 4>> region, float zoom) {
             if (camera != "top" && camera != "oblique") throw Error("render: camera must be 'top' or 'oblique'");
-            return image_array(s.render(camera == "top" ? Camera::top(s.dims()) : Camera::oblique(s.dims())));
+            if (!(std::isfinite(zoom) && zoom > 0.f && zoom <= 16.f)) throw Error("render: zoom must be in (0, 16]");
+            if (camera == "oblique") return image_array(s.render(Camera::oblique(s.dims(), 30.f, zoom)));
+            if (!region) return image_array(s.render(Camera::top_region(0.f, 0.f, float(s.dims().width), float(s.dims().height), zoom)));
+            const auto& r = *region;
+            if (!(std::isfinite(r[0]) && std::isfinite(r[1]) && r[2] >= 1.f && r[3] >= 1.f && r[2] * zoom <= 16384.f &&
+                  r[3] * zoom <= 16384.f))
+              throw Error("render: region is (x0, y0, width, height) in cells, at least a cell and at most 16384 pixels a side");
+            return image_array(s.render(Camera::top_region(r[0], r[1], r[2], r[3], zoom)));
           },
-          py::arg("camera") = "top", "The painting lit as the studio shows it, RGBA8.")
+          py::arg("camera") = "top", py::arg("region") = py::none(), py::arg("zoom") = 1.f,
+          "The painting lit as the studio shows it, RGBA8: from above (a region (x0, y0, width, height) in "
+          "cells, zoom pixels a cell) or oblique.")
+      .def(
+          "dip",
+          [](Session& s, std::array<float, 3> color, float oil, float load) {
+            StrokeEvent e;
+            e.kind = StrokeEventKind::Dip;
+            for (int i = 0; i < 3; ++i) e.ryb[i] = color[i];
+            e.oil = oil, e.load = load;
+            s.apply(e);
+          },
+          py::arg("color"), py::arg("oil") = 0.3f, py::arg("load") = 1.f,
+          "Dips the brush into a well of this paint (RYB), up to `load` of its capacity.")
+      .def(
+          "wipe",
+          [](Session& s, float fraction) {
+            StrokeEvent e;
+            e.kind = StrokeEventKind::Wipe;
+            e.fraction = fraction;
+            s.apply(e);
+          },
+          py::arg("fraction") = 0.5f, "Wipes this fraction of its paint off the brush.")
+      .def(
+          "clean",
+          [](Session& s) {
+            StrokeEvent e;
+            e.kind = StrokeEventKind::Clean;
+            s.apply(e);
+          },
+          "Cleans the brush in solvent.")
+      .def(
+          "dry",
+          [](Session& s) {
+            StrokeEvent e;
+            e.kind = StrokeEventKind::Dry;
+            s.apply(e);
+          },
+          "Lets the painting dry: every painted cell becomes solid (the undo history starts again).")
+      .def(
+          "lay_ground",
+          [](Session& s, const py::dict& ground) {
+            const std::string text = py::module_::import("json").attr("dumps")(ground).cast<std::string>();
+            s.lay_ground(ground_from_json(nlohmann::json::parse(text), "ground", ""));
+          },
+          py::arg("ground"),
+          "Primes the blank canvas with a woven ground: {'weave': 'linen' or 'cotton_duck', 'thread_mm', "
+          "'relief_mm', 'priming_mm'} (the stroke format's canvas.ground).")
       .def(
           "pick",
           [](Session& s, int x, int y) -> py::object {

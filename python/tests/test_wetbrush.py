@@ -83,6 +83,34 @@ def test_undo_and_files(painted, tmp_path):
     assert np.abs(s.height() - before).max() < 1e-3
 
 
+def test_palette_verbs_ground_and_regions():
+    s = small_session(undo=4)
+    s.lay_ground({"weave": "linen"})
+    primed = s.height()
+    assert primed.min() > 0.0, "the primer lies under the weave's hollows"
+    assert primed.max() - primed.min() > 0.5, "the weave's relief"
+    s.dip((0.05, 0.1, 0.9), oil=0.4, load=1.0)
+    s.wipe(0.2)
+    x, y, p = drag(12)
+    s.paint(x, y, p, color=(0.05, 0.1, 0.9))
+    assert s.albedo()[48, 60, 2] > s.albedo()[48, 60, 0]
+    s.paint(x, y + 20.0, p, color=(0.9, 0.1, 0.05))
+    assert s.undo() is True, "the second stroke goes"
+    s.clean()
+    before = s.census()["total"]
+    s.dry()
+    assert s.undo() is False, "drying starts a new history"
+    assert s.census()["total"] == pytest.approx(before, rel=1e-6), "the first stroke stays"
+    img = s.render(region=(40, 40, 32, 16), zoom=2)
+    assert img.shape == (32, 64, 4)
+    with pytest.raises(wetbrush.Error, match="in \\[0, 1\\]"):
+        s.dip((2.0, 0.0, 0.0))
+    with pytest.raises(wetbrush.Error):
+        s.wipe(math.nan)
+    with pytest.raises(wetbrush.Error, match="weave"):
+        s.lay_ground({"weave": "silk"})
+
+
 def test_parameters_by_id():
     table = {p["id"]: p for p in wetbrush.params()}
     assert "grid.tilt" in table and table["grid.tilt"]["unit"]

@@ -198,6 +198,11 @@ void Session::step(const StrokePlayer& player, const PlayerStep& step, std::span
 }
 
 void Session::apply(const StrokeEvent& event) {
+  // What a stroke file's reader checks of an event (the library's callers pass values unread).
+  const auto unit = [](float v) { return std::isfinite(v) && v >= 0.f && v <= 1.f; };
+  WB_REQUIRE(unit(event.ryb[0]) && unit(event.ryb[1]) && unit(event.ryb[2]) && unit(event.oil) && unit(event.load) &&
+                 unit(event.fraction),
+             std::string(to_string(event.kind)) + ": the pigment, oil, load and fraction must be in [0, 1]");
   if (event.kind == StrokeEventKind::Dry) reset_undo_records();
   sim_->apply(event);
 }
