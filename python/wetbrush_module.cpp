@@ -114,6 +114,12 @@ Stroke stroke_from_arrays(const CanvasDims& canvas, const BrushSpec& brush, cons
   return s;
 }
 
+StrokeEvent event_of(StrokeEventKind kind) {
+  StrokeEvent e;
+  e.kind = kind;
+  return e;
+}
+
 py::dict replay_report(Session& s) {
   const Replay& r = *s.replay();
   const Simulator& sim = s.sim();
@@ -325,8 +331,7 @@ PYBIND11_MODULE(wetbrush, m) {
       .def(
           "dip",
           [](Session& s, std::array<float, 3> color, float oil, float load) {
-            StrokeEvent e;
-            e.kind = StrokeEventKind::Dip;
+            StrokeEvent e = event_of(StrokeEventKind::Dip);
             for (int i = 0; i < 3; ++i) e.ryb[i] = color[i];
             e.oil = oil, e.load = load;
             s.apply(e);
@@ -336,27 +341,18 @@ PYBIND11_MODULE(wetbrush, m) {
       .def(
           "wipe",
           [](Session& s, float fraction) {
-            StrokeEvent e;
-            e.kind = StrokeEventKind::Wipe;
+            StrokeEvent e = event_of(StrokeEventKind::Wipe);
             e.fraction = fraction;
             s.apply(e);
           },
           py::arg("fraction") = 0.5f, "Wipes this fraction of its paint off the brush.")
       .def(
           "clean",
-          [](Session& s) {
-            StrokeEvent e;
-            e.kind = StrokeEventKind::Clean;
-            s.apply(e);
-          },
+          [](Session& s) { s.apply(event_of(StrokeEventKind::Clean)); },
           "Cleans the brush in solvent.")
       .def(
           "dry",
-          [](Session& s) {
-            StrokeEvent e;
-            e.kind = StrokeEventKind::Dry;
-            s.apply(e);
-          },
+          [](Session& s) { s.apply(event_of(StrokeEventKind::Dry)); },
           "Lets the painting dry: every painted cell becomes solid (the undo history starts again).")
       .def(
           "lay_ground",

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-
 namespace wb {
 
 CanvasRect stroke_region(const Stroke& stroke) {
