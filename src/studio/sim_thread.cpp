@@ -288,7 +288,7 @@ void SimThread::step_once(const SessionStep& s) {
     if (e.kind == StrokeEventKind::Dry) invalidate_all();
   lap(times_.step, t);
   // Paint changes only inside the active window (where it was and where it moved to).
-  const Int3 o = doc.sim().grid().window().origin(), n = doc.config().window;
+  const Int3 o = doc.sim().grid().window().origin(), n = doc.sim().grid().window().dims();
   invalidate_rect(std::min(o.x, o0.x), std::min(o.y, o0.y), std::max(o.x, o0.x) + n.x, std::max(o.y, o0.y) + n.y);
   session_.step_done(s);
   // The pen events up to the step's end are in the paint now: they go with its next frame.

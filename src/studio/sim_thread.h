@@ -34,8 +34,8 @@ namespace wb::studio {
 struct WorkerTimes {
   double commands = 0.0;  ///< posted commands: brush changes, undo, snapshots for saves
   double player = 0.0;    ///< session time line: stroke player rebuilds and step lookup
-  double undo = 0.0;      ///< tiles captured before each step and the settled record after a stroke
-  double step = 0.0;      ///< Simulator::step
+  double undo = 0.0;      ///< the settled undo record after a stroke (the capture before a step is in `step`)
+  double step = 0.0;      ///< Session::step: the undo capture and Simulator::step
   double render = 0.0;    ///< incremental re-render of the canvas image and its copy to the view
   double idle = 0.0;      ///< waiting for input
 };

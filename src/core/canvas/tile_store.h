@@ -102,8 +102,9 @@ class TileStore {
   double drying_clock() const { return clock_; }
   /// Empties the canvas (keeps the pool's memory).
   void clear();
-  /// Becomes a copy of `src` (same dimensions, same device), copied on the device: a brush
-  /// change or an opened painting replaces the live canvas without a trip through the host.
+  /// Becomes a copy of `src` (same dimensions), copied on the device when both live on one: a
+  /// brush change or an opened painting replaces the live canvas without a trip through the host.
+  /// From another device the tiles come through the host, one at a time.
   void copy_from(const TileStore& src);
 
   int allocated_tiles() const { return slots_used_; }

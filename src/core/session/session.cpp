@@ -139,18 +139,12 @@ void Session::reconfigure(const SimConfig& config) {
   end_stroke();
   // The new simulator first: one the memory cannot hold is refused while the old one stays.
   auto next = std::make_unique<Simulator>(config, rest_pose(config));
+  // The old simulator goes: its paint settles for good (with_settled_canvas would keep and put back
+  // the window and particles, reads a settled simulator does not make), and its canvas is copied.
   sim_->settle();
   std::unique_ptr<Simulator> old = std::move(sim_);
   sim_ = std::move(next);
-  sim_->replace_canvas([&](TileStore& canvas) {
-    if (old->device() == config.device) {
-      old->with_settled_canvas([&](TileStore& c) { canvas.copy_from(c); });
-    } else {
-      old->with_settled_canvas([&](TileStore& c) {
-        for (int id : c.allocated_tile_ids()) canvas.write_tile(c.read_tile(id));
-      });
-    }
-  });
+  sim_->replace_canvas([&](TileStore& canvas) { canvas.copy_from(old->canvas()); });
   old.reset();
   renderer_ = Renderer(config.device);
   renderer_.params() = config.params.render;
@@ -211,7 +205,7 @@ bool Session::end_stroke() {
   if (!record_open_) return false;
   record_open_ = false;
   TileDiff diff;
-  const Int3 o = sim_->grid().window().origin(), n = sim_->config().window;
+  const Int3 o = sim_->grid().window().origin(), n = sim_->grid().window().dims();
   sim_->with_settled_canvas([&](TileStore& c) {
     diff = recorder_.finish(c);
     // The tiles under the window, at rest now, start the next record, so that its undo comes back
@@ -230,7 +224,7 @@ CanvasRect Session::restore(const TileDiff& d, bool after) {
   recorder_.reset();
   record_open_ = false;
   int x0 = 1 << 30, y0 = 1 << 30, x1 = -1, y1 = -1;
-  const int tiles_x = (dims().width + kTileSize - 1) / kTileSize;
+  const int tiles_x = sim_->canvas().tiles_x();
   for (const TileSnapshot& t : d.before) {
     const int tx = t.tile_id % tiles_x, ty = t.tile_id / tiles_x;
     x0 = std::min(x0, tx * kTileSize), y0 = std::min(y0, ty * kTileSize);
@@ -290,14 +284,12 @@ void Session::begin_replay(const Stroke& stroke) {
   replay_.reset();
   player_.reset();
   // The stroke's brush, window, tilt and paper replace the session's where they differ.
-  const SimConfig want = [&] {
-    SimConfig c = config();
-    c.brush = stroke.brush;
-    if (stroke.window) c.window = stroke_config(stroke, c.device).window;
-    if (stroke.tilt) c.params.grid.tilt = *stroke.tilt;
-    if (stroke.paper_rgb) c.params.render.paper_rgb = stroke_config(stroke, c.device).params.render.paper_rgb;
-    return c;
-  }();
+  const SimConfig own = stroke_config(stroke, device());
+  SimConfig want = config();
+  want.brush = own.brush;
+  if (stroke.window) want.window = own.window;
+  if (stroke.tilt) want.params.grid.tilt = own.params.grid.tilt;
+  if (stroke.paper_rgb) want.params.render.paper_rgb = own.params.render.paper_rgb;
   const Int3 w0 = config().window;
   if (brush_to_json(want.brush) != brush_to_json(config().brush) || want.window.x != w0.x || want.window.y != w0.y ||
       want.window.z != w0.z ||
@@ -333,23 +325,22 @@ Image Session::render(const Camera& camera) {
   return renderer_.render(sim_->tiles(), camera, sim_->live_window(), &overlay);
 }
 
-FloatImage Session::height_map() {
+FloatImage Session::settled_map(FloatImage (Renderer::*map)(TileStore&, PaintWindow*)) {
+  // The maps describe the paint, not a view of it: the default render parameters, as the
+  // material maps' files (material_maps.h).
   FloatImage out;
-  sim_->with_settled_canvas([&](TileStore& c) { out = Renderer(device()).render_height_map(c); });
+  sim_->with_settled_canvas([&](TileStore& c) {
+    Renderer r(device());
+    out = (r.*map)(c, nullptr);
+  });
   return out;
 }
 
-FloatImage Session::normal_map() {
-  FloatImage out;
-  sim_->with_settled_canvas([&](TileStore& c) { out = Renderer(device()).render_normal_map(c); });
-  return out;
-}
+FloatImage Session::height_map() { return settled_map(&Renderer::render_height_map); }
 
-FloatImage Session::albedo() {
-  FloatImage out;
-  sim_->with_settled_canvas([&](TileStore& c) { out = Renderer(device()).render_albedo(c); });
-  return out;
-}
+FloatImage Session::normal_map() { return settled_map(&Renderer::render_normal_map); }
+
+FloatImage Session::albedo() { return settled_map(&Renderer::render_albedo); }
 
 std::optional<Vec3> Session::pick(int x, int y) {
   return renderer_.pigment_at(sim_->tiles(), x, y, sim_->live_window());
@@ -370,10 +361,7 @@ PaintingSnapshot Session::snapshot(const nlohmann::json& extra, const Image* mer
   TileStore copy = sim_->settled_canvas_copy(device());
   PaintingSnapshot s{TileStore(Device{}, d), merged ? *merged : renderer_.render(copy, Camera::top(d)),
                      nlohmann::json::object()};
-  if (device().is_cpu())
-    s.canvas = std::move(copy);
-  else
-    for (int id : copy.allocated_tile_ids()) s.canvas.write_tile(copy.read_tile(id));
+  s.canvas.copy_from(copy);
   const Vec3 paper = renderer_.params().paper_rgb;
   s.metadata = {{"brush", brush_to_json(config().brush)},
                 {"paper_rgb", {paper.x, paper.y, paper.z}},
@@ -402,12 +390,7 @@ void Session::load(Session& from) { load(from.canvas_copy(device())); }
 
 void Session::load(const TileStore& from) {
   WB_REQUIRE(from.dims() == dims(), "Session::load: the canvases differ in size");
-  write_canvas([&](TileStore& canvas) {
-    if (from.device() == device())
-      canvas.copy_from(from);
-    else
-      for (int id : from.allocated_tile_ids()) canvas.write_tile(from.read_tile(id));
-  });
+  write_canvas([&](TileStore& canvas) { canvas.copy_from(from); });
 }
 
 void Session::clear() {

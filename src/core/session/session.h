@@ -167,6 +167,8 @@ class Session {
   void capture_before_step(const BrushPose& to);
   /// Writes a record's tiles (before or after) and returns the rectangle they cover.
   CanvasRect restore(const TileDiff& d, bool after);
+  /// One of the renderer's maps of the painting at rest.
+  FloatImage settled_map(FloatImage (Renderer::*map)(TileStore&, PaintWindow*));
   /// The last record of `from` restored (its tiles after the stroke when `after`) and moved to `to`.
   std::optional<CanvasRect> move_record(std::deque<TileDiff>& from, std::deque<TileDiff>& to, bool after);
   void reset_undo_records();
