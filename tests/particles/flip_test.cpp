@@ -198,7 +198,7 @@ TEST_F(FlipTest, FaceVelocityOfAUniformFlowIsThatFlow) {
     vp[c] = vel[c].data();
   }
   particles_rasterise(device_, store.view(), g);
-  particles_face_velocity(device_, g, vp, -999.f);
+  particles_face_velocity(device_, g, vp[0], vp[1], vp[2], -999.f);
   for (int c = 0; c < 3; ++c) {
     const auto v = vel[c].to_host();
     const auto w = face[c].to_host();

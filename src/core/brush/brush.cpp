@@ -11,46 +11,14 @@
 #include "core/brush/brush_stages.h"
 #include "core/brush/samples_kernels.h"
 #include "core/exec/algorithms.h"
-#include "core/exec/dispatch.h"
 #include "core/exec/memory.h"
 #include "core/exec/profile.h"
 
 namespace wb {
 
+WB_DEFINE_DISPATCHERS(WB_BRUSH_KERNELS)
+
 namespace {
-// The one runtime switch per driver.
-#define WB_BRUSH_CALL(name, params, args) \
-  void name##_on(const Device& d, WB_BRUSH_UNPAREN params) { WB_DISPATCH(d, name args); }
-#define WB_BRUSH_UNPAREN(...) __VA_ARGS__
-WB_BRUSH_CALL(brush_integrate, (BristleState s, BristleRest r, BrushFrame f, BrushForces e, float b, float dmp, float dt),
-              (s, r, f, e, b, dmp, dt))
-WB_BRUSH_CALL(brush_solve, (BristleState s, BristleRest r, BrushFrame f, SolidField so, int it, float mu),
-              (s, r, f, so, it, mu))
-WB_BRUSH_CALL(brush_grid_keys, (BristleState s, float h, uint32_t m, uint32_t* k, uint32_t* i), (s, h, m, k, i))
-WB_BRUSH_CALL(brush_grid_ranges, (const uint32_t* k, int64_t n, uint32_t* a, uint32_t* b), (k, n, a, b))
-WB_BRUSH_CALL(brush_density_lambda, (BristleState s, MinDensityGrid g, float* l), (s, g, l))
-WB_BRUSH_CALL(brush_density_delta, (BristleState s, MinDensityGrid g, const float* l), (s, g, l))
-WB_BRUSH_CALL(brush_density_apply, (BristleState s), (s))
-WB_BRUSH_CALL(brush_inextensible, (BristleState s, BristleRest r, BrushFrame f, SolidField so), (s, r, f, so))
-WB_BRUSH_CALL(brush_velocities, (BristleState s, BrushFrame f, SolidField so, float dt), (s, f, so, dt))
-WB_BRUSH_CALL(brush_restore, (BristleState s, BrushFrame f, int64_t* c), (s, f, c))
-WB_BRUSH_CALL(brush_place, (BristleState s, BristleRest r, BrushFrame f), (s, r, f))
-WB_BRUSH_CALL(brush_stretch_and_z, (BristleState s, BristleRest r, float* a, float* b), (s, r, a, b))
-WB_BRUSH_CALL(samples_spline, (BristleState s, SampleView sv, SamplePrev p, SolidField so), (s, sv, p, so))
-WB_BRUSH_CALL(samples_frames, (SampleView sv, BrushFrame f, FrameScan q), (sv, f, q))
-WB_BRUSH_CALL(samples_motion, (SampleView sv, SamplePrev p, float dt, int h), (sv, p, dt, h))
-WB_BRUSH_CALL(samples_z, (SampleView sv, float* z), (sv, z))
-WB_BRUSH_CALL(samples_rasterize,
-              (SampleView sv, float r, Int3 o, Int3 n, float* psi, float* vx, float* vy, float* vz),
-              (sv, r, o, n, psi, vx, vy, vz))
-WB_BRUSH_CALL(samples_rasterize_finish, (int64_t n, float* psi, float* vx, float* vy, float* vz), (n, psi, vx, vy, vz))
-WB_BRUSH_CALL(samples_contact_keys,
-              (SampleView sv, SolidField so, float ch, int32_t* t, int tw, int th, int ox, int oy, uint32_t* k,
-               uint32_t* v),
-              (sv, so, ch, t, tw, th, ox, oy, k, v))
-WB_BRUSH_CALL(count_distinct_flags, (const uint32_t* k, int64_t n, uint32_t s, float* f), (k, n, s, f))
-#undef WB_BRUSH_CALL
-#undef WB_BRUSH_UNPAREN
 
 bool finite_pose(const BrushPose& p) {
   bool ok = isfinite3(p.position);
@@ -206,7 +174,7 @@ void Brush::reset(const BrushPose& pose) {
   frame_omega_B_ = Vec3();
   xb_.copy_from_host(layout_.rest);
   const BrushFrame f = frame_for(pose);
-  brush_place_on(device_, state_view(), rest_view(), f);
+  brush_place(device_, state_view(), rest_view(), f);
   sample_history_ = 0;
   update_samples(1.f, f, SolidField{});  // at rest: the canvas plane only
 }
@@ -257,21 +225,21 @@ BrushFrame Brush::substep(const BrushPose& pose, float dt, const BrushEnvironmen
   const BristleRest r = rest_view();
   {
     WB_PROFILE_SCOPE("brush.integrate");
-    brush_integrate_on(device_, s, r, f, forces, spec_.beta_B, 1.f - std::exp(-params_.damping * dt), dt);
+    brush_integrate(device_, s, r, f, forces, spec_.beta_B, 1.f - std::exp(-params_.damping * dt), dt);
   }
   {
     WB_PROFILE_SCOPE("brush.constraints");
-    brush_solve_on(device_, s, r, f, env.solid, params_.iterations, friction_it);
-    brush_inextensible_on(device_, s, r, f, env.solid);
+    brush_solve(device_, s, r, f, env.solid, params_.iterations, friction_it);
+    brush_inextensible(device_, s, r, f, env.solid);
   }
   {
     // Last but for a length-exact pass, so that bristles pressed together keep apart: its
     // corrections are lateral and carried down each bristle, which that pass leaves intact.
     WB_PROFILE_SCOPE("brush.min_density");
     apply_min_density(params_.density_iterations);
-    brush_inextensible_on(device_, s, r, f, env.solid);
+    brush_inextensible(device_, s, r, f, env.solid);
   }
-  brush_velocities_on(device_, s, f, env.solid, dt);
+  brush_velocities(device_, s, f, env.solid, dt);
   // Containment: a non-finite vertex never propagates; the sub-step is undone, on the device
   // (the host learns of it from rollback_counter(), read with the step's record).
   const int64_t N = vertex_count();
@@ -279,7 +247,7 @@ BrushFrame Brush::substep(const BrushPose& pose, float dt, const BrushEnvironmen
   state.add(reinterpret_cast<const float*>(xb_.data()), 3 * N);
   state.add(reinterpret_cast<const float*>(vb_.data()), 3 * N);
   count_nonfinite_each_into(device_, state, nonfinite_.data(), ws_);
-  brush_restore_on(device_, s, f, nonfinite_.data());
+  brush_restore(device_, s, f, nonfinite_.data());
   frame_v_ = v_now;
   frame_omega_B_ = omega_B;
   pose_ = pose;
@@ -307,14 +275,14 @@ void Brush::apply_min_density(int iterations) {
                                    uint64_t(iterations), launch_key_of(g.h)});
   density_graph_.run(device_, key, [&] {
     for (int it = 0; it < iterations; ++it) {
-      brush_grid_keys_on(device_, s, g.h, grid_mask_, grid_keys_.data(), grid_ids_.data());
+      brush_grid_keys(device_, s, g.h, grid_mask_, grid_keys_.data(), grid_ids_.data());
       sort_by_key(device_, grid_keys_.data(), grid_ids_.data(), N, grid_bits_, ws_);
       cell_start_.fill_zero();  // start == end: an empty bucket
       cell_end_.fill_zero();
-      brush_grid_ranges_on(device_, grid_keys_.data(), N, cell_start_.data(), cell_end_.data());
-      brush_density_lambda_on(device_, s, g, lambda_.data());
-      brush_density_delta_on(device_, s, g, lambda_.data());
-      brush_density_apply_on(device_, s);
+      brush_grid_ranges(device_, grid_keys_.data(), N, cell_start_.data(), cell_end_.data());
+      brush_density_lambda(device_, s, g, lambda_.data());
+      brush_density_delta(device_, s, g, lambda_.data());
+      brush_density_apply(device_, s);
     }
   });
 }
@@ -322,10 +290,10 @@ void Brush::apply_min_density(int iterations) {
 void Brush::update_samples(float dt, const BrushFrame& frame, const SolidField& solid) {
   const SampleView sv = samples();
   const SamplePrev prev = prev_view();
-  samples_spline_on(device_, state_view(), sv, prev, solid);
-  samples_frames_on(device_, sv, frame,
-                    FrameScan{{scan_w_[0].data(), scan_w_[1].data()}, {scan_v_[0].data(), scan_v_[1].data()}});
-  samples_motion_on(device_, sv, prev, dt, sample_history_);
+  samples_spline(device_, state_view(), sv, prev, solid);
+  samples_frames(device_, sv, frame,
+                 FrameScan{{scan_w_[0].data(), scan_w_[1].data()}, {scan_v_[0].data(), scan_v_[1].data()}});
+  samples_motion(device_, sv, prev, dt, sample_history_);
   sample_history_ = std::min(sample_history_ + 1, 2);
 }
 
@@ -335,8 +303,8 @@ void Brush::rasterize(Int3 window_origin, Int3 window_dims, float* psi, float* v
   WB_REQUIRE(psi && vx && vy && vz, "Brush::rasterize: null output pointer");
   const int64_t cells = int64_t(window_dims.x) * window_dims.y * window_dims.z;
   for (float* p : {psi, vx, vy, vz}) mem::fill_zero(device_, p, size_t(cells) * sizeof(float));
-  samples_rasterize_on(device_, samples(), spec_.bristle_radius, window_origin, window_dims, psi, vx, vy, vz);
-  samples_rasterize_finish_on(device_, cells, psi, vx, vy, vz);
+  samples_rasterize(device_, samples(), spec_.bristle_radius, window_origin, window_dims, psi, vx, vy, vz);
+  samples_rasterize_finish(device_, cells, psi, vx, vy, vz);
 }
 
 int64_t Brush::mark_contacts(int32_t* trace, int trace_w, int trace_h, int ox, int oy, float contact_height,
@@ -355,15 +323,15 @@ void Brush::mark_contacts_into(int32_t* trace, int trace_w, int trace_h, int ox,
   WB_REQUIRE(std::isfinite(contact_height) && contact_height >= 0.f, "Brush::mark_contacts: bad contact height");
   const int64_t S = sample_count();
   const uint32_t sentinel = uint32_t(trace_w) * uint32_t(trace_h);
-  samples_contact_keys_on(device_, samples(), solid, contact_height, trace, trace_w, trace_h, ox, oy,
-                          contact_keys_.data(), contact_vals_.data());
+  samples_contact_keys(device_, samples(), solid, contact_height, trace, trace_w, trace_h, ox, oy, contact_keys_.data(),
+                       contact_vals_.data());
   sort_by_key(device_, contact_keys_.data(), contact_vals_.data(), S, bit_width(sentinel), ws_);
-  count_distinct_flags_on(device_, contact_keys_.data(), S, sentinel, scratch_a_.data());
+  count_distinct_flags(device_, contact_keys_.data(), S, sentinel, scratch_a_.data());
   reduce_sum_into(device_, scratch_a_.data(), S, count, ws_);
 }
 
 void Brush::max_stretch_into(float* out) {
-  brush_stretch_and_z_on(device_, state_view(), rest_view(), scratch_a_.data(), scratch_b_.data());
+  brush_stretch_and_z(device_, state_view(), rest_view(), scratch_a_.data(), scratch_b_.data());
   reduce_max_into(device_, scratch_a_.data(), vertex_count(), out, ws_);
 }
 
@@ -380,10 +348,10 @@ void Brush::rolled_back(int64_t total) {
 BrushStats Brush::stats() {
   BrushStats st;
   const int64_t N = vertex_count(), S = sample_count();
-  brush_stretch_and_z_on(device_, state_view(), rest_view(), scratch_a_.data(), scratch_b_.data());
+  brush_stretch_and_z(device_, state_view(), rest_view(), scratch_a_.data(), scratch_b_.data());
   st.max_stretch = reduce_max(device_, scratch_a_.data(), N, ws_);
   const float zv = reduce_min(device_, scratch_b_.data(), N, ws_);
-  samples_z_on(device_, samples(), scratch_b_.data());
+  samples_z(device_, samples(), scratch_b_.data());
   st.min_z = std::min(zv, reduce_min(device_, scratch_b_.data(), S, ws_));
   int64_t total = 0;
   nonfinite_.copy_range_to_host(&total, 2, 1);

@@ -30,7 +30,7 @@ WB_HD WB_INLINE void decompose(const PaintWindowView& w, int64_t i, int& x, int&
 }
 }  // namespace detail
 
-void gather_window(TileStoreView t, PaintWindowView w) {
+void tiles_gather_window(TileStoreView t, PaintWindowView w) {
   parallel_for(w.size(), [=] WB_HD(int64_t i) {
     int x, y, z;
     detail::decompose(w, i, x, y, z);
@@ -48,7 +48,7 @@ void gather_window(TileStoreView t, PaintWindowView w) {
   });
 }
 
-void settle_tile_drying(TileStoreView t, const int32_t* slots, int64_t count) {
+void tiles_settle_drying(TileStoreView t, const int32_t* slots, int64_t count) {
   const int64_t n = t.tile_cells();
   parallel_for(count * n, [=] WB_HD(int64_t i) {
     const int32_t slot = slots[i / n];
@@ -59,7 +59,7 @@ void settle_tile_drying(TileStoreView t, const int32_t* slots, int64_t count) {
   parallel_for(count, [=] WB_HD(int64_t k) { t.dried_to[slots[k]] = t.clock; });
 }
 
-void mark_painted_tiles(TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* flags) {
+void tiles_mark_painted(TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* flags) {
   parallel_for(w.size(), [=] WB_HD(int64_t i) {
     if (w.density[i] == 0.f) return;
     int x, y, z;
@@ -71,7 +71,7 @@ void mark_painted_tiles(TileStoreView t, PaintWindowView w, int tx0, int ty0, in
   });
 }
 
-void scatter_window(TileStoreView t, PaintWindowView w, float* before, float* after) {
+void tiles_scatter_window(TileStoreView t, PaintWindowView w, float* before, float* after) {
   parallel_for(w.size(), [=] WB_HD(int64_t i) {
     int x, y, z;
     detail::decompose(w, i, x, y, z);
@@ -89,7 +89,7 @@ void scatter_window(TileStoreView t, PaintWindowView w, float* before, float* af
   });
 }
 
-void dry_all(TileStoreView t, int64_t cells) {
+void tiles_dry_all(TileStoreView t, int64_t cells) {
   parallel_for(cells, [=] WB_HD(int64_t i) {
     if (t.density[i] > 0.f) t.dryness[i] = 65535;
   });
@@ -97,7 +97,7 @@ void dry_all(TileStoreView t, int64_t cells) {
 
 /// Lays the woven ground into every cell of the canvas (all tiles allocated, slot = tile id):
 /// dried primer up to weave_height, nothing above it.
-void lay_weave(TileStoreView t, WeaveField w, int64_t cells) {
+void tiles_lay_weave(TileStoreView t, WeaveField w, int64_t cells) {
   parallel_for(cells, [=] WB_HD(int64_t i) {
     const int64_t tc = t.tile_cells();
     const int32_t slot = int32_t(i / tc);

@@ -4,26 +4,10 @@
 #include <cmath>
 
 #include "core/exec/algorithms.h"
-#include "core/exec/dispatch.h"
 
 namespace wb {
 
-namespace {
-void gather_dispatch(const Device& d, TileStoreView t, PaintWindowView w) { WB_DISPATCH(d, gather_window(t, w)); }
-void mark_dispatch(const Device& d, TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* f) {
-  WB_DISPATCH(d, mark_painted_tiles(t, w, tx0, ty0, ntx, f));
-}
-void scatter_dispatch(const Device& d, TileStoreView t, PaintWindowView w, float* before, float* after) {
-  WB_DISPATCH(d, scatter_window(t, w, before, after));
-}
-void dry_dispatch(const Device& d, TileStoreView t, int64_t cells) { WB_DISPATCH(d, dry_all(t, cells)); }
-void weave_dispatch(const Device& d, TileStoreView t, WeaveField w, int64_t cells) {
-  WB_DISPATCH(d, lay_weave(t, w, cells));
-}
-void settle_dispatch(const Device& d, TileStoreView t, const int32_t* slots, int64_t n) {
-  WB_DISPATCH(d, settle_tile_drying(t, slots, n));
-}
-}  // namespace
+WB_DEFINE_DISPATCHERS(WB_TILE_STORE_KERNELS)
 
 TileStore::TileStore(const Device& device, CanvasDims dims) : device_(device), dims_(dims) {
   WB_REQUIRE(dims.width > 0 && dims.height > 0 && dims.depth > 0, "canvas dimensions must be positive");
@@ -114,7 +98,7 @@ int32_t TileStore::ensure_slot(int tile_id) {
 
 void TileStore::gather(PaintWindow& window) {
   WB_REQUIRE(window.device() == device_, "gather: window and canvas live on different devices");
-  gather_dispatch(device_, view(), window.view());
+  tiles_gather_window(device_, view(), window.view());
 }
 
 void TileStore::scatter(PaintWindow& window) {
@@ -128,7 +112,7 @@ void TileStore::scatter(PaintWindow& window) {
   // Allocate the tiles that receive paint, then write every on-canvas cell of the window.
   tile_flags_.resize(size_t(ntx) * nty);
   tile_flags_.fill_zero();
-  mark_dispatch(device_, view(), window.view(), tx0, ty0, ntx, tile_flags_.data());
+  tiles_mark_painted(device_, view(), window.view(), tx0, ty0, ntx, tile_flags_.data());
   host_flags_.resize(tile_flags_.size());
   tile_flags_.copy_to_host(host_flags_.data(), host_flags_.size());
   touched_.clear();
@@ -145,7 +129,7 @@ void TileStore::scatter(PaintWindow& window) {
   const int64_t cells = window.view().size();
   mass_before_.resize(size_t(cells));
   mass_after_.resize(size_t(cells));
-  scatter_dispatch(device_, view(), window.view(), mass_before_.data(), mass_after_.data());
+  tiles_scatter_window(device_, view(), window.view(), mass_before_.data(), mass_after_.data());
   reduce_sum_add_into(device_, mass_after_.data(), cells, mass_sums_.data(), ws_);
   reduce_sum_add_into(device_, mass_before_.data(), cells, mass_sums_.data() + 1, ws_);
   mass_pending_ = true;
@@ -162,13 +146,13 @@ void TileStore::settle_drying(const std::vector<int32_t>& slots) {
   for (int32_t s : slots) behind = behind || host_dried_to_[size_t(s)] != float(clock_);
   if (!behind) return;
   settle_slots_.copy_from_host(slots);
-  settle_dispatch(device_, view(), settle_slots_.data(), int64_t(slots.size()));  // sets dried_to too
+  tiles_settle_drying(device_, view(), settle_slots_.data(), int64_t(slots.size()));  // sets dried_to too
   for (int32_t s : slots) host_dried_to_[size_t(s)] = float(clock_);
 }
 
 void TileStore::dry_all() {
   if (slots_used_ == 0) return;
-  dry_dispatch(device_, view(), int64_t(slots_used_) * tile_cells());
+  tiles_dry_all(device_, view(), int64_t(slots_used_) * tile_cells());
 }
 
 void TileStore::lay_weave(const WeaveField& w) {
@@ -182,7 +166,7 @@ void TileStore::lay_weave(const WeaveField& w) {
   host_dried_to_.assign(size_t(n), float(clock_));
   slot_of_tile_.copy_from_host(host_slot_);
   dried_to_.copy_range_from_host(host_dried_to_.data(), 0, size_t(n));
-  weave_dispatch(device_, view(), w, int64_t(n) * tile_cells());
+  tiles_lay_weave(device_, view(), w, int64_t(n) * tile_cells());
   mass_ = recount_density(ws_);
 }
 

@@ -17,6 +17,7 @@
 #include "core/canvas/paint_fields.h"
 #include "core/canvas/window.h"
 #include "core/exec/buffer.h"
+#include "core/exec/dispatch.h"
 #include "core/exec/workspace.h"
 
 namespace wb {
@@ -164,21 +165,16 @@ class TileStore {
   DeviceBuffer<int32_t> settle_slots_;  ///< scratch of settle_drying
 };
 
-namespace cpu {
-void gather_window(TileStoreView t, PaintWindowView w);
-void settle_tile_drying(TileStoreView t, const int32_t* slots, int64_t count);
-void mark_painted_tiles(TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* flags);
-void scatter_window(TileStoreView t, PaintWindowView w, float* before, float* after);
-void dry_all(TileStoreView t, int64_t cells);
-void lay_weave(TileStoreView t, WeaveField w, int64_t cells);
-}  // namespace cpu
-namespace cuda {
-void gather_window(TileStoreView t, PaintWindowView w);
-void settle_tile_drying(TileStoreView t, const int32_t* slots, int64_t count);
-void mark_painted_tiles(TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* flags);
-void scatter_window(TileStoreView t, PaintWindowView w, float* before, float* after);
-void dry_all(TileStoreView t, int64_t cells);
-void lay_weave(TileStoreView t, WeaveField w, int64_t cells);
-}  // namespace cuda
+// The tile store's backend drivers (gather_scatter_impl.h), one list (core/exec/dispatch.h).
+#define WB_TILE_STORE_KERNELS(X)                                                                               \
+  X(void, tiles_gather_window, (TileStoreView t, PaintWindowView w), (t, w))                                   \
+  X(void, tiles_settle_drying, (TileStoreView t, const int32_t* slots, int64_t count), (t, slots, count))      \
+  X(void, tiles_mark_painted, (TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* flags), \
+      (t, w, tx0, ty0, ntx, flags))                                                                            \
+  X(void, tiles_scatter_window, (TileStoreView t, PaintWindowView w, float* before, float* after),             \
+      (t, w, before, after))                                                                                   \
+  X(void, tiles_dry_all, (TileStoreView t, int64_t cells), (t, cells))                                         \
+  X(void, tiles_lay_weave, (TileStoreView t, WeaveField w, int64_t cells), (t, w, cells))
+WB_DECLARE_KERNELS(WB_TILE_STORE_KERNELS)
 
 }  // namespace wb

@@ -14,6 +14,7 @@ namespace wb::cpu {
 // LSD radix sort, 8 bits a pass, only as many passes as key_bits needs. A generic
 // comparison sort over OpenMP is an order of magnitude slower on the per-step path.
 void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Workspace& ws) {
+  check_sort_args(n, key_bits);
   if (n <= 1) return;
   const int passes = std::max(1, (std::min(key_bits, 32) + 7) / 8);
   auto* scratch = static_cast<uint32_t*>(ws.get(size_t(n) * 2 * sizeof(uint32_t)));
@@ -91,6 +92,7 @@ float reduce_min(const float* in, int64_t n, Workspace&) {
 }
 
 void count_nonfinite_each_into(const FloatArrays& arrays, int64_t* out, Workspace& ws) {
+  if (arrays.count == 0) return;
   for (int k = 0; k < arrays.count; ++k) out[k] = count_nonfinite(arrays.ptr[k], arrays.n[k], ws);
 }
 

@@ -65,6 +65,7 @@ T reduce(InputIt in, int64_t n, Op op, T init, Workspace& ws) {
 }  // namespace
 
 void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Workspace& ws) {
+  check_sort_args(n, key_bits);
   if (n <= 1) return;
   const int end_bit = key_bits < 1 ? 1 : (key_bits > 32 ? 32 : key_bits);
   const size_t pair_bytes = size_t(n) * sizeof(uint32_t);
@@ -151,6 +152,7 @@ __global__ void count_nonfinite_each(FloatArrays a, unsigned long long* out) {
 }  // namespace
 
 void count_nonfinite_each_into(const FloatArrays& arrays, int64_t* out, Workspace&) {
+  if (arrays.count == 0) return;
   static_assert(sizeof(int64_t) == sizeof(unsigned long long), "count type");
   int64_t most = 0;
   for (int k = 0; k < arrays.count; ++k) most = arrays.n[k] > most ? arrays.n[k] : most;

@@ -3,19 +3,11 @@
 #include <string>
 
 #include "core/exec/buffer.h"
-#include "core/exec/dispatch.h"
 
 namespace wb {
 
-void selftest_atomic_contention(const Device& d, float* acc4, int32_t* iacc2, int64_t n) {
-  WB_DISPATCH(d, selftest_atomic_contention(acc4, iacc2, n));
-}
-void selftest_count_visits(const Device& d, int32_t* hits, int64_t n) { WB_DISPATCH(d, selftest_count_visits(hits, n)); }
+WB_DEFINE_DISPATCHERS(WB_SELFTEST_KERNELS)
 
-void selftest_sum_squares(const Device& d, const int64_t* count, int64_t capacity, double* x, double* out,
-                          SumScratch s) {
-  WB_DISPATCH(d, selftest_sum_squares(count, capacity, x, out, s));
-}
 std::string selftest_run(const Device& d) {
   try {
     d.activate();

@@ -5,6 +5,7 @@
 
 namespace wb::WB_BACKEND_NS {
 
+/// n threads add 1 to acc4[i % 4], add 1 to iacc2[0] and take atomic max of i into iacc2[1].
 void selftest_atomic_contention(float* acc4, int32_t* iacc2, int64_t n) {
   parallel_for(n, [=] WB_HD(int64_t i) {
     atomic_add(&acc4[i % 4], 1.0f);
@@ -13,10 +14,13 @@ void selftest_atomic_contention(float* acc4, int32_t* iacc2, int64_t n) {
   });
 }
 
+/// hits[i] += 1 for every i in [0, n).
 void selftest_count_visits(int32_t* hits, int64_t n) {
   parallel_for(n, [=] WB_HD(int64_t i) { hits[i] += 1; });
 }
 
+/// x[i] = (i % 97) * 0.125 - 3.3 for the first *count of `capacity` entries, and *out = the sum of
+/// x[i]^2 over them, formed as the pass goes (parallel_sum_count).
 void selftest_sum_squares(const int64_t* count, int64_t capacity, double* x, double* out, SumScratch s) {
   parallel_sum_count(
       count, capacity,

@@ -4,17 +4,10 @@
 #include <cmath>
 
 #include "core/exec/algorithms.h"
-#include "core/exec/dispatch.h"
 #include "core/exec/profile.h"
 #include "core/grid/grid.h"
 
 namespace wb {
-
-namespace {
-void shift_dispatch(const Device& d, const float* src, float* dst, int ex, int ey, int ez, int dx, int dy, int dz) {
-  WB_DISPATCH(d, grid_shift_lattice(src, dst, ex, ey, ez, dx, dy, dz));
-}
-}  // namespace
 
 ActiveWindow::ActiveWindow(TileStore& canvas, Int3 dims, Int3 origin)
     : canvas_(&canvas), paint_(canvas.device(), dims), ws_(canvas.device()), gathered_dev_(canvas.device(), 1) {
@@ -38,7 +31,7 @@ void ActiveWindow::shift_faces(int c, int dx, int dy, int dz) {
   int ex, ey, ez;
   d.face_extent(c, ex, ey, ez);
   shift_tmp_.resize(size_t(d.faces(c)));
-  shift_dispatch(device(), vel_[c].data(), shift_tmp_.data(), ex, ey, ez, dx, dy, dz);
+  grid_shift_lattice(device(), vel_[c].data(), shift_tmp_.data(), ex, ey, ez, dx, dy, dz);
   vel_[c].swap(shift_tmp_);
 }
 

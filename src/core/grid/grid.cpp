@@ -22,120 +22,6 @@ std::pair<HerschelBulkley, HerschelBulkley> paint_end_members(const GridParams& 
           HerschelBulkley{p.yield_stress_oily, p.consistency_oily, p.flow_index_oily}};
 }
 
-// One wrapper per backend driver: the only place that switches on the device.
-void classify_d(const Device& d, GridView g, PaintWindowView pw, BristleField br, const float* pd, CanvasDims cd,
-                float lt, float dt) {
-  WB_DISPATCH(d, grid_classify(g, pw, br, pd, cd.width, cd.height, cd.depth, lt, dt));
-}
-void column_tops_d(const Device& d, GridDims g, const float* rho, const float* pd, float trace, float* out) {
-  WB_DISPATCH(d, grid_column_tops(g, rho, pd, trace, out));
-}
-void first_extent_d(const Device& d, GridDims g, const float* maxima, GridExtent* e) {
-  WB_DISPATCH(d, grid_first_extent(g, maxima, e));
-}
-void outflow_d(const Device& d, GridView g, const float* rho, float* out) { WB_DISPATCH(d, grid_paint_outflow(g, rho, out)); }
-void advect_axis_d(const Device& d, GridView g, PaintWindowView s, PaintWindowView t, int axis, float dt, int reach,
-                   float dry, PaintTiles tiles, const int32_t* process, int32_t* painted, const int32_t* below,
-                   int32_t* next) {
-  WB_REQUIRE(g.extent, "grid advection: the paint's box is not set");
-  WB_DISPATCH(d, grid_advect_paint_axis(g, s, t, axis, dt, reach, dry, tiles, process, painted, below, next));
-}
-void tiles_pass_d(const Device& d, GridDims g, PaintTiles tiles, const int32_t* before, int axis, int reach_tiles,
-                  int32_t* process) {
-  WB_DISPATCH(d, grid_paint_tiles_pass(g, tiles, before, axis, reach_tiles, process));
-}
-void paint_tiles_d(const Device& d, GridDims g, const float* rho, const float* dryness, float dry_threshold, int top,
-                   int layers, int reach, int halo, int deep, int32_t* mark, int32_t* a, int32_t* h, int64_t* counts,
-                   int32_t* below) {
-  WB_DISPATCH(d, grid_paint_tiles(g, rho, dryness, dry_threshold, top, layers, reach, halo, deep, mark, a, h, counts,
-                                  below));
-}
-void copy_tiles_d(const Device& d, GridDims g, PaintTiles t, PaintWindowView s, PaintWindowView dst, bool reads) {
-  WB_DISPATCH(d, grid_copy_paint_tiles(g, t, s, dst, reads));
-}
-void advect_vel_d(const Device& d, GridView g, const float* u, const float* v, const float* w, float dt) {
-  WB_REQUIRE(g.extent, "grid advection: the velocity's extent is not set");
-  WB_DISPATCH(d, grid_advect_velocity(g, u, v, w, dt));
-}
-void film_columns_d(const Device& d, GridDims g, const GridExtent* e, PaintWindowView pw, BristleField br,
-                    const float* pd, float dry, float film_max, float* col) {
-  WB_DISPATCH(d, grid_film_columns(g, e, pw, br, pd, dry, film_max, col));
-}
-void film_update_d(const Device& d, GridDims g, const float* col, FilmFlow f, float* next) {
-  WB_DISPATCH(d, grid_film_update(g, col, f, next));
-}
-void film_write_d(const Device& d, GridDims g, PaintWindowView pw, const float* col) {
-  WB_DISPATCH(d, grid_film_write(g, pw, col));
-}
-void gravity_d(const Device& d, GridView g, float* ph, float g_dt, float g_dt_y) {
-  WB_DISPATCH(d, grid_gravity(g, ph, g_dt, g_dt_y));
-}
-void mu_d(const Device& d, GridView g, JointOil oil, HerschelBulkley s, HerschelBulkley o, float m, float* mu) {
-  WB_DISPATCH(d, grid_effective_viscosity(g, oil, s, o, m, mu));
-}
-void visc_flags_d(const Device& d, GridView g, uint32_t* flag) { WB_DISPATCH(d, grid_viscous_flags(g, flag)); }
-void visc_list_d(const Device& d, GridView g, const uint32_t* idx, uint32_t* list) {
-  WB_DISPATCH(d, grid_viscous_list(g, idx, list));
-}
-void visc_count_d(const Device& d, GridView g, const uint32_t* idx, int64_t capacity, int64_t* run, double* total) {
-  WB_DISPATCH(d, grid_viscous_count(g, idx, capacity, run, total));
-}
-void visc_setup_d(const Device& d, GridView g, const uint32_t* list, ListCount n, const uint32_t* idx, const float* mu,
-                  float scale, float* nu, int32_t* nb, double* diag, double* b, double* x) {
-  WB_DISPATCH(d, grid_viscous_setup(g, list, n, idx, mu, scale, nu, nb, diag, b, x));
-}
-void visc_apply_d(const Device& d, ListCount n, const float* nu, const int32_t* nb, const double* diag, const double* p,
-                  double* q, double* pq, CgGuard guard, SumScratch s) {
-  WB_DISPATCH(d, grid_viscous_apply(n, nu, nb, diag, p, q, pq, guard, s));
-}
-void pcg_start_d(const Device& d, ListCount n, const double* b, const double* ax, const double* diag, double* r,
-                 double* z, double* p, double* rz, double* bz, SumScratch s) {
-  WB_DISPATCH(d, grid_pcg_start(n, b, ax, diag, r, z, p, rz, bz, s));
-}
-void pcg_update_d(const Device& d, ListCount n, CgGuard guard, const double* pq, const double* p, const double* q,
-                  const double* diag, double* x, double* r, double* z, double* rz, double* iterations, SumScratch s) {
-  WB_DISPATCH(d, grid_pcg_update(n, guard, pq, p, q, diag, x, r, z, rz, iterations, s));
-}
-void pcg_direction_d(const Device& d, ListCount n, CgGuard guard, const double* rz_new, const double* z, double* p) {
-  WB_DISPATCH(d, grid_pcg_direction(n, guard, rz_new, z, p));
-}
-void visc_write_d(const Device& d, GridView g, const uint32_t* list, ListCount n, const double* x) {
-  WB_DISPATCH(d, grid_viscous_write(g, list, n, x));
-}
-void rhs_d(const Device& d, GridView g, const float* rho, float inv_dt, float* b) {
-  WB_DISPATCH(d, grid_rhs(g, rho, inv_dt, b));
-}
-void jacobi_d(const Device& d, PoissonView s, const float* b, const float* x, float* out, float omega) {
-  WB_DISPATCH(d, poisson_jacobi(s, b, x, out, omega));
-}
-void residual_d(const Device& d, PoissonView s, const float* b, const float* x, float* r) {
-  WB_DISPATCH(d, poisson_residual(s, b, x, r));
-}
-void cheb_d(const Device& d, PoissonView s, const float* b, const float* x, const float* xp, float* out, float w) {
-  WB_DISPATCH(d, poisson_chebyshev(s, b, x, xp, out, w));
-}
-void fp_first_d(const Device& d, PoissonView s, const float* r, const float* y, float* out, float alpha) {
-  WB_DISPATCH(d, poisson_fixed_point_first(s, r, y, out, alpha));
-}
-void fp_second_d(const Device& d, PoissonView s, const float* r, const float* z, float* y, float* x) {
-  WB_DISPATCH(d, poisson_fixed_point_second(s, r, z, y, x));
-}
-void apply_all_d(const Device& d, PoissonView s, const float* x, float* out) {
-  WB_DISPATCH(d, poisson_apply_all(s, x, out));
-}
-void apply_pressure_d(const Device& d, GridView g, const float* p) { WB_DISPATCH(d, grid_apply_pressure(g, p)); }
-void extrapolate_d(const Device& d, GridView g) { WB_DISPATCH(d, grid_extrapolate(g)); }
-void extent_d(const Device& d, GridDims g, const float* before, const float* after, GridExtent* e) {
-  WB_DISPATCH(d, grid_extent(g, before, after, e));
-}
-void dry_d(const Device& d, PaintWindowView pw, float amount) { WB_DISPATCH(d, grid_dry(pw, amount)); }
-void max_speed_d(const Device& d, GridView g, float* out) { WB_DISPATCH(d, grid_max_abs_fluid_velocity(g, out)); }
-void square_d(const Device& d, const float* x, float* out, int64_t n) { WB_DISPATCH(d, grid_square(x, out, n)); }
-void scale_d(const Device& d, float* x, float s, int64_t n) { WB_DISPATCH(d, grid_scale(x, s, n)); }
-void hash_d(const Device& d, float* x, const uint8_t* cls, int64_t n, uint32_t seed) {
-  WB_DISPATCH(d, grid_fill_hash(x, cls, n, seed));
-}
-
 void check_params(const GridParams& p) {
   WB_REQUIRE(p.dt > 0.f && p.dt <= 0.1f, "grid: dt must be in (0, 0.1] s");
   WB_REQUIRE(p.jacobi_L >= 0 && p.jacobi_L <= 1000, "grid: jacobi_L must be in [0, 1000]");
@@ -170,6 +56,8 @@ void check_params(const GridParams& p) {
 }
 }  // namespace
 
+WB_DEFINE_DISPATCHERS(WB_GRID_KERNELS)
+
 void SolverScratch::reserve(const Device& d, int64_t cells) {
   for (auto* b : {&y, &z, &r, &prev, &tmp}) {
     b->set_device(d);
@@ -177,11 +65,13 @@ void SolverScratch::reserve(const Device& d, int64_t cells) {
   }
 }
 
-void poisson_apply(const Device& device, PoissonView s, const float* x, float* out) { apply_all_d(device, s, x, out); }
+void poisson_apply(const Device& device, PoissonView s, const float* x, float* out) {
+  poisson_apply_all(device, s, x, out);
+}
 
 double norm2(const Device& device, const float* v, int64_t n, SolverScratch& scratch, Workspace& ws) {
   scratch.tmp.resize(size_t(n));
-  square_d(device, v, scratch.tmp.data(), n);
+  grid_square(device, v, scratch.tmp.data(), n);
   return std::sqrt(std::max(0.0, reduce_sum(device, scratch.tmp.data(), n, ws)));
 }
 
@@ -198,9 +88,9 @@ void solve_pressure(const Device& device, PoissonView s, const float* b, float* 
       sc.y.fill_zero();
       const int L = cfg.sweeps / 2;
       for (int l = 0; l < L; ++l) {
-        residual_d(device, s, b, x, sc.r.data());
-        fp_first_d(device, s, sc.r.data(), sc.y.data(), sc.z.data(), cfg.alpha);
-        fp_second_d(device, s, sc.r.data(), sc.z.data(), sc.y.data(), x);
+        poisson_residual(device, s, b, x, sc.r.data());
+        poisson_fixed_point_first(device, s, sc.r.data(), sc.y.data(), sc.z.data(), cfg.alpha);
+        poisson_fixed_point_second(device, s, sc.r.data(), sc.z.data(), sc.y.data(), x);
         if (observe) observe(2 * (l + 1), x);
       }
       break;
@@ -211,7 +101,7 @@ void solve_pressure(const Device& device, PoissonView s, const float* b, float* 
       float* cur = x;
       float* nxt = sc.y.data();
       for (int k = 0; k < cfg.sweeps; ++k) {
-        jacobi_d(device, s, b, cur, nxt, omega);
+        poisson_jacobi(device, s, b, cur, nxt, omega);
         std::swap(cur, nxt);
         if (observe) observe(k + 1, cur);
       }
@@ -228,7 +118,7 @@ void solve_pressure(const Device& device, PoissonView s, const float* b, float* 
       float omega = 1.f;
       for (int k = 0; k < cfg.sweeps; ++k) {
         omega = chebyshev_omega(k, cfg.rho, omega);
-        cheb_d(device, s, b, cur, prev, nxt, omega);
+        poisson_chebyshev(device, s, b, cur, prev, nxt, omega);
         float* old_prev = prev;
         prev = cur;
         cur = nxt;
@@ -244,7 +134,7 @@ void solve_pressure(const Device& device, PoissonView s, const float* b, float* 
 float estimate_jacobi_rho(const Device& device, PoissonView s, int iters, SolverScratch& sc, Workspace& ws) {
   const int64_t n = s.d.cells();
   sc.reserve(device, n);
-  hash_d(device, sc.y.data(), s.cls, n, 12345u);
+  grid_fill_hash(device, sc.y.data(), s.cls, n, 12345u);
   sc.r.fill_zero();  // b = 0: each sweep applies D^-1 R
   double nrm = norm2(device, sc.y.data(), n, sc, ws);
   if (nrm <= 0.0) return 0.f;
@@ -252,8 +142,8 @@ float estimate_jacobi_rho(const Device& device, PoissonView s, int iters, Solver
   float* nxt = sc.z.data();
   double ratio = 0.0;
   for (int k = 0; k < iters; ++k) {
-    scale_d(device, cur, float(1.0 / nrm), n);
-    jacobi_d(device, s, sc.r.data(), cur, nxt, 1.f);
+    grid_scale(device, cur, float(1.0 / nrm), n);
+    poisson_jacobi(device, s, sc.r.data(), cur, nxt, 1.f);
     std::swap(cur, nxt);
     nrm = norm2(device, cur, n, sc, ws);
     if (nrm <= 0.0) return 0.f;
@@ -363,8 +253,8 @@ bool Grid::move_window(Int3 new_origin) {
 
 void Grid::classify() {
   WB_PROFILE_SCOPE("grid.classify");
-  classify_d(device(), view(), window_.paint().view(), bristles_, particle_density_, window_.canvas().dims(), params_.liquid_threshold,
-             params_.dry_threshold);
+  grid_classify(device(), view(), window_.paint().view(), bristles_, particle_density_, window_.canvas().dims(),
+                params_.liquid_threshold, params_.dry_threshold);
 }
 
 void Grid::advect(float dt) {
@@ -386,9 +276,9 @@ void Grid::advect(float dt) {
   // has told how far the paint moves (below). Beyond, nothing in the step reads them
   // (docs/GRID.md).
   column_maxima(kTraceDensity, kPaintTop);
-  first_extent_d(d, g, advect_max_.data() + kJointTop, advect_extent_.data());
+  grid_first_extent(d, g, advect_max_.data() + kJointTop, advect_extent_.data());
   within(advect_extent_.data(), [&] { classify(); });
-  outflow_d(d, view(), paint.density.data(), face_tmp_.data());
+  grid_paint_outflow(d, view(), paint.density.data(), face_tmp_.data());
   // The maxima in one copy: the outflow rate along each axis, the layers holding paint and
   // those holding paint or particles.
   // (face_tmp_, one value per face, holds the three rates: there are more faces than 3 cells.)
@@ -429,9 +319,8 @@ void Grid::advect(float dt) {
   // writes it again, and nothing in the step reads it where there is no paint (docs/GRID.md).
   for (int c = 0; c < 3; ++c)
     mem::copy_on_device(d, vel_tmp_[c].data(), v.vel[c], size_t(g.faces(c)) * sizeof(float));
-  within(advect_extent_.data() + 1, [&] {
-    advect_vel_d(d, view(), vel_tmp_[0].data(), vel_tmp_[1].data(), vel_tmp_[2].data(), dt);
-  });
+  within(advect_extent_.data() + 1,
+         [&] { grid_advect_velocity(d, view(), vel_tmp_[0].data(), vel_tmp_[1].data(), vel_tmp_[2].data(), dt); });
 }
 
 void Grid::advect_paint(float dt, const int reach[3], int top) {
@@ -450,13 +339,13 @@ void Grid::advect_paint(float dt, const int reach[3], int top) {
   const int reach_tiles = (across + kPaintTile - 1) / kPaintTile;
   const int halo_tiles = std::max(1, (across + 1 + kPaintTile - 1) / kPaintTile);
   tile_counts_.fill_zero();
-  paint_tiles_d(d, g, paint.density.data(), paint.dryness.data(), params_.dry_threshold, top, layers, reach_tiles,
-                halo_tiles, deep, tile_mark_.data(), tile_active_.data(), tile_halo_.data(), tile_counts_.data(),
-                pass_below_.data());
+  grid_paint_tiles(d, g, paint.density.data(), paint.dryness.data(), params_.dry_threshold, top, layers, reach_tiles,
+                   halo_tiles, deep, tile_mark_.data(), tile_active_.data(), tile_halo_.data(), tile_counts_.data(),
+                   pass_below_.data());
   const int tiles_x = (g.nx + kPaintTile - 1) / kPaintTile, tiles_y = (g.ny + kPaintTile - 1) / kPaintTile;
   const PaintTiles tiles{tile_active_.data(), tile_halo_.data(), tile_counts_.data(), layers, deep, tiles_x,
                          int64_t(tiles_x) * tiles_y * kPaintTile * g.nz};
-  copy_tiles_d(d, g, tiles, paint.view(), paint_tmp_.view(), true);
+  grid_copy_paint_tiles(d, g, tiles, paint.view(), paint_tmp_.view(), true);
   // Which tiles held paint that can move after the last pass (before the first: the paint's) and
   // after this one; which the step's passes visit; the layers holding paint after each pass.
   int32_t* painted[2] = {tile_painted_[0].data(), tile_painted_[1].data()};
@@ -468,11 +357,12 @@ void Grid::advect_paint(float dt, const int reach[3], int top) {
   for (int n = 0; n < 3; ++n) {
     const int axis = advect_order_ == 0 ? n : 2 - n;
     if (reach[axis] == 0) continue;
-    tiles_pass_d(d, g, tiles, painted[0], axis, (reach[axis] + kPaintTile - 1) / kPaintTile, tile_process_.data());
+    grid_paint_tiles_pass(d, g, tiles, painted[0], axis, (reach[axis] + kPaintTile - 1) / kPaintTile,
+                          tile_process_.data());
     mem::fill_zero(d, painted[1], tile_bytes);
     mem::copy_on_device(d, below[1], below[0], sizeof(int32_t));
-    advect_axis_d(d, v, paint.view(), paint_tmp_.view(), axis, dt, reach[axis], params_.dry_threshold, tiles,
-                  tile_process_.data(), painted[1], below[0], below[1]);
+    grid_advect_paint_axis(d, v, paint.view(), paint_tmp_.view(), axis, dt, reach[axis], params_.dry_threshold, tiles,
+                           tile_process_.data(), painted[1], below[0], below[1]);
     std::swap(painted[0], painted[1]);
     std::swap(below[0], below[1]);
     ++made;
@@ -487,21 +377,21 @@ void Grid::advect_paint(float dt, const int reach[3], int top) {
 #define WB_X(name, doc) paint.name.swap(paint_tmp_.name);
     WB_PAINT_FIELDS(WB_X)
 #undef WB_X
-    copy_tiles_d(d, g, tiles, paint_tmp_.view(), paint.view(), false);
+    grid_copy_paint_tiles(d, g, tiles, paint_tmp_.view(), paint.view(), false);
   }
 }
 
 void Grid::column_maxima(float trace, int slot) {
   const GridDims g = dims();
   const int64_t columns = int64_t(g.nx) * g.ny;
-  column_tops_d(device(), g, window_.paint().density.data(), particle_density_, trace, cell_tmp_.data());
+  grid_column_tops(device(), g, window_.paint().density.data(), particle_density_, trace, cell_tmp_.data());
   for (int s = 0; s < 6; ++s)
     reduce_max_into(device(), cell_tmp_.data() + s * columns, columns, advect_max_.data() + slot + s, ws_);
 }
 
 void Grid::find_extent() {
   column_maxima(0.f, kExtentPaintTop);
-  extent_d(device(), dims(), advect_max_.data() + kJointTop, advect_max_.data() + kExtentTop, extent_.data());
+  grid_extent(device(), dims(), advect_max_.data() + kJointTop, advect_max_.data() + kExtentTop, extent_.data());
 }
 
 void Grid::rheology() {
@@ -509,7 +399,7 @@ void Grid::rheology() {
   const auto [stiff, oily] = paint_end_members(params_);
   const PaintWindow& paint = window_.paint();
   const JointOil oil{paint.density.data(), paint.oil.data(), particle_density_, particle_oil_};
-  mu_d(device(), view(), oil, stiff, oily, params_.regularisation, mu_.data());
+  grid_effective_viscosity(device(), view(), oil, stiff, oily, params_.regularisation, mu_.data());
 }
 
 void Grid::add_external_forces(float dt) {
@@ -522,7 +412,7 @@ void Grid::add_external_forces(float dt) {
     mem::copy_on_device(device(), vel_pre_[c].data(), v.vel[c], size_t(g.faces(c)) * sizeof(float));
   if (params_.gravity <= 0.f) return;
   const Vec3 gv = params_.gravity_vector();
-  gravity_d(device(), view(), cell_tmp_.data(), -gv.z * dt, gv.y * dt);
+  grid_gravity(device(), view(), cell_tmp_.data(), -gv.z * dt, gv.y * dt);
 }
 
 void Grid::apply_viscosity(float dt) {
@@ -537,9 +427,9 @@ void Grid::apply_viscosity(float dt) {
   // Their count stays on the device (ListCount) and comes back with the CG's one read; a list
   // longer than the vectors' capacity runs nothing and is solved again once they are sized.
   const int64_t all = int64_t(visc_idx_.size());
-  visc_flags_d(d, v, visc_idx_.data());
+  grid_viscous_flags(d, v, visc_idx_.data());
   exclusive_scan_into(d, visc_idx_.data(), visc_idx_.data(), all, ws_);
-  visc_list_d(d, v, visc_idx_.data(), visc_list_.data());
+  grid_viscous_list(d, v, visc_idx_.data(), visc_list_.data());
   // (1 - dt div(nu grad)) u = u_old, nu = mu / rho0 in cells^2/s.
   const double h = params_.cell_size;
   const float nu_scale = float(double(dt) / (double(params_.rho0) * h * h));
@@ -569,24 +459,25 @@ void Grid::apply_viscosity(float dt) {
     }
     const ListCount n{cg_count_.data(), int64_t(cg_x_.size())};
     cg_sums_.fill_zero();
-    visc_count_d(d, v, idx, n.capacity, cg_count_.data(), sums + 5);
-    visc_setup_d(d, v, list, n, idx, mu_.data(), nu_scale, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(),
-                 cg_b_.data(), cg_x_.data());
+    grid_viscous_count(d, v, idx, n.capacity, cg_count_.data(), sums + 5);
+    grid_viscous_setup(d, v, list, n, idx, mu_.data(), nu_scale, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(),
+                       cg_b_.data(), cg_x_.data());
     // A x into q (its p.Ap lands in slot 2, which the first iteration writes again), then r, z,
     // p, r.z and b.D^-1 b.
-    visc_apply_d(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_x_.data(), cg_q_.data(), sums + 2, {}, sum);
-    pcg_start_d(d, n, cg_b_.data(), cg_q_.data(), cg_diag_.data(), cg_r_.data(), cg_z_.data(), cg_p_.data(), sums + 0,
-                sums + 3, sum);
+    grid_viscous_apply(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_x_.data(), cg_q_.data(), sums + 2, {},
+                       sum);
+    grid_pcg_start(d, n, cg_b_.data(), cg_q_.data(), cg_diag_.data(), cg_r_.data(), cg_z_.data(), cg_p_.data(),
+                   sums + 0, sums + 3, sum);
     // Three launches an iteration (each pass forms its dot product as it goes), queued two
     // iterations at a time: the pair repeats with the same arguments (r.z's slots alternate), so
     // on CUDA it is one graph's launch (recorded again when the vectors move).
     const auto iterate = [&](int c) {
       const CgGuard guard{sums + c, sums + 3, tol2};
-      visc_apply_d(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_p_.data(), cg_q_.data(), sums + 2, guard,
-                   sum);
-      pcg_update_d(d, n, guard, sums + 2, cg_p_.data(), cg_q_.data(), cg_diag_.data(), cg_x_.data(), cg_r_.data(),
-                   cg_z_.data(), sums + 1 - c, sums + 4, sum);
-      pcg_direction_d(d, n, guard, sums + 1 - c, cg_z_.data(), cg_p_.data());
+      grid_viscous_apply(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_p_.data(), cg_q_.data(), sums + 2,
+                         guard, sum);
+      grid_pcg_update(d, n, guard, sums + 2, cg_p_.data(), cg_q_.data(), cg_diag_.data(), cg_x_.data(), cg_r_.data(),
+                      cg_z_.data(), sums + 1 - c, sums + 4, sum);
+      grid_pcg_direction(d, n, guard, sums + 1 - c, cg_z_.data(), cg_p_.data());
     };
     const uint64_t key = launch_key({launch_key_of(cg_x_.data()), launch_key_of(cg_nb_.data()),
                                      launch_key_of(cg_nu_.data()), launch_key_of(sums), uint64_t(n.capacity)});
@@ -618,12 +509,12 @@ void Grid::apply_viscosity(float dt) {
   if (host[5] > 0.0) cg_last_iterations_ = it;  // a solve of nothing plans nothing
   stats_.viscosity_iterations = it;
   stats_.viscosity_residual = host[3] > 0.0 ? std::sqrt(std::max(host[cur], 0.0) / host[3]) : 0.0;
-  visc_write_d(d, v, list, ListCount{cg_count_.data(), int64_t(cg_x_.size())}, cg_x_.data());
+  grid_viscous_write(d, v, list, ListCount{cg_count_.data(), int64_t(cg_x_.size())}, cg_x_.data());
 }
 
 void Grid::compute_rhs(float dt) {
-  rhs_d(device(), view(), dt > 0.f ? window_.paint().density.data() : nullptr, dt > 0.f ? 1.f / dt : 0.f,
-        rhs_.data());
+  grid_rhs(device(), view(), dt > 0.f ? window_.paint().density.data() : nullptr, dt > 0.f ? 1.f / dt : 0.f,
+           rhs_.data());
 }
 
 void Grid::project(float dt) {
@@ -647,18 +538,18 @@ void Grid::project(float dt) {
   solve_pressure(d, v.poisson(), rhs_.data(), pressure_.data(), cfg, scratch_);
   if (params_.projection_norms) {
     stats_.rhs_norm = norm2(d, rhs_.data(), g.cells(), scratch_, ws_);
-    residual_d(d, v.poisson(), rhs_.data(), pressure_.data(), scratch_.r.data());
+    poisson_residual(d, v.poisson(), rhs_.data(), pressure_.data(), scratch_.r.data());
     stats_.residual_norm = norm2(d, scratch_.r.data(), g.cells(), scratch_, ws_);
   }
-  apply_pressure_d(d, v, pressure_.data());
-  extrapolate_d(d, v);
+  grid_apply_pressure(d, v, pressure_.data());
+  grid_extrapolate(d, v);
 }
 
 void Grid::dry(float dt) {
   WB_PROFILE_SCOPE("grid.dry");
   if (params_.dry_rate <= 0.f) return;
   // §4.2 dries every cell: the window's cells here, the rest of the canvas by its clock.
-  dry_d(device(), window_.paint().view(), params_.dry_rate * dt);
+  grid_dry(device(), window_.paint().view(), params_.dry_rate * dt);
   window_.canvas().advance_drying(double(params_.dry_rate) * double(dt));
 }
 
@@ -677,11 +568,12 @@ void Grid::flow_film(float dt) {
   const Vec3 gv = params_.gravity_vector();
   FilmFlow f{stiff, oily, rho0 * -gv.z * cell, rho0 * gv.y * cell, cell, dt / float(substeps)};
   // The columns are read from the cells once, flow in their own planes, and are written back once.
-  film_columns_d(device(), g, extent_.data(), window_.paint().view(), bristles_, particle_density_,
-                 params_.dry_threshold, params_.film_max, film_[0].data());
+  grid_film_columns(device(), g, extent_.data(), window_.paint().view(), bristles_, particle_density_,
+                    params_.dry_threshold, params_.film_max, film_[0].data());
   int cur = 0;
-  for (int s = 0; s < substeps; ++s, cur = 1 - cur) film_update_d(device(), g, film_[cur].data(), f, film_[1 - cur].data());
-  film_write_d(device(), g, window_.paint().view(), film_[cur].data());
+  for (int s = 0; s < substeps; ++s, cur = 1 - cur)
+    grid_film_update(device(), g, film_[cur].data(), f, film_[1 - cur].data());
+  grid_film_write(device(), g, window_.paint().view(), film_[cur].data());
 }
 
 void Grid::step(float dt, const std::function<void()>& after_advection) {
@@ -710,7 +602,7 @@ double Grid::divergence_norm(float dt) {
 }
 
 float Grid::max_fluid_speed() {
-  max_speed_d(device(), view(), face_tmp_.data());
+  grid_max_abs_fluid_velocity(device(), view(), face_tmp_.data());
   const GridDims g = dims();
   return reduce_max(device(), face_tmp_.data(), g.nu() + g.nv() + g.nw(), ws_);
 }

@@ -8,6 +8,7 @@
 #include <functional>
 
 #include "core/canvas/tile_store.h"
+#include "core/exec/dispatch.h"
 #include "core/exec/graph.h"
 #include "core/grid/active_window.h"
 #include "core/grid/grid_fields.h"
@@ -210,66 +211,75 @@ class Grid {
   GridStats stats_;
 };
 
-#define WB_GRID_BACKEND_DECLS                                                                                        \
-  void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float* particle_density, int canvas_w, int canvas_h, int canvas_d,     \
-                     float liquid_threshold, float dry_threshold);                                                   \
-  void grid_column_tops(GridDims d, const float* rho, const float* particle_density, float trace, float* out);    \
-  void grid_first_extent(GridDims d, const float* maxima, GridExtent* e);                                          \
-  void grid_paint_outflow(GridView g, const float* rho, float* out);                                                \
-  void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt, int reach, \
-                              float dry_threshold, PaintTiles tiles, const int32_t* process, int32_t* painted,       \
-                              const int32_t* below, int32_t* below_next);                                            \
-  void grid_paint_tiles_pass(GridDims d, PaintTiles tiles, const int32_t* before, int axis, int reach_tiles,        \
-                             int32_t* process);                                                                      \
-  void grid_paint_tiles(GridDims d, const float* rho, const float* dryness, float dry_threshold, int top,          \
-                        int layers, int reach, int halo_width, int deep, int32_t* mark, int32_t* active,            \
-                        int32_t* halo, int64_t* counts, int32_t* below);                                             \
-  void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst, bool reads);   \
-  void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt);                  \
-  void grid_film_columns(GridDims d, const GridExtent* e, PaintWindowView pw, BristleField br,                    \
-                         const float* particle_density, float dry_threshold, float film_max, float* col);         \
-  void grid_film_update(GridDims d, const float* col, FilmFlow f, float* next);                                    \
-  void grid_film_write(GridDims d, PaintWindowView pw, const float* col);                                         \
-  void grid_gravity(GridView g, float* ph, float g_dt, float g_dt_y);                                                            \
-  void grid_effective_viscosity(GridView g, JointOil oil, HerschelBulkley stiff, HerschelBulkley oily, float m,    \
-                                float* mu);                                                                          \
-  void grid_viscous_flags(GridView g, uint32_t* flag);                                                               \
-  void grid_viscous_list(GridView g, const uint32_t* idx, uint32_t* list);                                           \
-  void grid_viscous_count(GridView g, const uint32_t* idx, int64_t capacity, int64_t* run, double* total);       \
-  void grid_viscous_setup(GridView g, const uint32_t* list, ListCount n, const uint32_t* idx, const float* mu,     \
-                          float nu_scale, float* nu, int32_t* nb, double* diag, double* b, double* x);               \
-  void grid_viscous_apply(ListCount n, const float* nu, const int32_t* nb, const double* diag, const double* p,       \
-                          double* q, double* pq, CgGuard guard, SumScratch s);                                       \
-  void grid_pcg_start(ListCount n, const double* b, const double* ax, const double* diag, double* r, double* z,      \
-                      double* p, double* rz, double* bz, SumScratch s);                                              \
-  void grid_pcg_update(ListCount n, CgGuard guard, const double* pq, const double* p, const double* q,               \
-                       const double* diag, double* x, double* r, double* z, double* rz, double* iterations,         \
-                       SumScratch s);                                                                                \
-  void grid_pcg_direction(ListCount n, CgGuard guard, const double* rz_new, const double* z, double* p);          \
-  void grid_viscous_write(GridView g, const uint32_t* list, ListCount n, const double* x);                         \
-  void grid_rhs(GridView g, const float* rho, float inv_dt, float* b);                                                                               \
-  void poisson_jacobi(PoissonView s, const float* b, const float* x, float* out, float omega);                      \
-  void poisson_residual(PoissonView s, const float* b, const float* x, float* r);                                   \
-  void poisson_chebyshev(PoissonView s, const float* b, const float* x, const float* x_prev, float* out,            \
-                         float omega_k);                                                                             \
-  void poisson_fixed_point_first(PoissonView s, const float* r, const float* y, float* out, float alpha);           \
-  void poisson_fixed_point_second(PoissonView s, const float* r, const float* z, float* y_out, float* x);           \
-  void poisson_apply_all(PoissonView s, const float* x, float* out);                                                 \
-  void grid_apply_pressure(GridView g, const float* p);                                                              \
-  void grid_extrapolate(GridView g);                                                                                 \
-  void grid_extent(GridDims d, const float* before, const float* after, GridExtent* e);                              \
-  void grid_dry(PaintWindowView pw, float amount);                                                                   \
-  void grid_shift_lattice(const float* src, float* dst, int ex, int ey, int ez, int dx, int dy, int dz);            \
-  void grid_max_abs_fluid_velocity(GridView g, float* out);                                                          \
-  void grid_square(const float* x, float* out, int64_t n);                                                          \
-  void grid_scale(float* x, float s, int64_t n);                                                                     \
-  void grid_fill_hash(float* x, const uint8_t* cls, int64_t n, uint32_t seed);
-
-namespace cpu {
-WB_GRID_BACKEND_DECLS
-}  // namespace cpu
-namespace cuda {
-WB_GRID_BACKEND_DECLS
-}  // namespace cuda
+// The grid stage's backend drivers (grid_impl.h), one list (core/exec/dispatch.h).
+#define WB_GRID_KERNELS(X)                                                                                           \
+  X(void, grid_classify, (GridView g, PaintWindowView pw, BristleField br, const float* particle_density,            \
+      CanvasDims canvas, float liquid_threshold, float dry_threshold),                                               \
+      (g, pw, br, particle_density, canvas, liquid_threshold, dry_threshold))                                        \
+  X(void, grid_column_tops, (GridDims d, const float* rho, const float* particle_density, float trace, float* out),  \
+      (d, rho, particle_density, trace, out))                                                                        \
+  X(void, grid_first_extent, (GridDims d, const float* maxima, GridExtent* e), (d, maxima, e))                       \
+  X(void, grid_paint_outflow, (GridView g, const float* rho, float* out), (g, rho, out))                             \
+  X(void, grid_advect_paint_axis, (GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt,         \
+      int reach, float dry_threshold, PaintTiles tiles, const int32_t* process, int32_t* painted,                    \
+      const int32_t* below, int32_t* below_next),                                                                    \
+      (g, src, dst, axis, dt, reach, dry_threshold, tiles, process, painted, below, below_next))                     \
+  X(void, grid_paint_tiles_pass, (GridDims d, PaintTiles tiles, const int32_t* before, int axis, int reach_tiles,    \
+      int32_t* process), (d, tiles, before, axis, reach_tiles, process))                                             \
+  X(void, grid_paint_tiles, (GridDims d, const float* rho, const float* dryness, float dry_threshold, int top,       \
+      int layers, int reach, int halo_width, int deep, int32_t* mark, int32_t* active, int32_t* halo,                \
+      int64_t* counts, int32_t* below),                                                                              \
+      (d, rho, dryness, dry_threshold, top, layers, reach, halo_width, deep, mark, active, halo, counts, below))     \
+  X(void, grid_copy_paint_tiles, (GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst,            \
+      bool reads), (d, tiles, src, dst, reads))                                                                      \
+  X(void, grid_advect_velocity, (GridView g, const float* u, const float* v, const float* w, float dt),              \
+      (g, u, v, w, dt))                                                                                              \
+  X(void, grid_film_columns, (GridDims d, const GridExtent* e, PaintWindowView pw, BristleField br,                  \
+      const float* particle_density, float dry_threshold, float film_max, float* col),                               \
+      (d, e, pw, br, particle_density, dry_threshold, film_max, col))                                                \
+  X(void, grid_film_update, (GridDims d, const float* col, FilmFlow f, float* next), (d, col, f, next))              \
+  X(void, grid_film_write, (GridDims d, PaintWindowView pw, const float* col), (d, pw, col))                         \
+  X(void, grid_gravity, (GridView g, float* ph, float g_dt, float g_dt_y), (g, ph, g_dt, g_dt_y))                    \
+  X(void, grid_effective_viscosity, (GridView g, JointOil oil, HerschelBulkley stiff, HerschelBulkley oily, float m, \
+      float* mu), (g, oil, stiff, oily, m, mu))                                                                      \
+  X(void, grid_viscous_flags, (GridView g, uint32_t* flag), (g, flag))                                               \
+  X(void, grid_viscous_list, (GridView g, const uint32_t* idx, uint32_t* list), (g, idx, list))                      \
+  X(void, grid_viscous_count, (GridView g, const uint32_t* idx, int64_t capacity, int64_t* run, double* total),      \
+      (g, idx, capacity, run, total))                                                                                \
+  X(void, grid_viscous_setup, (GridView g, const uint32_t* list, ListCount n, const uint32_t* idx, const float* mu,  \
+      float nu_scale, float* nu, int32_t* nb, double* diag, double* b, double* x),                                   \
+      (g, list, n, idx, mu, nu_scale, nu, nb, diag, b, x))                                                           \
+  X(void, grid_viscous_apply, (ListCount n, const float* nu, const int32_t* nb, const double* diag, const double* p, \
+      double* q, double* pq, CgGuard guard, SumScratch s), (n, nu, nb, diag, p, q, pq, guard, s))                    \
+  X(void, grid_pcg_start, (ListCount n, const double* b, const double* ax, const double* diag, double* r, double* z, \
+      double* p, double* rz, double* bz, SumScratch s), (n, b, ax, diag, r, z, p, rz, bz, s))                        \
+  X(void, grid_pcg_update, (ListCount n, CgGuard guard, const double* pq, const double* p, const double* q,          \
+      const double* diag, double* x, double* r, double* z, double* rz, double* iterations, SumScratch s),            \
+      (n, guard, pq, p, q, diag, x, r, z, rz, iterations, s))                                                        \
+  X(void, grid_pcg_direction, (ListCount n, CgGuard guard, const double* rz_new, const double* z, double* p),        \
+      (n, guard, rz_new, z, p))                                                                                      \
+  X(void, grid_viscous_write, (GridView g, const uint32_t* list, ListCount n, const double* x), (g, list, n, x))     \
+  X(void, grid_rhs, (GridView g, const float* rho, float inv_dt, float* b), (g, rho, inv_dt, b))                     \
+  X(void, poisson_jacobi, (PoissonView s, const float* b, const float* x, float* out, float omega),                  \
+      (s, b, x, out, omega))                                                                                         \
+  X(void, poisson_residual, (PoissonView s, const float* b, const float* x, float* r), (s, b, x, r))                 \
+  X(void, poisson_chebyshev, (PoissonView s, const float* b, const float* x, const float* x_prev, float* out,        \
+      float omega_k), (s, b, x, x_prev, out, omega_k))                                                               \
+  X(void, poisson_fixed_point_first, (PoissonView s, const float* r, const float* y, float* out, float alpha),       \
+      (s, r, y, out, alpha))                                                                                         \
+  X(void, poisson_fixed_point_second, (PoissonView s, const float* r, const float* z, float* y_out, float* x),       \
+      (s, r, z, y_out, x))                                                                                           \
+  X(void, poisson_apply_all, (PoissonView s, const float* x, float* out), (s, x, out))                               \
+  X(void, grid_apply_pressure, (GridView g, const float* p), (g, p))                                                 \
+  X(void, grid_extrapolate, (GridView g), (g))                                                                       \
+  X(void, grid_extent, (GridDims d, const float* before, const float* after, GridExtent* e), (d, before, after, e))  \
+  X(void, grid_dry, (PaintWindowView pw, float amount), (pw, amount))                                                \
+  X(void, grid_shift_lattice, (const float* src, float* dst, int ex, int ey, int ez, int dx, int dy, int dz),        \
+      (src, dst, ex, ey, ez, dx, dy, dz))                                                                            \
+  X(void, grid_max_abs_fluid_velocity, (GridView g, float* out), (g, out))                                           \
+  X(void, grid_square, (const float* x, float* out, int64_t n), (x, out, n))                                         \
+  X(void, grid_scale, (float* x, float s, int64_t n), (x, s, n))                                                     \
+  X(void, grid_fill_hash, (float* x, const uint8_t* cls, int64_t n, uint32_t seed), (x, cls, n, seed))
+WB_DECLARE_KERNELS(WB_GRID_KERNELS)
 
 }  // namespace wb

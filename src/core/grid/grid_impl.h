@@ -79,8 +79,9 @@ void for_faces(const GridDims& d, const GridExtent* e, F fn) {
     parallel_for(detail::all_faces(d), detail::AllFaces<F>{d, fn});
 }
 
-void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float* particle_density, int canvas_w,
-                   int canvas_h, int canvas_d, float liquid_threshold, float dry_threshold) {
+void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float* particle_density, CanvasDims canvas,
+                   float liquid_threshold, float dry_threshold) {
+  const int canvas_w = canvas.width, canvas_h = canvas.height, canvas_d = canvas.depth;
   const GridDims d = g.d;
   const auto cell = [=] WB_HD(int64_t c) {
     int i, j, k;
@@ -275,6 +276,7 @@ void grid_paint_tiles_pass(GridDims d, PaintTiles tiles, const int32_t* before, 
 void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt, int reach,
                             float dry_threshold, PaintTiles tiles, const int32_t* process, int32_t* painted,
                             const int32_t* below, int32_t* below_next) {
+  WB_REQUIRE(g.extent, "grid advection: the paint's box is not set");
   const GridDims d = g.d;
   const GridExtent* box = g.extent;
   auto cell = [=] WB_HD(int32_t t, int64_t c) {
@@ -335,6 +337,7 @@ void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst
 }
 
 void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt) {
+  WB_REQUIRE(g.extent, "grid advection: the velocity's extent is not set");
   const GridDims d = g.d;
   for_faces(d, g.extent, [=] WB_HD(int c, int64_t f) {
     int i, j, k;

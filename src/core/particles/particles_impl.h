@@ -1,12 +1,40 @@
 // Particle stage drivers (paper §4.3, Eq. 8-11), compiled once per backend: one
 // parallel_for per stage over the particles (or faces), physics in the *_kernels.h.
 #pragma once
+#include <cmath>
+#include <string>
+
+#include "core/exec/error.h"
 #include "core/exec/parallel_for.h"
 #include "core/particles/particles.h"
 
 namespace wb::WB_BACKEND_NS {
 
+namespace detail {
+void check_params(const ParticleParams& prm, float dt) {
+  WB_REQUIRE(std::isfinite(dt) && dt > 0.f, "particles: time step must be positive, got " + std::to_string(dt));
+  WB_REQUIRE(prm.beta_L >= 0.f && prm.beta_L <= 1.f,
+             "particles: beta_L must lie in [0, 1], got " + std::to_string(prm.beta_L));
+  WB_REQUIRE(prm.D1 >= 0.f && std::isfinite(prm.D1), "particles: D1 must be >= 0, got " + std::to_string(prm.D1));
+  WB_REQUIRE(prm.delta >= 0.f && std::isfinite(prm.delta),
+             "particles: delta must be >= 0, got " + std::to_string(prm.delta));
+  WB_REQUIRE(isfinite3(prm.gravity), "particles: gravity is not finite");
+}
+void check_grid(int nx, int ny, int nz, const char* what) {
+  WB_REQUIRE(nx > 0 && ny > 0 && nz > 0, std::string("particles: ") + what + " has an empty window (" +
+                                             std::to_string(nx) + " x " + std::to_string(ny) + " x " +
+                                             std::to_string(nz) + ")");
+}
+}  // namespace detail
+
+/// Two-step adhesion update of every particle (Eq. 8-10) over dt seconds. Needs the
+/// particles' nearest / d_B from SampleGrid::query_nearest with a range >= prm.D1 on
+/// the same samples. Positions and velocities are updated in place.
 void particles_adhesion_step(ParticleView p, SampleView s, SolidView solid, ParticleParams prm, float dt) {
+  detail::check_params(prm, dt);
+  WB_REQUIRE(p.count >= 0, "particles_adhesion_step: negative particle count");
+  WB_REQUIRE(solid.height == nullptr || (solid.nx > 0 && solid.ny > 0),
+             "particles_adhesion_step: solid height map without extent");
   const int64_t n_samples = s.count();
   parallel_for(p.count, [=] WB_HD(int64_t k) {
     Vec3 x = p.x[k], v = p.v[k];
@@ -29,7 +57,14 @@ constexpr int64_t kRasterRun = 1;  // a thread a particle: the device's atomics 
 constexpr int64_t kRasterRun = 64;  // a thread's particles in order, their runs summed first
 #endif
 
+/// Adds the particles' mass (cell centres) and momentum and mass weight (MAC faces) into g,
+/// trilinearly (flip_kernels.h); the mass only when the face fields are all null. Particles
+/// outside the window are skipped.
 void particles_rasterise(ParticleView p, ParticleRasterView g) {
+  detail::check_grid(g.nx, g.ny, g.nz, "rasterisation target");
+  const bool faces = g.face[0] && g.face[1] && g.face[2];
+  const bool cells_only = !g.face[0] && !g.face[1] && !g.face[2];
+  WB_REQUIRE(g.cell && (faces || cells_only), "particles_rasterise: a target field is null");
   const int64_t n = p.count, chunks = (n + kRasterRun - 1) / kRasterRun;
   parallel_for(
       chunks,
@@ -40,7 +75,11 @@ void particles_rasterise(ParticleView p, ParticleRasterView g) {
       kMinParallelSize / kRasterRun);
 }
 
+/// (u, v, w)[f] = momentum / weight on faces with weight > 0, else `empty` (e.g. 0).
 void particles_face_velocity(ParticleRasterView g, float* u, float* v, float* w, float empty) {
+  detail::check_grid(g.nx, g.ny, g.nz, "face velocity");
+  WB_REQUIRE(g.face[0] && g.face[1] && g.face[2], "particles_face_velocity: a rasterised face field is null");
+  WB_REQUIRE(u && v && w, "particles_face_velocity: an output field is null");
   const int64_t nu = int64_t(g.nx + 1) * g.ny * g.nz, nv = int64_t(g.nx) * (g.ny + 1) * g.nz,
                 nw = int64_t(g.nx) * g.ny * (g.nz + 1);
   parallel_for(nu, [=] WB_HD(int64_t f) { u[f] = face_velocity(g.face[0][f], empty); });
@@ -48,17 +87,28 @@ void particles_face_velocity(ParticleRasterView g, float* u, float* v, float* w,
   parallel_for(nw, [=] WB_HD(int64_t f) { w[f] = face_velocity(g.face[2][f], empty); });
 }
 
+/// Eq. 11 for every particle: before = joint field u before projection, after = u_bar.
 void particles_flip_pic(ParticleView p, MacView before, MacView after, float gamma) {
+  WB_REQUIRE(gamma >= 0.f && gamma <= 1.f,
+             "particles_flip_pic: gamma must lie in [0, 1], got " + std::to_string(gamma));
+  detail::check_grid(before.nx, before.ny, before.nz, "FLIP/PIC field before projection");
+  detail::check_grid(after.nx, after.ny, after.nz, "FLIP/PIC field after projection");
+  WB_REQUIRE(before.nx == after.nx && before.ny == after.ny && before.nz == after.nz && before.ox == after.ox &&
+                 before.oy == after.oy && before.oz == after.oz,
+             "particles_flip_pic: the fields before and after projection cover different windows");
   parallel_for(p.count, [=] WB_HD(int64_t k) {
     const Vec3 x = p.x[k];
     p.v[k] = flip_pic_velocity(p.v[k], before.sample(x), after.sample(x), gamma);
   });
 }
 
+/// Particles whose dead flag is clear; used by ParticleStore::compact.
 void particles_keep_flags(const uint32_t* dead, uint32_t* keep, int64_t n) {
   parallel_for(n, [=] WB_HD(int64_t i) { keep[i] = dead[i] ? 0u : 1u; });
 }
 
+/// to[pos[i]] = the state of particle i for every i < n with !dead[i]; pos is the exclusive scan
+/// of the keep flags (ParticleStore::compact).
 void particles_compact_state(ParticleView p, ParticleStateView to, const uint32_t* pos, int64_t n) {
   parallel_for(n, [=] WB_HD(int64_t i) {
     if (p.dead[i]) return;
@@ -69,7 +119,12 @@ void particles_compact_state(ParticleView p, ParticleStateView to, const uint32_
   });
 }
 
+/// Sort keys by half cell: keys[k] = the half cell (a window cell halved along each axis) of
+/// particle k, numbered x fastest over the window of `dims` cells at canvas cell `origin` (the
+/// half cells' count for a particle outside it or not finite), index[k] = k.
 void particles_cell_keys(ParticleView p, Int3 origin, Int3 dims, uint32_t* keys, uint32_t* index) {
+  WB_REQUIRE(dims.x > 0 && dims.y > 0 && dims.z > 0 && int64_t(8) * dims.x * dims.y * dims.z < (int64_t(1) << 31),
+             "particles_cell_keys: the window's cells do not fit a key");
   parallel_for(p.count, [=] WB_HD(int64_t k) {
     const Vec3 x = p.x[k];
     const float q[3] = {x.x - float(origin.x), x.y - float(origin.y), x.z - float(origin.z)};
@@ -86,6 +141,8 @@ void particles_cell_keys(ParticleView p, Int3 origin, Int3 dims, uint32_t* keys,
   });
 }
 
+/// to[i] = the state of particle from[i] for i < n: the particles in a new order
+/// (ParticleStore::sort_by_cell).
 void particles_gather_state(ParticleView p, ParticleStateView to, const uint32_t* from, int64_t n) {
   parallel_for(n, [=] WB_HD(int64_t i) {
     const int64_t k = from[i];
@@ -95,6 +152,7 @@ void particles_gather_state(ParticleView p, ParticleStateView to, const uint32_t
   });
 }
 
+/// Scratch of particles [first, first + n): nearest = -1, d_B = 0, dead = 0.
 void particles_init_scratch(ParticleView p, int64_t first, int64_t n) {
   parallel_for(n, [=] WB_HD(int64_t i) {
     const int64_t k = first + i;
@@ -104,8 +162,20 @@ void particles_init_scratch(ParticleView p, int64_t first, int64_t n) {
   });
 }
 
+/// Height fields of what the particles rest on over the window's columns (SolidView), absolute
+/// canvas z, nx * ny floats each: `height`, the top of the highest dried cell (dryness at or above
+/// dry_threshold, the grid's solid test) as a whole cell (the grid holds one state a cell, so
+/// wet paint over a partly filled dried cell starts at its top; column_solid_top gives the paint's
+/// own top), or floor_z where none; `wet_top` (nullable), the top
+/// of the highest liquid cell above it, or `height` where none. Liquid is the grid's joint test:
+/// density plus `particle_density` (the particles' raster, nullable) at or above liquid_threshold;
+/// where the layer near the bristles is mostly particles (§5.2), its grid density alone is air.
 void particles_solid_height(PaintWindowView pw, const float* particle_density, float dry_threshold,
                             float liquid_threshold, float floor_z, float* height, float* wet_top) {
+  WB_REQUIRE(pw.density && pw.dryness && height, "particles_solid_height: missing fields");
+  WB_REQUIRE(std::isfinite(dry_threshold) && dry_threshold > 0.f && std::isfinite(liquid_threshold) &&
+                 liquid_threshold > 0.f && std::isfinite(floor_z),
+             "particles_solid_height: bad threshold or floor");
   parallel_for(int64_t(pw.nx) * pw.ny, [=] WB_HD(int64_t c) {
     const int64_t layer = int64_t(pw.nx) * pw.ny;
     int above = 0;
@@ -129,8 +199,15 @@ void particles_solid_height(PaintWindowView pw, const float* particle_density, f
   });
 }
 
+/// The ground a particle in flight lands on, per window column (absolute canvas z): the solid's
+/// top (as `height` above), raised through the liquid cells (joint test) stacked on it up to the
+/// first that is not. Paint held up in the air above a gap is not ground.
 void particles_ground_surface(PaintWindowView pw, const float* particle_density, float dry_threshold,
                               float liquid_threshold, float floor_z, float* surface) {
+  WB_REQUIRE(pw.density && pw.dryness && surface, "particles_ground_surface: missing fields");
+  WB_REQUIRE(std::isfinite(dry_threshold) && dry_threshold > 0.f && std::isfinite(liquid_threshold) &&
+                 liquid_threshold > 0.f && std::isfinite(floor_z),
+             "particles_ground_surface: bad threshold or floor");
   parallel_for(int64_t(pw.nx) * pw.ny, [=] WB_HD(int64_t c) {
     const int64_t layer = int64_t(pw.nx) * pw.ny;
     int above = 0;

@@ -1,4 +1,4 @@
-// Sample grid: validation and the one runtime dispatch.
+// Sample grid: validation and the one runtime dispatch of its drivers (sample_grid_impl.h).
 #include "core/particles/sample_grid.h"
 
 #include <cmath>
@@ -6,28 +6,11 @@
 #include <string>
 
 #include "core/exec/algorithms.h"
-#include "core/exec/dispatch.h"
 
 namespace wb {
+WB_DEFINE_DISPATCHERS(WB_SAMPLE_GRID_KERNELS)
+
 namespace {
-void box(const Device& d, const Vec3* x, const Vec3* v, float rw, int64_t n, float inv_h, CellBox r, int32_t* b) {
-  WB_DISPATCH(d, sample_grid_box(x, v, rw, n, inv_h, r, b));
-}
-void keys(const Device& d, const Vec3* x, const Vec3* v, float rw, int64_t n, float inv_h, CellBox r,
-          const int32_t* b, uint32_t* k, uint32_t* idx) {
-  WB_DISPATCH(d, sample_grid_keys(x, v, rw, n, inv_h, r, b, k, idx));
-}
-void first(const Device& d, const uint32_t* k, const uint32_t* idx, const Vec3* x, const Vec3* v, float rw, int64_t n,
-           const int32_t* b, uint32_t* f, Vec3* sx) {
-  WB_DISPATCH(d, sample_grid_first(k, idx, x, v, rw, n, b, f, sx));
-}
-void coarse(const Device& d, const int32_t* b, const uint32_t* f, int64_t cap, uint8_t* occ) {
-  WB_DISPATCH(d, sample_grid_coarse(b, f, cap, occ));
-}
-void near(const Device& d, const int32_t* b, const uint8_t* occ, int reach, int64_t cap, uint8_t* out) {
-  WB_DISPATCH(d, sample_grid_near(b, occ, reach, cap, out));
-}
-void query(const Device& d, SampleGridView g, ParticleView p, float r) { WB_DISPATCH(d, sample_grid_query(g, p, r)); }
 
 /// The grid's cell table holds at most this many cells (128 M, 512 MiB). The simulator's region
 /// (its window's columns over the canvas's depth, up to 1024 cells) stays below it at the default
@@ -92,13 +75,14 @@ void SampleGrid::build(const SampleView& s, float cell_size, Vec3 region_lo, Vec
     index_.grow_keep(size_t(n));
     sorted_x_.grow_keep(size_t(n));
   }
-  box(device_, s.x, s.v, rewind_dt, n, inv_h, region, box_.data());
-  keys(device_, s.x, s.v, rewind_dt, n, inv_h, region, box_.data(), keys_.data(), index_.data());
+  sample_grid_box(device_, s.x, s.v, rewind_dt, n, inv_h, region, box_.data());
+  sample_grid_keys(device_, s.x, s.v, rewind_dt, n, inv_h, region, box_.data(), keys_.data(), index_.data());
   int bits = 1;  // keys run to the box's cells, at most the region's
   while ((int64_t(1) << bits) <= cells) ++bits;
   if (n > 0) sort_by_key(device_, keys_.data(), index_.data(), n, bits, ws);
-  first(device_, keys_.data(), index_.data(), s.x, s.v, rewind_dt, n, box_.data(), first_.data(), sorted_x_.data());
-  coarse(device_, box_.data(), first_.data(), coarse_capacity_, occupied_.data());
+  sample_grid_first(device_, keys_.data(), index_.data(), s.x, s.v, rewind_dt, n, box_.data(), first_.data(),
+                    sorted_x_.data());
+  sample_grid_coarse(device_, box_.data(), first_.data(), coarse_capacity_, occupied_.data());
 }
 
 SampleGridView SampleGrid::view() const {
@@ -115,8 +99,8 @@ void SampleGrid::query_nearest(const ParticleView& p, float max_range) {
   // the rounding of x / h on a large canvas), so at most ceil(F / kCoarse) coarse cells.
   const int fine = int(std::ceil(max_range / h_ + 0.01f));
   const int reach = (fine + kCoarse - 1) / kCoarse;
-  near(device_, box_.data(), occupied_.data(), reach, coarse_capacity_, near_.data());
-  query(device_, view(), p, max_range);
+  sample_grid_near(device_, box_.data(), occupied_.data(), reach, coarse_capacity_, near_.data());
+  sample_grid_query(device_, view(), p, max_range);
 }
 
 NearestSample nearest_sample_brute_force(const Vec3* samples, int64_t n, Vec3 p, float max_range) {

@@ -12,6 +12,7 @@
 #include "core/brush/bristle_fields.h"
 #include "core/exec/buffer.h"
 #include "core/exec/device.h"
+#include "core/exec/dispatch.h"
 #include "core/exec/workspace.h"
 #include "core/particles/sample_grid_kernels.h"
 #include "core/particles/particle_fields.h"
@@ -63,22 +64,20 @@ class SampleGrid {
 /// Reference for tests: the nearest sample to p among all n (host arrays), within max_range.
 NearestSample nearest_sample_brute_force(const Vec3* samples, int64_t n, Vec3 p, float max_range);
 
-#define WB_SAMPLE_GRID_BACKEND_DECLS                                                                              \
-  void sample_grid_box(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, CellBox region,     \
-                       int32_t* box);                                                                             \
-  void sample_grid_keys(const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, CellBox region,    \
-                        const int32_t* box, uint32_t* keys, uint32_t* index);                                     \
-  void sample_grid_first(const uint32_t* sorted_keys, const uint32_t* index, const Vec3* x, const Vec3* v,        \
-                         float rewind_dt, int64_t n, const int32_t* box, uint32_t* first, Vec3* sorted_x);        \
-  void sample_grid_coarse(const int32_t* box, const uint32_t* first, int64_t capacity, uint8_t* occupied);        \
-  void sample_grid_near(const int32_t* box, const uint8_t* occupied, int reach, int64_t capacity, uint8_t* near); \
-  void sample_grid_query(SampleGridView g, ParticleView p, float max_range);
-
-namespace cpu {
-WB_SAMPLE_GRID_BACKEND_DECLS
-}  // namespace cpu
-namespace cuda {
-WB_SAMPLE_GRID_BACKEND_DECLS
-}  // namespace cuda
+// The sample grid's backend drivers (sample_grid_impl.h), one list (core/exec/dispatch.h).
+#define WB_SAMPLE_GRID_KERNELS(X)                                                                                   \
+  X(void, sample_grid_box, (const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, CellBox region,  \
+      int32_t* box), (x, v, rewind_dt, n, inv_h, region, box))                                                      \
+  X(void, sample_grid_keys, (const Vec3* x, const Vec3* v, float rewind_dt, int64_t n, float inv_h, CellBox region, \
+      const int32_t* box, uint32_t* keys, uint32_t* index), (x, v, rewind_dt, n, inv_h, region, box, keys, index))  \
+  X(void, sample_grid_first, (const uint32_t* sorted_keys, const uint32_t* index, const Vec3* x, const Vec3* v,     \
+      float rewind_dt, int64_t n, const int32_t* box, uint32_t* first, Vec3* sorted_x),                             \
+      (sorted_keys, index, x, v, rewind_dt, n, box, first, sorted_x))                                               \
+  X(void, sample_grid_coarse, (const int32_t* box, const uint32_t* first, int64_t capacity, uint8_t* occupied),     \
+      (box, first, capacity, occupied))                                                                             \
+  X(void, sample_grid_near, (const int32_t* box, const uint8_t* occupied, int reach, int64_t capacity,              \
+      uint8_t* near), (box, occupied, reach, capacity, near))                                                       \
+  X(void, sample_grid_query, (SampleGridView g, ParticleView p, float max_range), (g, p, max_range))
+WB_DECLARE_KERNELS(WB_SAMPLE_GRID_KERNELS)
 
 }  // namespace wb

@@ -7,27 +7,14 @@
 #include <cstring>
 
 #include "core/color/ryb.h"
-#include "core/exec/dispatch.h"
-#include "core/render/ao_kernels.h"
 #include "core/exec/profile.h"
+#include "core/render/ao_kernels.h"
 
 namespace wb {
 
+WB_DEFINE_DISPATCHERS(WB_RENDER_KERNELS)
+
 namespace {
-void top_map_dispatch(const Device& d, RenderVolume v, const RenderParams& P, int x0, int y0, int w, int h,
-                      uint16_t* top, FilmColumn* film) {
-  WB_DISPATCH(d, render_top_map(v, P, x0, y0, w, h, top, film));
-}
-void block_dispatch(const Device& d, const uint16_t* top, const FilmColumn* film, int w, int h, uint16_t* b,
-                    uint8_t* bf, int bw, int bh) {
-  WB_DISPATCH(d, render_block_top(top, film, w, h, b, bf, bw, bh));
-}
-void splat_dispatch(const Device& d, SplatView s, ParticleOverlay p) { WB_DISPATCH(d, render_splat(s, p)); }
-void pixels_dispatch(const Device& d, RenderVolume v, RenderParams P, CameraBasis cam, const Vec3* dirs,
-                     const int32_t* tiles, int ntiles, int tile_px, int w, int h, int mode, uint32_t* rgba,
-                     float* fout) {
-  WB_DISPATCH(d, render_pixels(v, P, cam, dirs, tiles, ntiles, tile_px, w, h, mode, rgba, fout));
-}
 
 std::vector<int32_t> all_tiles(int w, int h, int tile_px) {
   const int n = ((w + tile_px - 1) / tile_px) * ((h + tile_px - 1) / tile_px);
@@ -95,7 +82,7 @@ void Renderer::prepare(TileStore& canvas, const Camera& camera, const std::vecto
     }
     SplatView s{splat_d_.data(), splat_r_.data(), splat_y_.data(), splat_b_.data(), splat_oil_.data(),
                 n.x, n.y, n.z, o.x, o.y, o.z};
-    splat_dispatch(device_, s, *particles);
+    render_splat(device_, s, *particles);
     vol_.splat = s;
     vol_.has_splat = 1;
   }
@@ -139,8 +126,8 @@ void Renderer::prepare(TileStore& canvas, const Camera& camera, const std::vecto
     film_.resize(size_t(w) * h);
     block_top_.resize(size_t(bw) * bh);
     block_film_.resize(size_t(bw) * bh);
-    top_map_dispatch(device_, vol_, kparams_, x0, y0, w, h, top_.data(), film_.data());
-    block_dispatch(device_, top_.data(), film_.data(), w, h, block_top_.data(), block_film_.data(), bw, bh);
+    render_top_map(device_, vol_, kparams_, x0, y0, w, h, top_.data(), film_.data());
+    render_block_top(device_, top_.data(), film_.data(), w, h, block_top_.data(), block_film_.data(), bw, bh);
     host_blocks_.resize(size_t(bw) * bh);
     block_top_.copy_to_host(host_blocks_.data(), host_blocks_.size());
     for (uint16_t b : host_blocks_) vol_.z_top_max = std::max<int>(vol_.z_top_max, b);
@@ -172,8 +159,8 @@ void Renderer::run(RenderOutput mode, const Camera& camera, int tile_px, int nti
     fout_.resize(n * 4);
     rgba_.resize(1);
   }
-  pixels_dispatch(device_, vol_, kparams_, camera_basis(camera), ao_dirs_.data(), tile_list_.data(), ntiles, tile_px,
-                  img_w_, img_h_, int(mode), rgba_.data(), fout_.data());
+  render_pixels(device_, vol_, kparams_, camera_basis(camera), ao_dirs_.data(), tile_list_.data(), ntiles, tile_px,
+                img_w_, img_h_, int(mode), rgba_.data(), fout_.data());
   last_pixels_ = int64_t(n);
 }
 

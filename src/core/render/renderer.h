@@ -9,6 +9,7 @@
 #include "core/canvas/tile_store.h"
 #include "core/canvas/window.h"
 #include "core/exec/buffer.h"
+#include "core/exec/dispatch.h"
 #include "core/math/vec.h"
 #include "core/render/camera.h"
 #include "core/render/raycast_kernels.h"
@@ -138,23 +139,16 @@ class CanvasImageCache {
   int last_tiles_ = 0;
 };
 
-namespace cpu {
-void render_top_map(RenderVolume v, RenderParams P, int x0, int y0, int w, int h, uint16_t* top,
-                    FilmColumn* film);
-void render_block_top(const uint16_t* top, const FilmColumn* film, int w, int h, uint16_t* blocks,
-                      uint8_t* block_film, int bw, int bh);
-void render_splat(SplatView s, ParticleOverlay p);
-void render_pixels(RenderVolume v, RenderParams P, CameraBasis cam, const Vec3* ao_dirs, const int32_t* tiles,
-                   int ntiles, int tile_px, int img_w, int img_h, int mode, uint32_t* rgba, float* fout);
-}  // namespace cpu
-namespace cuda {
-void render_top_map(RenderVolume v, RenderParams P, int x0, int y0, int w, int h, uint16_t* top,
-                    FilmColumn* film);
-void render_block_top(const uint16_t* top, const FilmColumn* film, int w, int h, uint16_t* blocks,
-                      uint8_t* block_film, int bw, int bh);
-void render_splat(SplatView s, ParticleOverlay p);
-void render_pixels(RenderVolume v, RenderParams P, CameraBasis cam, const Vec3* ao_dirs, const int32_t* tiles,
-                   int ntiles, int tile_px, int img_w, int img_h, int mode, uint32_t* rgba, float* fout);
-}  // namespace cuda
+// The renderer's backend drivers (render_impl.h), one list (core/exec/dispatch.h).
+#define WB_RENDER_KERNELS(X)                                                                                       \
+  X(void, render_top_map, (RenderVolume v, RenderParams P, int x0, int y0, int w, int h, uint16_t* top,            \
+      FilmColumn* film), (v, P, x0, y0, w, h, top, film))                                                          \
+  X(void, render_block_top, (const uint16_t* top, const FilmColumn* film, int w, int h, uint16_t* blocks,          \
+      uint8_t* block_film, int bw, int bh), (top, film, w, h, blocks, block_film, bw, bh))                         \
+  X(void, render_splat, (SplatView s, ParticleOverlay p), (s, p))                                                  \
+  X(void, render_pixels, (RenderVolume v, RenderParams P, CameraBasis cam, const Vec3* ao_dirs,                    \
+      const int32_t* tiles, int ntiles, int tile_px, int img_w, int img_h, int mode, uint32_t* rgba, float* fout), \
+      (v, P, cam, ao_dirs, tiles, ntiles, tile_px, img_w, img_h, mode, rgba, fout))
+WB_DECLARE_KERNELS(WB_RENDER_KERNELS)
 
 }  // namespace wb

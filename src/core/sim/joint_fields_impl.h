@@ -1,15 +1,20 @@
 // Joint-field kernels (§4.3), compiled once per backend.
 #pragma once
+#include "core/exec/error.h"
 #include "core/exec/parallel_for.h"
 #include "core/sim/joint_fields.h"
 
 namespace wb::WB_BACKEND_NS {
 
+/// out[i] = in[i] * scale (kg to cell-volume fractions and back).
 void joint_scale(const float* in, float* out, int64_t n, float scale) {
   parallel_for(n, [=] WB_HD(int64_t i) { out[i] = in[i] * scale; });
 }
 
+/// The particles' raster as densities: density[i] = cell[i].first * scale and, where oil is
+/// not null, oil[i] = cell[i].second * scale (scale 1 / cell_mass: kg to cell-volume fractions).
 void joint_raster_density(const FloatPair* cell, float* density, float* oil, int64_t n, float scale) {
+  WB_REQUIRE(n == 0 || (cell && density), "joint_raster_density: a field is null");
   parallel_for(n, [=] WB_HD(int64_t i) {
     const FloatPair c = cell[i];
     density[i] = c.first * scale;
@@ -17,6 +22,9 @@ void joint_raster_density(const FloatPair* cell, float* density, float* oil, int
   });
 }
 
+/// Per window column: the dried paint's top (column_solid_top) where the column's centre lies
+/// within r of (cx, cy) and the top is above floor_z, else 0 (their maximum is the ground under a
+/// brush footprint). Only the columns under the footprint are scanned.
 void joint_ground_under(PaintWindowView pw, float dry_threshold, float cx, float cy, float r, float floor_z,
                         float* out) {
   parallel_for(int64_t(pw.nx) * pw.ny, [=] WB_HD(int64_t c) {
@@ -29,6 +37,8 @@ void joint_ground_under(PaintWindowView pw, float dry_threshold, float cx, float
   });
 }
 
+/// Per sample below height z_top: x, -x, y and -y into out[0..n), [n..2n), [2n..3n), [3n..4n)
+/// (-inf above z_top); their maxima are the horizontal box of the samples that reach the window.
 void joint_sample_extent(const Vec3* x, int64_t n, float z_top, float* out) {
   parallel_for(n, [=] WB_HD(int64_t i) {
     const Vec3 p = x[i];
@@ -41,7 +51,12 @@ void joint_sample_extent(const Vec3* x, int64_t n, float z_top, float* out) {
   });
 }
 
+/// Blends the particles' face momentum into the grid's face velocity, per face:
+/// u = (w_g u + P) / (w_g + W), w_g = cell_mass * mean density of the two cells (Eq. 11's u).
 void joint_blend_velocity(GridView g, PaintWindowView paint, ParticleRasterView raster, float cell_mass) {
+  WB_REQUIRE(raster.nx == g.d.nx && raster.ny == g.d.ny && raster.nz == g.d.nz,
+             "joint_blend_velocity: particle raster and grid differ in size");
+  WB_REQUIRE(raster.face[0] && raster.face[1] && raster.face[2], "joint_blend_velocity: the raster has no faces");
   const GridDims d = g.d;
   for (int c = 0; c < 3; ++c) {
     float* u = g.vel[c];
@@ -66,12 +81,15 @@ void joint_blend_velocity(GridView g, PaintWindowView paint, ParticleRasterView 
   }
 }
 
+/// Replaces non-finite values by 0 in [n] floats; returns nothing (count them first).
 void joint_zero_nonfinite(float* v, int64_t n) {
   parallel_for(n, [=] WB_HD(int64_t i) {
     if (!isfinite(v[i])) v[i] = 0.f;
   });
 }
 
+/// Keeps particles inside the canvas box: its sides and floor are walls, so paint never leaves
+/// the canvas (and is never deposited into off-canvas window cells, which are not stored).
 void joint_clamp_to_canvas(ParticleView p, Vec3 lo, Vec3 hi) {
   parallel_for(p.count, [=] WB_HD(int64_t k) {
     const Vec3 x = p.x[k];
@@ -88,6 +106,7 @@ void joint_clamp_to_canvas(ParticleView p, Vec3 lo, Vec3 hi) {
   });
 }
 
+/// Flags particles with any non-finite state as dead.
 void joint_kill_nonfinite(ParticleView p) {
   parallel_for(p.count, [=] WB_HD(int64_t k) {
     const bool ok = isfinite3(p.x[k]) && isfinite3(p.v[k]) && isfinite(p.m[k]) && isfinite(p.pigment_r[k]) &&

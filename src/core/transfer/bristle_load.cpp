@@ -7,24 +7,11 @@
 
 #include "core/color/ryb.h"
 #include "core/exec/algorithms.h"
-#include "core/exec/dispatch.h"
 #include "core/exec/error.h"
 #include "core/transfer/transfer.h"
 
 namespace wb {
 namespace {
-
-void d_dip(const Device& d, BristleLoadView l, const float* exchange, Vec3 ryb, float oil, float level, int replace,
-           float* added) {
-  WB_DISPATCH(d, transfer_load_dip(l, exchange, ryb, oil, level, replace, added));
-}
-void d_scale(const Device& d, BristleLoadView l, float keep, float* removed) {
-  WB_DISPATCH(d, transfer_load_scale(l, keep, removed));
-}
-void d_product(const Device& d, const float* a, const float* b, float* out, int64_t n) {
-  WB_DISPATCH(d, transfer_product(a, b, out, n));
-}
-void d_brightness(const Device& d, BristleLoadView l, float* out) { WB_DISPATCH(d, transfer_load_brightness(l, out)); }
 
 void validate(const PaintLoad& p, const char* what) {
   for (int c = 0; c < 3; ++c)
@@ -75,8 +62,9 @@ double BristleLoad::dip(const PaintLoad& paint) { return load(paint, false, "Bri
 double BristleLoad::load(const PaintLoad& paint, bool replace, const char* what) {
   validate(paint, what);
   if (count_ == 0) return 0.0;
-  d_dip(device_, view(), exchange_.empty() ? nullptr : exchange_.data(), Vec3(paint.ryb[0], paint.ryb[1], paint.ryb[2]),
-        paint.oil, paint.load, replace ? 1 : 0, scratch_.data());
+  transfer_load_dip(device_, view(), exchange_.empty() ? nullptr : exchange_.data(),
+                    Vec3(paint.ryb[0], paint.ryb[1], paint.ryb[2]), paint.oil, paint.load, replace ? 1 : 0,
+                    scratch_.data());
   return reduce_sum(device_, scratch_.data(), count_, ws_);
 }
 
@@ -92,14 +80,14 @@ double BristleLoad::wipe(float fraction) {
   WB_REQUIRE(std::isfinite(fraction) && fraction >= 0.f && fraction <= 1.f,
              "BristleLoad::wipe: the fraction must lie in [0, 1], got " + std::to_string(fraction));
   if (count_ == 0) return 0.0;
-  d_scale(device_, view(), 1.f - fraction, scratch_.data());
+  transfer_load_scale(device_, view(), 1.f - fraction, scratch_.data());
   return reduce_sum(device_, scratch_.data(), count_, ws_);
 }
 
 double BristleLoad::clean() {
   if (count_ == 0) return 0.0;
   // A fill with nothing: no load, no pigment (white), no oil.
-  d_dip(device_, view(), nullptr, Vec3(0.f, 0.f, 0.f), 0.f, 0.f, 1, scratch_.data());
+  transfer_load_dip(device_, view(), nullptr, Vec3(0.f, 0.f, 0.f), 0.f, 0.f, 1, scratch_.data());
   return -reduce_sum(device_, scratch_.data(), count_, ws_);
 }
 
@@ -114,10 +102,10 @@ Vec3 BristleLoad::mean_color(double w, Workspace& ws) {
   double sums[4];
   const float* comp[3] = {pigment_r.data(), pigment_y.data(), pigment_b.data()};
   for (int c = 0; c < 3; ++c) {
-    d_product(device_, m.data(), comp[c], scratch_.data(), count_);
+    transfer_product(device_, m.data(), comp[c], scratch_.data(), count_);
     sums[c] = reduce_sum(device_, scratch_.data(), count_, ws);
   }
-  d_brightness(device_, view(), scratch_.data());
+  transfer_load_brightness(device_, view(), scratch_.data());
   sums[3] = reduce_sum(device_, scratch_.data(), count_, ws);
   // Many-colour Algorithm 2: mass-weighted RYB mean, rescaled to the mass-weighted brightness.
   const Vec3 lin(float(sums[0] / w), float(sums[1] / w), float(sums[2] / w));
@@ -126,7 +114,7 @@ Vec3 BristleLoad::mean_color(double w, Workspace& ws) {
 
 float BristleLoad::mean_oil(double w, Workspace& ws) {
   if (!(w > 0.0)) return 0.f;
-  d_product(device_, m.data(), oil.data(), scratch_.data(), count_);
+  transfer_product(device_, m.data(), oil.data(), scratch_.data(), count_);
   return float(reduce_sum(device_, scratch_.data(), count_, ws) / w);
 }
 

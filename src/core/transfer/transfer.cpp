@@ -27,71 +27,9 @@ float TransferParams::absorb_range() const {
   // M'_j = max((1 - mu psi) M_max, M_min) (Eq. 12) is at most max(M_max, M_min).
   return load_radius(std::max(M_max, M_min), cell_mass());
 }
-namespace {
+WB_DEFINE_DISPATCHERS(WB_TRANSFER_KERNELS)
 
-// One dispatcher per backend pass (WB_DISPATCH returns from the function it is in).
-void d_absorb(const Device& d, ParticleView p, SampleView s, BristleLoadView l, AbsorbScratch a, TransferParams prm,
-              float dt, int64_t step_index) {
-  WB_DISPATCH(d, transfer_absorb(p, s, l, a, prm, dt, step_index));
-}
-void d_wick(const Device& d, SampleView s, BristleLoadView l, int bristles, int per, float k_dt, float k_slide,
-            float dt, WickScratch w) {
-  WB_DISPATCH(d, transfer_wick(s, l, bristles, per, k_dt, k_slide, dt, w));
-}
-void d_contact_paths(const Device& d, SampleView s, BristleLoadView l, float dt, int ox, int oy, int nx, int ny,
-                     uint32_t* passes) {
-  WB_DISPATCH(d, transfer_contact_paths(s, l, dt, ox, oy, nx, ny, passes));
-}
-void d_contact_share(const Device& d, SampleView s, BristleLoadView l, float dt, int ox, int oy, int nx, int ny,
-                     const uint32_t* passes, float split) {
-  WB_DISPATCH(d, transfer_contact_share(s, l, dt, ox, oy, nx, ny, passes, split));
-}
-void d_absorb_apply(const Device& d, BristleLoadView l, AbsorbScratch a) { WB_DISPATCH(d, transfer_absorb_apply(l, a)); }
-void d_occupancy(const Device& d, SampleView s, DistanceBlocks db, int32_t* occ, int ox, int oy, int oz) {
-  WB_DISPATCH(d, transfer_distance_occupancy(s, db, occ, ox, oy, oz));
-}
-void d_distance_init(const Device& d, const int32_t* occ, float* d2, int64_t n) {
-  WB_DISPATCH(d, transfer_distance_init(occ, d2, n));
-}
-void d_distance_pass(const Device& d, DistanceBlocks db, int axis, const float* src, float* dst, int32_t* v, float* z) {
-  WB_DISPATCH(d, transfer_distance_pass(db, axis, src, dst, v, z));
-}
-void d_to_grid_mark(const Device& d, ParticleView p, PaintWindowView pw, DistanceBlocks db, DepositScratch acc,
-                    TransferParams prm, float dry) {
-  WB_DISPATCH(d, transfer_to_grid_mark(p, pw, db, acc, prm, dry));
-}
-void d_to_grid_apply(const Device& d, PaintWindowView pw, DepositScratch acc) {
-  WB_DISPATCH(d, transfer_to_grid_apply(pw, acc));
-}
-void d_emit_count(const Device& d, SampleView s, BristleLoadView l, TransferParams prm, float dt, uint32_t* count,
-                  float* mass_each, float* swept_each, uint32_t* swept_n) {
-  WB_DISPATCH(d, transfer_emit_count(s, l, prm, dt, count, mass_each, swept_each, swept_n));
-}
-void d_emit_fill(const Device& d, SampleView s, BristleLoadView l, ParticleView p, NewBatch b, const float* mass_each,
-                 const float* swept_each, const uint32_t* swept_n, int64_t step_index, TransferParams prm,
-                 float floor_z, float dt, PaintWindowView pw, float dry_threshold, float* emitted) {
-  WB_DISPATCH(d, transfer_emit_fill(s, l, p, b, mass_each, swept_each, swept_n, step_index, prm, floor_z, dt, pw,
-                                    dry_threshold, emitted));
-}
-void d_grid_count(const Device& d, PaintWindowView pw, DistanceBlocks db, KeepBox keep, TransferParams prm, float dry,
-                  uint32_t* count) {
-  WB_DISPATCH(d, transfer_grid_count(pw, db, keep, prm, dry, count));
-}
-void d_grid_emit(const Device& d, PaintWindowView pw, MacView vel, ParticleView p, NewBatch b, TransferParams prm,
-                 float dry, float* demand) {
-  WB_DISPATCH(d, transfer_grid_emit(pw, vel, p, b, prm, dry, demand));
-}
-void d_room_ends(const Device& d, const uint32_t* count, const uint32_t* offset, int64_t n, int64_t a, int64_t b,
-                 uint32_t* ends) {
-  WB_DISPATCH(d, transfer_room_ends(count, offset, n, a, b, ends));
-}
-void d_grid_clamp(const Device& d, PaintWindowView pw, float* demand_ratio, float* removed) {
-  WB_DISPATCH(d, transfer_grid_clamp(pw, demand_ratio, removed));
-}
-void d_grid_finish(const Device& d, ParticleView p, int64_t first, int64_t n, PaintWindowView pw, const float* ratio,
-                   TransferParams prm, float dry) {
-  WB_DISPATCH(d, transfer_grid_finish(p, first, n, pw, ratio, prm, dry));
-}
+namespace {
 
 void validate(const TransferParams& p) {
   auto in = [](float v, float lo, float hi) { return std::isfinite(v) && v >= lo && v <= hi; };
@@ -149,15 +87,6 @@ double TransferRecord::max_closure_error() const {
                    rel_gap(emitted_from_bristles, emitted_into_particles),
                    rel_gap(to_particles_from_grid, to_particles_into_particles),
                    rel_gap(to_grid_from_particles, to_grid_into_grid)});
-}
-
-void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadView& load, const CellField& psi,
-                       const CellField& density, const CellField& dryness, const TransferParams& prm,
-                       float floor_z, float dry_threshold, float dt) {
-  WB_REQUIRE(s.count() == load.count, "transfer_capacity: " + std::to_string(s.count()) + " samples but a load of " +
-                                          std::to_string(load.count));
-  validate(prm);
-  WB_DISPATCH(d, transfer_capacity(s, load, psi, density, dryness, prm, floor_z, dry_threshold, dt));
 }
 
 Transfer::Transfer(const Device& device, const TransferParams& params)
@@ -251,6 +180,8 @@ void Transfer::add_sums(const TransferSums& s, double cm, TransferRecord& rec) {
 void Transfer::update_capacity(const SampleView& samples, BristleLoad& load, const TransferEnv& env) {
   validate(env);
   WB_REQUIRE(load.device() == device_, "Transfer: the bristle load lives on another device");
+  WB_REQUIRE(samples.count() == load.size(),
+             "Transfer: " + std::to_string(samples.count()) + " samples but a load of " + std::to_string(load.size()));
   const PaintWindowView& pw = env.paint;
   const CellField psi{env.psi, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
   const CellField density{pw.density, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
@@ -265,8 +196,8 @@ void Transfer::share_contact(const SampleView& samples, BristleLoad& load, const
   passes_.resize(size_t(pw.nx) * size_t(pw.ny));
   passes_.fill_zero();
   const BristleLoadView lv = load.view();
-  d_contact_paths(device_, samples, lv, env.dt, pw.ox, pw.oy, pw.nx, pw.ny, passes_.data());
-  d_contact_share(device_, samples, lv, env.dt, pw.ox, pw.oy, pw.nx, pw.ny, passes_.data(), params_.split);
+  transfer_contact_paths(device_, samples, lv, env.dt, pw.ox, pw.oy, pw.nx, pw.ny, passes_.data());
+  transfer_contact_share(device_, samples, lv, env.dt, pw.ox, pw.oy, pw.nx, pw.ny, passes_.data(), params_.split);
 }
 
 void Transfer::wick(const SampleView& samples, BristleLoad& load, float dt) {
@@ -291,8 +222,9 @@ void Transfer::wick(const SampleView& samples, BristleLoad& load, float dt) {
                                    launch_key_of(lv.capacity), launch_key_of(w.a[0]), uint64_t(samples.bristles),
                                    uint64_t(samples.per_bristle), launch_key_of(k_dt), launch_key_of(k_slide),
                                    launch_key_of(dt)});
-  wick_graph_.run(device_, key,
-                  [&] { d_wick(device_, samples, lv, samples.bristles, samples.per_bristle, k_dt, k_slide, dt, w); });
+  wick_graph_.run(device_, key, [&] {
+    transfer_wick(device_, samples, lv, samples.bristles, samples.per_bristle, k_dt, k_slide, dt, w);
+  });
 }
 
 void Transfer::absorb(const SampleView& samples, BristleLoad& load, ParticleStore& particles, float dt) {
@@ -320,8 +252,8 @@ void Transfer::absorb(const SampleView& samples, BristleLoad& load, ParticleStor
   a.counters = sums_ptr_->absorb_counts;  // address only: the counts accumulate in the record
   const BristleLoadView lv = load.view();
   if (np > 0 && ns > 0) {
-    d_absorb(device_, particles.view(), samples, lv, a, params_, dt, step_index_);
-    d_absorb_apply(device_, lv, a);
+    transfer_absorb(device_, particles.view(), samples, lv, a, params_, dt, step_index_);
+    transfer_absorb_apply(device_, lv, a);
   }
   reduce_sum_add_into(device_, p_moved_.data(), np, sum_field(&TransferSums::absorbed_from_particles), ws_);
   reduce_sum_add_into(device_, a.acc_m, ns, sum_field(&TransferSums::absorbed_into_bristles), ws_);
@@ -349,12 +281,12 @@ void Transfer::update_distance(const SampleView& samples, const TransferEnv& env
   edt_z_.resize(size_t(2 * total));
   occ_.fill_zero();
   db.d2 = d2_.data();
-  d_occupancy(device_, samples, db, occ_.data(), pw.ox, pw.oy, pw.oz);
-  d_distance_init(device_, occ_.data(), d2_.data(), total);
+  transfer_distance_occupancy(device_, samples, db, occ_.data(), pw.ox, pw.oy, pw.oz);
+  transfer_distance_init(device_, occ_.data(), d2_.data(), total);
   // Separable exact squared distance transform: x (d2 -> tmp), y (tmp -> d2), z (d2 -> tmp).
-  d_distance_pass(device_, db, 0, d2_.data(), d2_tmp_.data(), edt_v_.data(), edt_z_.data());
-  d_distance_pass(device_, db, 1, d2_tmp_.data(), d2_.data(), edt_v_.data(), edt_z_.data());
-  d_distance_pass(device_, db, 2, d2_.data(), d2_tmp_.data(), edt_v_.data(), edt_z_.data());
+  transfer_distance_pass(device_, db, 0, d2_.data(), d2_tmp_.data(), edt_v_.data(), edt_z_.data());
+  transfer_distance_pass(device_, db, 1, d2_tmp_.data(), d2_.data(), edt_v_.data(), edt_z_.data());
+  transfer_distance_pass(device_, db, 2, d2_.data(), d2_tmp_.data(), edt_v_.data(), edt_z_.data());
   d2_.swap(d2_tmp_);
   db.d2 = d2_.data();
   blocks_ = db;
@@ -395,8 +327,8 @@ void Transfer::particles_to_grid(ParticleStore& particles, const TransferEnv& en
   acc.only_leaving = env.only_leaving;
   acc.surface = env.surface;
   if (np > 0) {
-    d_to_grid_mark(device_, particles.view(), env.paint, db, acc, params_, env.dry_threshold);
-    d_to_grid_apply(device_, env.paint, acc);
+    transfer_to_grid_mark(device_, particles.view(), env.paint, db, acc, params_, env.dry_threshold);
+    transfer_to_grid_apply(device_, env.paint, acc);
   }
   reduce_sum_add_into(device_, p_moved_.data(), np, sum_field(&TransferSums::to_grid_from_particles), ws_);
   // Density units here; collect() turns them into kg.
@@ -439,14 +371,15 @@ void Transfer::make_particles(const SampleView* samples, BristleLoad* load, Part
     if (ns > 0) {
       ensure_samples(ns);
       const EmitScratch e = emit_scratch();
-      d_emit_count(device_, *samples, load->view(), params_, env.dt, count + nk, e.mass_each, e.swept_each, e.swept_n);
+      transfer_emit_count(device_, *samples, load->view(), params_, env.dt, count + nk, e.mass_each, e.swept_each,
+                          e.swept_n);
     }
     if (nc > 0) {
       ensure_cells(nc);
-      d_grid_count(device_, env.paint, db, env.keep, params_, env.dry_threshold, count + nk + ns);
+      transfer_grid_count(device_, env.paint, db, env.keep, params_, env.dry_threshold, count + nk + ns);
     }
     exclusive_scan_into(device_, count, offset, n, ws_);
-    d_room_ends(device_, count, offset, n, nk, nk + ns, room_ends_.data());
+    transfer_room_ends(device_, count, offset, n, nk, nk + ns, room_ends_.data());
     uint32_t ends[3];
     room_ends_.copy_to_host(ends, 3);  // the step's one wait of the transfer
     const int64_t kept = compact ? int64_t(ends[0]) : particles.size();
@@ -480,8 +413,8 @@ void Transfer::fill_emission(const SampleView& samples, BristleLoad& load, Parti
   const ParticleView pv = particles.view();
   const EmitScratch e = emit_scratch();
   float* emitted = e.emitted;
-  d_emit_fill(device_, samples, load.view(), pv, batch, e.mass_each, e.swept_each, e.swept_n, step_index_, params_,
-              env.floor_z, env.dt, env.paint, env.dry_threshold, emitted);
+  transfer_emit_fill(device_, samples, load.view(), pv, batch, e.mass_each, e.swept_each, e.swept_n, step_index_,
+                     params_, env.floor_z, env.dt, env.paint, env.dry_threshold, emitted);
   reduce_sum_add_into(device_, emitted, ns, sum_field(&TransferSums::emitted_from_bristles), ws_);
   reduce_sum_add_into(device_, pv.m + batch.first, batch.n, sum_field(&TransferSums::emitted_into_particles), ws_);
 }
@@ -492,9 +425,9 @@ void Transfer::fill_candidates(ParticleStore& particles, const TransferEnv& env,
   float* demand = c_f32_[0].data();
   float* removed = c_f32_[1].data();
   c_f32_[0].fill_zero();
-  d_grid_emit(device_, env.paint, env.velocity, pv, batch, params_, env.dry_threshold, demand);
-  d_grid_clamp(device_, env.paint, demand, removed);
-  d_grid_finish(device_, pv, batch.first, batch.n, env.paint, demand, params_, env.dry_threshold);
+  transfer_grid_emit(device_, env.paint, env.velocity, pv, batch, params_, env.dry_threshold, demand);
+  transfer_grid_clamp(device_, env.paint, demand, removed);
+  transfer_grid_finish(device_, pv, batch.first, batch.n, env.paint, demand, params_, env.dry_threshold);
   // Density units here; collect() turns them into kg.
   reduce_sum_add_into(device_, removed, nc, sum_field(&TransferSums::to_particles_from_grid), ws_);
   reduce_sum_add_into(device_, pv.m + batch.first, batch.n, sum_field(&TransferSums::to_particles_into_particles), ws_);

@@ -12,6 +12,7 @@
 #include "core/canvas/window.h"
 #include "core/exec/buffer.h"
 #include "core/exec/device.h"
+#include "core/exec/dispatch.h"
 #include "core/exec/graph.h"
 #include "core/exec/hd.h"
 #include "core/exec/workspace.h"
@@ -263,56 +264,50 @@ class Transfer {
   }
 };
 
-/// Validates and runs Eq. 12-13 for every sample (the dispatcher behind Transfer::update_capacity).
-void transfer_capacity(const Device& d, const SampleView& s, const BristleLoadView& load, const CellField& psi,
-                       const CellField& density, const CellField& dryness, const TransferParams& prm,
-                       float floor_z, float dry_threshold, float dt);
-
-#define WB_TRANSFER_BACKEND_DECLS                                                                                  \
-  void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellField density, CellField dryness,  \
-                         TransferParams prm, float floor_z, float dry_threshold, float dt);                       \
-  void transfer_contact_paths(SampleView s, BristleLoadView load, float dt, int ox, int oy, int nx, int ny,       \
-                              uint32_t* passes);                                                                  \
-  void transfer_contact_share(SampleView s, BristleLoadView load, float dt, int ox, int oy, int nx, int ny,       \
-                              const uint32_t* passes, float split);                                               \
-  void transfer_absorb(ParticleView p, SampleView s, BristleLoadView load, AbsorbScratch a, TransferParams prm,  \
-                       float dt, int64_t step_index);                                                              \
-  void transfer_absorb_apply(BristleLoadView load, AbsorbScratch a);                                               \
-  void transfer_wick(SampleView s, BristleLoadView load, int bristles, int per, float k_dt, float k_slide, float dt, \
-                     WickScratch w);                                                                                 \
-  void transfer_distance_occupancy(SampleView s, DistanceBlocks db, int32_t* occ, int ox, int oy, int oz);         \
-  void transfer_distance_init(const int32_t* occ, float* d2, int64_t n);                                           \
-  void transfer_distance_pass(DistanceBlocks db, int axis, const float* src, float* dst, int32_t* v, float* z);    \
-  void transfer_to_grid_mark(ParticleView p, PaintWindowView pw, DistanceBlocks db, DepositScratch acc,            \
-                             TransferParams prm, float dry_threshold);                                              \
-  void transfer_to_grid_apply(PaintWindowView pw, DepositScratch acc);                                             \
-  void transfer_emit_count(SampleView s, BristleLoadView load, TransferParams prm, float dt, uint32_t* count,       \
-                           float* mass_each, float* swept_each, uint32_t* swept_n);                                \
-  void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, NewBatch batch,                     \
-                          const float* mass_each, const float* swept_each, const uint32_t* swept_n,                \
-                          int64_t step_index, TransferParams prm, float floor_z, float dt, PaintWindowView pw,     \
-                          float dry_threshold, float* emitted);                                                    \
-  void transfer_grid_count(PaintWindowView pw, DistanceBlocks db, KeepBox keep, TransferParams prm,                \
-                           float dry_threshold, uint32_t* count);                                                                        \
-  void transfer_grid_emit(PaintWindowView pw, MacView vel, ParticleView p, NewBatch batch, TransferParams prm,     \
-                          float dry_threshold, float* demand);                                                      \
-  void transfer_room_ends(const uint32_t* count, const uint32_t* offset, int64_t n, int64_t a, int64_t b,          \
-                          uint32_t* ends);                                                                         \
-  void transfer_grid_clamp(PaintWindowView pw, float* demand_ratio, float* removed);                               \
-  void transfer_grid_finish(ParticleView p, int64_t first, int64_t n, PaintWindowView pw, const float* ratio,       \
-                            TransferParams prm, float dry_threshold);                                               \
-  void transfer_product(const float* a, const float* b, float* out, int64_t n);                                   \
-  void transfer_load_brightness(BristleLoadView load, float* out);                                                 \
-  void transfer_load_dip(BristleLoadView load, const float* exchange, Vec3 ryb, float oil, float level, int replace, \
-                         float* added);                                                                        \
-  void transfer_load_scale(BristleLoadView load, float keep, float* removed);
-
-namespace cpu {
-WB_TRANSFER_BACKEND_DECLS
-}  // namespace cpu
-namespace cuda {
-WB_TRANSFER_BACKEND_DECLS
-}  // namespace cuda
-#undef WB_TRANSFER_BACKEND_DECLS
+// The transfer stage's backend drivers (transfer_impl.h), one list (core/exec/dispatch.h).
+#define WB_TRANSFER_KERNELS(X)                                                                                       \
+  X(void, transfer_capacity, (SampleView s, BristleLoadView load, CellField psi, CellField density,                  \
+      CellField dryness, TransferParams prm, float floor_z, float dry_threshold, float dt),                          \
+      (s, load, psi, density, dryness, prm, floor_z, dry_threshold, dt))                                             \
+  X(void, transfer_contact_paths, (SampleView s, BristleLoadView load, float dt, int ox, int oy, int nx, int ny,     \
+      uint32_t* passes), (s, load, dt, ox, oy, nx, ny, passes))                                                      \
+  X(void, transfer_contact_share, (SampleView s, BristleLoadView load, float dt, int ox, int oy, int nx, int ny,     \
+      const uint32_t* passes, float split), (s, load, dt, ox, oy, nx, ny, passes, split))                            \
+  X(void, transfer_absorb, (ParticleView p, SampleView s, BristleLoadView load, AbsorbScratch a, TransferParams prm, \
+      float dt, int64_t step_index), (p, s, load, a, prm, dt, step_index))                                           \
+  X(void, transfer_absorb_apply, (BristleLoadView load, AbsorbScratch a), (load, a))                                 \
+  X(void, transfer_wick, (SampleView s, BristleLoadView load, int bristles, int per, float k_dt, float k_slide,      \
+      float dt, WickScratch w), (s, load, bristles, per, k_dt, k_slide, dt, w))                                      \
+  X(void, transfer_distance_occupancy, (SampleView s, DistanceBlocks db, int32_t* occ, int ox, int oy, int oz),      \
+      (s, db, occ, ox, oy, oz))                                                                                      \
+  X(void, transfer_distance_init, (const int32_t* occ, float* d2, int64_t n), (occ, d2, n))                          \
+  X(void, transfer_distance_pass, (DistanceBlocks db, int axis, const float* src, float* dst, int32_t* v, float* z), \
+      (db, axis, src, dst, v, z))                                                                                    \
+  X(void, transfer_to_grid_mark, (ParticleView p, PaintWindowView pw, DistanceBlocks db, DepositScratch acc,         \
+      TransferParams prm, float dry_threshold), (p, pw, db, acc, prm, dry_threshold))                                \
+  X(void, transfer_to_grid_apply, (PaintWindowView pw, DepositScratch acc), (pw, acc))                               \
+  X(void, transfer_emit_count, (SampleView s, BristleLoadView load, TransferParams prm, float dt, uint32_t* count,   \
+      float* mass_each, float* swept_each, uint32_t* swept_n),                                                       \
+      (s, load, prm, dt, count, mass_each, swept_each, swept_n))                                                     \
+  X(void, transfer_emit_fill, (SampleView s, BristleLoadView load, ParticleView p, NewBatch batch,                   \
+      const float* mass_each, const float* swept_each, const uint32_t* swept_n, int64_t step_index,                  \
+      TransferParams prm, float floor_z, float dt, PaintWindowView pw, float dry_threshold, float* emitted),         \
+      (s, load, p, batch, mass_each, swept_each, swept_n, step_index, prm, floor_z, dt, pw, dry_threshold, emitted)) \
+  X(void, transfer_grid_count, (PaintWindowView pw, DistanceBlocks db, KeepBox keep, TransferParams prm,             \
+      float dry_threshold, uint32_t* count), (pw, db, keep, prm, dry_threshold, count))                              \
+  X(void, transfer_grid_emit, (PaintWindowView pw, MacView vel, ParticleView p, NewBatch batch, TransferParams prm,  \
+      float dry_threshold, float* demand), (pw, vel, p, batch, prm, dry_threshold, demand))                          \
+  X(void, transfer_room_ends, (const uint32_t* count, const uint32_t* offset, int64_t n, int64_t a, int64_t b,       \
+      uint32_t* ends), (count, offset, n, a, b, ends))                                                               \
+  X(void, transfer_grid_clamp, (PaintWindowView pw, float* demand_ratio, float* removed),                            \
+      (pw, demand_ratio, removed))                                                                                   \
+  X(void, transfer_grid_finish, (ParticleView p, int64_t first, int64_t n, PaintWindowView pw, const float* ratio,   \
+      TransferParams prm, float dry_threshold), (p, first, n, pw, ratio, prm, dry_threshold))                        \
+  X(void, transfer_product, (const float* a, const float* b, float* out, int64_t n), (a, b, out, n))                 \
+  X(void, transfer_load_brightness, (BristleLoadView load, float* out), (load, out))                                 \
+  X(void, transfer_load_dip, (BristleLoadView load, const float* exchange, Vec3 ryb, float oil, float level,         \
+      int replace, float* added), (load, exchange, ryb, oil, level, replace, added))                                 \
+  X(void, transfer_load_scale, (BristleLoadView load, float keep, float* removed), (load, keep, removed))
+WB_DECLARE_KERNELS(WB_TRANSFER_KERNELS)
 
 }  // namespace wb
