@@ -316,35 +316,42 @@ TEST_F(FilmTest, ThickRidgeKeepsItsThresholdSurface) {
     }
 }
 
-TEST_F(FilmTest, WetCoatOnDriedPaintShowsItsColourAndThickness) {
-  // A dried blue layer 2 cells thick; over its middle a wet coat of the film test's red, 0.1, 0.2
-  // or 0.4 cells of paint in the cell above (as the grid holds wet paint on dried paint). The coat
-  // is what the top view shows there, and the surface rises by its paint; the dried layer beside
-  // it keeps its own surface and colour.
+TEST_F(FilmTest, CoatOnDriedPaintShowsItsColourAndThicknessWetOrDried) {
+  // A dried blue layer 2 cells thick; over its middle a coat of the film test's red, 0.1, 0.2 or
+  // 0.4 cells of paint in the cell above (as the grid holds paint laid on dried paint), wet, half
+  // dry or dried. The coat is what the top view shows there, and the surface rises by its paint;
+  // the dried layer beside it keeps its own surface and colour.
   const Vec3 blue(0.1f, 0.15f, 0.85f);
   Renderer r(device_);
-  for (float coat : {0.1f, 0.2f, 0.4f}) {
-    TileStore c(device_, CanvasDims{kN, kN, 16});
-    fill_volume(c, kLo, kLo, kHi, kHi, [&](int x, int y, int z) {
-      PaintCell p = layer(2.f, z, blue, 0.1f);
-      p.dryness = p.density > 0.f ? 1.f : 0.f;
-      if (z == 2 && x >= kIn0 && x < kIn1 && y >= kIn0 && y < kIn1) p = layer(2.f + coat, z, kPigment, 0.1f);
-      return p;
-    });
-    const FloatImage h = r.render_height_map(c);
-    const FloatImage a = r.render_albedo(c);
-    const Vec3 red = ryb_to_rgb(kPigment), dried = ryb_to_rgb(blue);
-    const int m = (kIn0 + kIn1) / 2, o = (kLo + kIn0) / 2;
-    std::printf("coat %.1f: height %.3f (dried beside it %.3f); albedo %.2f %.2f %.2f (its paint %.2f %.2f %.2f)\n", coat,
-                h.at(m, m), h.at(o, o), a.at(m, m, 0), a.at(m, m, 1), a.at(m, m, 2), red.x, red.y, red.z);
-    EXPECT_NEAR(h.at(m, m), 2.f + coat, 0.05f) << "the coat stands on the dried paint";
-    EXPECT_NEAR(h.at(o, o), 2.f, 0.05f) << "the dried paint beside it keeps its surface";
-    // The coat hides the dried paint as a film of its thickness hides the canvas.
-    const Vec3 seen = lerp(dried, red, film_cover(r.params(), coat));
-    EXPECT_LT(maxdiff(rgb_at(a, m, m), seen), 0.03f) << "the top view shows the coat over the dried paint";
-    EXPECT_GT(coverage(rgb_at(a, m, m), dried, red), 0.8f) << "a coat a tenth of a cell thick already hides most of it";
-    EXPECT_LT(maxdiff(rgb_at(a, o, o), dried), 0.03f) << "and the dried paint's beside it";
-  }
+  for (float coat_dryness : {0.f, 0.5f, 1.f})
+    for (float coat : {0.1f, 0.2f, 0.4f}) {
+      TileStore c(device_, CanvasDims{kN, kN, 16});
+      fill_volume(c, kLo, kLo, kHi, kHi, [&](int x, int y, int z) {
+        PaintCell p = layer(2.f, z, blue, 0.1f);
+        p.dryness = p.density > 0.f ? 1.f : 0.f;
+        if (z == 2 && x >= kIn0 && x < kIn1 && y >= kIn0 && y < kIn1) {
+          p = layer(2.f + coat, z, kPigment, 0.1f);
+          p.dryness = coat_dryness;
+        }
+        return p;
+      });
+      const FloatImage h = r.render_height_map(c);
+      const FloatImage a = r.render_albedo(c);
+      const Vec3 red = ryb_to_rgb(kPigment), dried = ryb_to_rgb(blue);
+      const int m = (kIn0 + kIn1) / 2, o = (kLo + kIn0) / 2;
+      std::printf(
+          "coat %.1f, dryness %.1f: height %.3f (dried beside it %.3f); albedo %.2f %.2f %.2f (its paint %.2f %.2f "
+          "%.2f)\n",
+          coat, coat_dryness, h.at(m, m), h.at(o, o), a.at(m, m, 0), a.at(m, m, 1), a.at(m, m, 2), red.x, red.y, red.z);
+      EXPECT_NEAR(h.at(m, m), 2.f + coat, 0.05f) << "the coat stands on the dried paint";
+      EXPECT_NEAR(h.at(o, o), 2.f, 0.05f) << "the dried paint beside it keeps its surface";
+      // The coat hides the dried paint as a film of its thickness hides the canvas.
+      const Vec3 seen = lerp(dried, red, film_cover(r.params(), coat));
+      EXPECT_LT(maxdiff(rgb_at(a, m, m), seen), 0.03f) << "the top view shows the coat over the dried paint";
+      EXPECT_GT(coverage(rgb_at(a, m, m), dried, red), 0.8f)
+          << "a coat a tenth of a cell thick already hides most of it";
+      EXPECT_LT(maxdiff(rgb_at(a, o, o), dried), 0.03f) << "and the dried paint's beside it";
+    }
 }
 
 TEST_F(FilmTest, IncrementalCacheMatchesFullRenderOverFilms) {

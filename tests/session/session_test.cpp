@@ -1,12 +1,14 @@
 // wb::Session, the layer the CLI, the studio and Python paint through: a stroke is one undo unit,
 // a saved painting opens again as it was, and what does not fit the session is refused.
+#include "core/session/session.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include "core/exec/error.h"
-#include "core/session/session.h"
 #include "sim/sim_fixture.h"
 
 namespace wb::test {
@@ -98,6 +100,37 @@ TEST_F(SessionTest, ASavedPaintingOpensWithItsBrushPaperAndPaint) {
   ASSERT_TRUE(at.has_value());
   EXPECT_GT(at->z, 0.8f) << "the dab's blue";
   EXPECT_FALSE(o->pick(200, 200).has_value()) << "bare canvas";
+}
+
+TEST_F(SessionTest, ThinPaintOnAWovenGroundLooksTheSameWhenItHasDried) {
+  // A glaze (0.3 cells) and a thicker dab (0.8 cells) on a primed linen ground, then the canvas
+  // dries: the paint's colour and relief are what they were wet (the dried glaze once rendered as
+  // the bare primer, its cells being paint above dried paint that was no wetter than it).
+  Session s(small_config());
+  s.lay_ground(CanvasGround::of(Weave::Linen));
+  PaintLoad blue = red();
+  blue.ryb[0] = 0.f, blue.ryb[1] = 0.1f, blue.ryb[2] = 0.9f;
+  s.put_paint(50.f, 60.f, 14.f, 0.3f, blue);
+  s.put_paint(100.f, 60.f, 14.f, 0.8f, blue);
+  const FloatImage a0 = s.albedo(), h0 = s.height_map();
+  StrokeEvent dry;
+  dry.kind = StrokeEventKind::Dry;
+  s.apply(dry);
+  const FloatImage a1 = s.albedo(), h1 = s.height_map();
+  for (const int cx : {50, 100}) {
+    double wet = 0.0, dried = 0.0, dh = 0.0;
+    for (int y = 54; y < 66; ++y)
+      for (int x = cx - 6; x < cx + 6; ++x) {
+        wet += a0.at(x, y, 2) - a0.at(x, y, 0);  // blue over red: the glaze's colour against the primer's
+        dried += a1.at(x, y, 2) - a1.at(x, y, 0);
+        dh = std::max(dh, double(std::fabs(h1.at(x, y) - h0.at(x, y))));
+      }
+    wet /= 144.0, dried /= 144.0;
+    std::printf("dab at x %d: blue - red %.3f wet, %.3f dried; largest height change %.3f cells\n", cx, wet, dried, dh);
+    EXPECT_GT(wet, 0.15) << "the paint shows over the primer";
+    EXPECT_NEAR(dried, wet, 0.02) << "and still does when it has dried";
+    EXPECT_LT(dh, 0.05) << "its relief is the same dried";
+  }
 }
 
 TEST_F(SessionTest, APaintingsUnreadableRecordsCostThoseRecordsNotThePainting) {

@@ -48,7 +48,7 @@ void render_top_map(RenderVolume v, RenderParams P, int x0, int y0, int w, int h
     const float thin = column_thinness(P, dmax);
     // A thick column: its top thick cell (density at the threshold or more) and the paint above it.
     int kt = -1;
-    float above = 0.f, dt = 0.f, dry_above = 0.f, dry_top = 0.f;
+    float above = 0.f, dt = 0.f, dry_top = 0.f;
     if (sum > 0.f && !(thin > 0.f)) {
       for (int z = t - 1; z >= 0; --z) {
         const RenderCell c = tiles_only ? RenderCell{v.tiles.density[a0 + z * dz], 0.f, 0.f, 0.f, 0.f,
@@ -60,13 +60,13 @@ void render_top_map(RenderVolume v, RenderParams P, int x0, int y0, int w, int h
           dry_top = c.dryness;
           break;
         }
-        if (c.density > 0.f) above += c.density, dry_above += c.density * c.dryness;
+        if (c.density > 0.f) above += c.density;
       }
     }
-    // A coat is wet paint on dried (or drying) paint: a layer of its own, which the grid keeps in
-    // the cells above the dried ones. Paint above a wet top is that top's own surface, partly
-    // filled cells the threshold surface already passes through.
-    const bool coat = kt >= 0 && above > 0.f && dry_top - dry_above / above >= 0.5f;
+    // A coat is paint on dried paint: a layer of its own, which the grid keeps in the cells above
+    // the dried ones, wet or dried itself (a glaze stays a glaze as it dries). Paint above a wet
+    // top is that top's own surface, partly filled cells the threshold surface passes through.
+    const bool coat = kt >= 0 && above > 0.f && dry_top >= 0.5f;
     if (sum > 0.f && (thin > 0.f || coat)) {
       // The film's paint (a thin column: all of it) or the coat's (the cells above kt).
       const int z0 = coat ? kt + 1 : 0;
