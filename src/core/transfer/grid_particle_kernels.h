@@ -238,24 +238,30 @@ struct DistanceBlocks {
   int block;
   int margin;
   float D0;  ///< cells
+  /// The lattice's offset this step, cells in [0, block) on each axis: a low-discrepancy sequence
+  /// over the transfer's steps (Transfer::update_distance), so the blocks' error does not stand
+  /// still under a slow stroke (docs/TRANSFER.md "Ribs on slow strokes").
+  Vec3 shift;
   WB_HD int64_t index(int i, int j, int k) const { return (int64_t(k) * by + j) * bx + i; }
   /// Block of window position q (may fall outside: then -1).
   WB_HD int64_t block_of(Vec3 q) const {
-    const int i = int(floorf(q.x / float(block))) + margin, j = int(floorf(q.y / float(block))) + margin,
-              k = int(floorf(q.z / float(block))) + margin;
+    const float inv = 1.f / float(block);
+    const int i = int(floorf((q.x + shift.x) * inv)) + margin, j = int(floorf((q.y + shift.y) * inv)) + margin,
+              k = int(floorf((q.z + shift.z) * inv)) + margin;
     if (i < 0 || j < 0 || k < 0 || i >= bx || j >= by || k >= bz) return -1;
     return index(i, j, k);
   }
   /// Distance from window position q to the bristles, cells: the block centres' distances
   /// (exact between block centres, so within +-block*sqrt(3) of the true distance) interpolated
-  /// trilinearly, so the D0 front has no block's steps in space. It still steps a block in time
-  /// as samples enter the next block (the marking is per block): the ribs along slow strokes
-  /// (docs/TRANSFER.md "Ribs on slow strokes"). Huge outside the field or with no bristle in it.
+  /// trilinearly, so the D0 front has no block's steps in space. A block is marked or not, so the
+  /// front steps a block in time as samples enter the next block; the lattice's shift, another
+  /// each step, spreads those steps over the track instead of a block apart.
+  /// Huge outside the field or with no bristle in it.
   WB_HD float distance(Vec3 q) const {
     if (block_of(q) < 0) return 1e30f;
     const float inv = 1.f / float(block);
-    const float fx = q.x * inv - 0.5f + float(margin), fy = q.y * inv - 0.5f + float(margin),
-                fz = q.z * inv - 0.5f + float(margin);
+    const float fx = (q.x + shift.x) * inv - 0.5f + float(margin), fy = (q.y + shift.y) * inv - 0.5f + float(margin),
+                fz = (q.z + shift.z) * inv - 0.5f + float(margin);
     const int i0 = imin(imax(int(floorf(fx)), 0), bx - 2), j0 = imin(imax(int(floorf(fy)), 0), by - 2),
               k0 = imin(imax(int(floorf(fz)), 0), bz - 2);
     const float tx = fminf(fmaxf(fx - float(i0), 0.f), 1.f), ty = fminf(fmaxf(fy - float(j0), 0.f), 1.f),

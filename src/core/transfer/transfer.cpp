@@ -265,12 +265,22 @@ void Transfer::update_distance(const SampleView& samples, const TransferEnv& env
   const int B = params_.distance_block;
   const int margin = int(std::ceil(env.D0 / float(B))) + 1;
   DistanceBlocks db{};
-  db.bx = (pw.nx + B - 1) / B + 2 * margin;
-  db.by = (pw.ny + B - 1) / B + 2 * margin;
-  db.bz = (pw.nz + B - 1) / B + 2 * margin;
+  // One block more on each axis for the lattice's shift.
+  db.bx = (pw.nx + B - 1) / B + 1 + 2 * margin;
+  db.by = (pw.ny + B - 1) / B + 1 + 2 * margin;
+  db.bz = (pw.nz + B - 1) / B + 1 + 2 * margin;
   db.block = B;
   db.margin = margin;
   db.D0 = env.D0;
+  // The lattice's shift: the R3 low-discrepancy sequence (Roberts 2018; the plastic number's
+  // powers) over the steps, the same on every backend and for a replay of the same steps.
+  const double g = 1.2207440846057594, a[3] = {1.0 / g, 1.0 / (g * g), 1.0 / (g * g * g)};
+  float sh[3];
+  for (int c = 0; c < 3; ++c) {
+    const double u = 0.5 + double(step_index_) * a[c];
+    sh[c] = float((u - std::floor(u)) * double(B));
+  }
+  db.shift = Vec3(sh[0], sh[1], sh[2]);
   const int64_t total = int64_t(db.bx) * db.by * db.bz;
   WB_REQUIRE(total < (int64_t(1) << 28), "Transfer: the distance field would need " + std::to_string(total) +
                                              " blocks; raise distance_block or lower D0");
