@@ -202,8 +202,24 @@ def linen_dry_brush():
           s, events, canvas=canvas)
 
 
+def glaze_on_linen():
+    # A glaze on linen that dries: a lightly loaded brush of oily blue dragged lightly in a wave
+    # over the weave, then the canvas dries (docs/RENDERING.md "Coats": the dried glaze keeps its
+    # colour; it once rendered as the primer).
+    canvas = {"width": 320, "height": 160, "depth": 16, "paper_rgb": [0.93, 0.9, 0.82],
+              "ground": {"weave": "linen", "thread_mm": 1.0, "relief_mm": 0.3}}
+    s = stroke(0.0, lambda u: (60 + 200 * u, 80 + 10 * math.sin(2 * math.pi * u)), 0.8, 0.35, tilt=(15, 0))
+    events = [{"type": "dry", "t": s[-1]["t"]}]
+    write("glaze-on-linen.json",
+          "A glaze on linen that dries: oily blue at a quarter of the brush's capacity dragged lightly "
+          "over the weave, then the canvas dries; the dried glaze keeps its colour.",
+          {"shape": "round"}, {"ryb": [0.05, 0.15, 0.9], "oil": 0.6, "load": 0.25, "reload_on_pen_down": False},
+          s, events, canvas=canvas)
+
+
 if __name__ == "__main__":
     linen_dry_brush()
+    glaze_on_linen()
     flat_streaks()
     cross_wet()
     scumble()

@@ -18,8 +18,6 @@
 
 namespace wb {
 
-
-
 // The particle stage's backend drivers (particles_impl.h, where each is described), one list
 // (core/exec/dispatch.h).
 #define WB_PARTICLES_KERNELS(X)                                                                                   \
