@@ -318,11 +318,15 @@ PYBIND11_MODULE(wetbrush, m) {
             if (camera != "top" && camera != "oblique") throw Error("render: camera must be 'top' or 'oblique'");
             if (!(std::isfinite(zoom) && zoom > 0.f && zoom <= 16.f)) throw Error("render: zoom must be in (0, 16]");
             if (camera == "oblique") return image_array(s.render(Camera::oblique(s.dims(), 30.f, zoom)));
-            if (!region) return image_array(s.render(Camera::top_region(0.f, 0.f, float(s.dims().width), float(s.dims().height), zoom)));
+            const CanvasDims d = s.dims();
+            if (!region)
+              return image_array(s.render(Camera::top_region(0.f, 0.f, float(d.width), float(d.height), zoom)));
             const auto& r = *region;
             if (!(std::isfinite(r[0]) && std::isfinite(r[1]) && r[2] >= 1.f && r[3] >= 1.f && r[2] * zoom <= 16384.f &&
                   r[3] * zoom <= 16384.f))
-              throw Error("render: region is (x0, y0, width, height) in cells, at least a cell and at most 16384 pixels a side");
+              throw Error(
+                  "render: region is (x0, y0, width, height) in cells, at least a cell and at most 16384 pixels a "
+                  "side");
             return image_array(s.render(Camera::top_region(r[0], r[1], r[2], r[3], zoom)));
           },
           py::arg("camera") = "top", py::arg("region") = py::none(), py::arg("zoom") = 1.f,

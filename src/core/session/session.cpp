@@ -113,12 +113,16 @@ std::unique_ptr<Session> Session::open(const std::string& path, const SimConfig&
   }
   if (m.contains("paper_rgb")) {
     const nlohmann::json& p = m["paper_rgb"];
-    const auto unit = [](const nlohmann::json& v) { return v.is_number() && v.get<double>() >= 0.0 && v.get<double>() <= 1.0; };
+    const auto unit = [](const nlohmann::json& v) {
+      return v.is_number() && v.get<double>() >= 0.0 && v.get<double>() <= 1.0;
+    };
     if (p.is_array() && p.size() == 3 && std::all_of(p.begin(), p.end(), unit))
       cfg.params.render.paper_rgb = Vec3(p[0].get<float>(), p[1].get<float>(), p[2].get<float>());
     else
-      std::fprintf(stderr, "wetbrush: warning: %s: metadata.paper_rgb is not three numbers in [0, 1] (the painting "
-                   "opens with the default paper)\n", path.c_str());
+      std::fprintf(stderr,
+                   "wetbrush: warning: %s: metadata.paper_rgb is not three numbers in [0, 1] (the painting "
+                   "opens with the default paper)\n",
+                   path.c_str());
   }
   auto s = std::make_unique<Session>(cfg, options.undo_levels);
   if (m.contains("ground") && m["ground"].is_object()) {
