@@ -380,6 +380,7 @@ int run_replay(const ReplayArgs& a) {
         {"step_median", prof.median_ms("sim.step")}};
     j["nonfinite_events"] = nonfinite;
     j["zone_cut_steps"] = sim.counters().zone_cut_steps;
+    j["box_reads"] = sim.counters().box_reads;
     j["split_steps"] = sim.counters().split_steps;
     j["step_parts"] = sim.counters().step_parts;
     j["warnings"] = stroke.warnings;

@@ -48,18 +48,27 @@ void tiles_gather_window(TileStoreView t, PaintWindowView w) {
   });
 }
 
-void tiles_settle_drying(TileStoreView t, const int32_t* slots, int64_t count) {
-  const int64_t n = t.tile_cells();
-  parallel_for(count * n, [=] WB_HD(int64_t i) {
-    const int32_t slot = slots[i / n];
-    const int64_t at = int64_t(slot) * n + i % n;
-    t.dryness[at] = encode_unorm16(t.dryness_at(slot, at));
+void tiles_settle_window(TileStoreView t, int tx0, int ty0, int ntx, int nty) {
+  // A layer of a tile a thread: a tile up to date (every tile, once the first layer set it, at a
+  // step's scatter where nothing dried) costs a read.
+  const int64_t layer = int64_t(kTileSize) * kTileSize, layers = int64_t(ntx) * nty * t.depth;
+  parallel_for(layers, [=] WB_HD(int64_t k) {
+    const int64_t f = k / t.depth;
+    const int tile = (ty0 + int(f / ntx)) * t.tiles_x + tx0 + int(f % ntx);
+    const int32_t slot = t.slot_of_tile[tile];
+    if (slot < 0 || !(t.clock - t.dried_to[slot] > 0.f)) return;
+    const int64_t at0 = int64_t(slot) * t.tile_cells() + (k % t.depth) * layer;
+    for (int64_t at = at0; at < at0 + layer; ++at) t.dryness[at] = encode_unorm16(t.dryness_at(slot, at));
   });
-  // Then each slot is up to date (after every cell has read its old clock).
-  parallel_for(count, [=] WB_HD(int64_t k) { t.dried_to[slots[k]] = t.clock; });
+  // Then each tile is up to date (after every cell has read its old clock).
+  parallel_for(int64_t(ntx) * nty, [=] WB_HD(int64_t f) {
+    const int32_t slot = t.slot_of_tile[(ty0 + int(f / ntx)) * t.tiles_x + tx0 + int(f % ntx)];
+    if (slot >= 0) t.dried_to[slot] = t.clock;
+  });
 }
 
-void tiles_mark_painted(TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* flags) {
+void tiles_allocate_painted(TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int nty, int32_t* flags,
+                            TileSlots slots) {
   parallel_for(w.size(), [=] WB_HD(int64_t i) {
     if (w.density[i] == 0.f) return;
     int x, y, z;
@@ -68,6 +77,16 @@ void tiles_mark_painted(TileStoreView t, PaintWindowView w, int tx0, int ty0, in
     if (!t.inside(cx, cy, cz)) return;
     const int f = (cy / kTileSize - ty0) * ntx + (cx / kTileSize - tx0);
     if (flags[f] == 0) atomic_or(&flags[f], 1);
+  });
+  // A painted tile without a slot takes the next: the pool holds them (TileStore::scatter sizes
+  // it for every tile of the window), and its slot is empty and up to date with the clock.
+  parallel_for(int64_t(ntx) * nty, [=] WB_HD(int64_t f) {
+    const int tile = (ty0 + int(f / ntx)) * t.tiles_x + tx0 + int(f % ntx);
+    if (!flags[f] || slots.slot_of_tile[tile] >= 0) return;
+    const int32_t s = atomic_add(slots.used, int32_t(1));
+    slots.slot_of_tile[tile] = s;
+    slots.tile_of_slot[s] = tile;
+    t.dried_to[s] = t.clock;
   });
 }
 

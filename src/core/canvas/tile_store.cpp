@@ -22,7 +22,9 @@ TileStore::TileStore(const Device& device, CanvasDims dims) : device_(device), d
   density_.set_device(device);
   tile_flags_.set_device(device);
   dried_to_.set_device(device);
-  settle_slots_.set_device(device);
+  tile_of_slot_dev_.set_device(device);
+  slots_used_dev_ = DeviceBuffer<int32_t>(device, 1);
+  slots_used_dev_.fill_zero();
   ws_ = Workspace(device);
   mass_before_.set_device(device);
   mass_after_.set_device(device);
@@ -75,6 +77,7 @@ void TileStore::grow_pool(int32_t slots) {
   density_.grow_keep(cells);
   for (auto* b : {&pigment_r_, &pigment_y_, &pigment_b_, &oil_, &dryness_}) b->grow_keep(cells);
   dried_to_.grow_keep(size_t(cap));
+  tile_of_slot_dev_.grow_keep(size_t(cap));
   // New slots start empty.
   mem::fill_zero(device_, density_.data() + used, (cells - used) * sizeof(float));
   for (auto* b : {&pigment_r_, &pigment_y_, &pigment_b_, &oil_, &dryness_})
@@ -82,13 +85,42 @@ void TileStore::grow_pool(int32_t slots) {
   slot_capacity_ = cap;
 }
 
+int TileStore::allocated_tiles() const {
+  sync_host();
+  return slots_used_;
+}
+
+void TileStore::take_tiles_used(int32_t used) { bound_ = used; }
+
+void TileStore::sync_host() const {
+  if (!host_stale_) return;
+  // The device's scatters allocated tiles and brought the window's tiles up to the clock.
+  int32_t used = 0;
+  slots_used_dev_.copy_to_host(&used, 1);
+  tile_of_slot_.resize(size_t(used));
+  host_dried_to_.resize(size_t(used));
+  if (used > slots_used_) {
+    const size_t from = size_t(slots_used_), n = size_t(used - slots_used_);
+    tile_of_slot_dev_.copy_range_to_host(tile_of_slot_.data() + from, from, n);
+    for (size_t s = from; s < size_t(used); ++s) host_slot_[size_t(tile_of_slot_[s])] = int32_t(s);
+  }
+  if (used > 0) dried_to_.copy_range_to_host(host_dried_to_.data(), 0, size_t(used));
+  slots_used_ = used;
+  bound_ = used;
+  host_stale_ = false;
+}
+
 int32_t TileStore::ensure_slot(int tile_id) {
+  sync_host();
   int32_t& s = host_slot_[size_t(tile_id)];
   if (s >= 0) return s;
   grow_pool(slots_used_ + 1);
   s = slots_used_++;
+  bound_ = std::max<int64_t>(bound_, slots_used_);
   tile_of_slot_.push_back(tile_id);
   slot_of_tile_.copy_range_from_host(&s, size_t(tile_id), 1);
+  tile_of_slot_dev_.copy_range_from_host(&tile_id, size_t(s), 1);
+  slots_used_dev_.copy_from_host(&slots_used_, 1);
   // A new tile is empty: it is up to date with the clock.
   host_dried_to_.resize(size_t(slots_used_));
   host_dried_to_[size_t(s)] = float(clock_);
@@ -107,24 +139,24 @@ void TileStore::scatter(PaintWindow& window) {
   const int x0 = std::max(o.x, 0), y0 = std::max(o.y, 0);
   const int x1 = std::min(o.x + n.x, dims_.width) - 1, y1 = std::min(o.y + n.y, dims_.height) - 1;
   if (x1 < x0 || y1 < y0 || o.z >= dims_.depth || o.z + n.z <= 0) return;  // window entirely off-canvas
-  const int tx0 = x0 / kTileSize, ty0 = y0 / kTileSize;
-  const int ntx = x1 / kTileSize - tx0 + 1, nty = y1 / kTileSize - ty0 + 1;
-  // Allocate the tiles that receive paint, then write every on-canvas cell of the window.
+  const int tx0 = x0 / kTileSize, ty0 = y0 / kTileSize, ntx = x1 / kTileSize - tx0 + 1;
+  // The tiles that receive paint are allocated on the device, from a pool sized for every tile
+  // of the window the host does not know to be allocated: no read (docs/ARCHITECTURE.md "The
+  // sparse canvas"). The record of the step tells the host how many were taken (take_tiles_used).
+  const int nty = y1 / kTileSize - ty0 + 1;
+  int64_t unknown = 0;
+  for (int j = 0; j < nty; ++j)
+    for (int i = 0; i < ntx; ++i) unknown += host_slot_[size_t((ty0 + j) * tiles_x_ + tx0 + i)] < 0;
+  bound_ += unknown;
+  grow_pool(int32_t(bound_));
   tile_flags_.resize(size_t(ntx) * nty);
   tile_flags_.fill_zero();
-  tiles_mark_painted(device_, view(), window.view(), tx0, ty0, ntx, tile_flags_.data());
-  host_flags_.resize(tile_flags_.size());
-  tile_flags_.copy_to_host(host_flags_.data(), host_flags_.size());
-  touched_.clear();
-  for (int j = 0; j < nty; ++j)
-    for (int i = 0; i < ntx; ++i) {
-      const int tile = (ty0 + j) * tiles_x_ + tx0 + i;
-      if (host_flags_[size_t(j) * ntx + i]) ensure_slot(tile);
-      if (host_slot_[size_t(tile)] >= 0) touched_.push_back(host_slot_[size_t(tile)]);
-    }
+  tiles_allocate_painted(device_, view(), window.view(), tx0, ty0, ntx, nty, tile_flags_.data(),
+                         TileSlots{slot_of_tile_.data(), tile_of_slot_dev_.data(), slots_used_dev_.data()});
+  host_stale_ = true;
   // The window covers these tiles only in part: the rest of each must carry its drying before
   // the tile is marked up to date.
-  settle_drying(touched_);
+  tiles_settle_window(device_, view(), tx0, ty0, ntx, nty);
   // The running total: what the scatter writes less what it overwrites.
   const int64_t cells = window.view().size();
   mass_before_.resize(size_t(cells));
@@ -140,22 +172,14 @@ void TileStore::advance_drying(double amount) {
   clock_ += amount;
 }
 
-void TileStore::settle_drying(const std::vector<int32_t>& slots) {
-  if (slots.empty()) return;
-  bool behind = false;
-  for (int32_t s : slots) behind = behind || host_dried_to_[size_t(s)] != float(clock_);
-  if (!behind) return;
-  settle_slots_.copy_from_host(slots);
-  tiles_settle_drying(device_, view(), settle_slots_.data(), int64_t(slots.size()));  // sets dried_to too
-  for (int32_t s : slots) host_dried_to_[size_t(s)] = float(clock_);
-}
-
 void TileStore::dry_all() {
+  sync_host();
   if (slots_used_ == 0) return;
   tiles_dry_all(device_, view(), int64_t(slots_used_) * tile_cells());
 }
 
 void TileStore::lay_weave(const WeaveField& w) {
+  sync_host();
   WB_REQUIRE(slots_used_ == 0, "TileStore::lay_weave: the canvas is not empty");
   // Slot = tile id, allocated at once (one index upload, not one per tile).
   const int32_t n = tiles_x_ * tiles_y_;
@@ -163,18 +187,24 @@ void TileStore::lay_weave(const WeaveField& w) {
   tile_of_slot_.resize(size_t(n));
   for (int32_t s = 0; s < n; ++s) host_slot_[size_t(s)] = tile_of_slot_[size_t(s)] = s;
   slots_used_ = n;
+  bound_ = n;
   host_dried_to_.assign(size_t(n), float(clock_));
   slot_of_tile_.copy_from_host(host_slot_);
+  tile_of_slot_dev_.copy_range_from_host(tile_of_slot_.data(), 0, size_t(n));
+  slots_used_dev_.copy_from_host(&slots_used_, 1);
   dried_to_.copy_range_from_host(host_dried_to_.data(), 0, size_t(n));
   tiles_lay_weave(device_, view(), w, int64_t(n) * tile_cells());
   mass_ = recount_density(ws_);
 }
 
 void TileStore::clear() {
-  for (int32_t t : tile_of_slot_) host_slot_[size_t(t)] = -1;
+  std::fill(host_slot_.begin(), host_slot_.end(), -1);  // the mirror may miss the device's newest
   tile_of_slot_.clear();
   host_dried_to_.clear();
   slots_used_ = 0;
+  bound_ = 0;
+  host_stale_ = false;
+  slots_used_dev_.fill_zero();
   mass_ = 0.0;
   mass_sums_.fill_zero();
   mass_pending_ = false;
@@ -193,24 +223,30 @@ void TileStore::copy_from(const TileStore& src) {
     for (int id : src.allocated_tile_ids()) write_tile(src.read_tile(id));
     return;
   }
+  // The device's slot table is the truth: copied on the device with the slots it may use
+  // (bound_), and the host's mirror as stale as src's.
   clear();
-  grow_pool(src.slots_used_);
+  grow_pool(int32_t(src.bound_));
   host_slot_ = src.host_slot_;
   tile_of_slot_ = src.tile_of_slot_;
   host_dried_to_ = src.host_dried_to_;
   slots_used_ = src.slots_used_;
+  bound_ = src.bound_;
+  host_stale_ = src.host_stale_;
   clock_ = src.clock_;
   mass_ = src.mass_;  // and the sums src has not read yet, on the device below
   mem::copy_on_device(device_, mass_sums_.data(), src.mass_sums_.data(), 2 * sizeof(double));
   mass_pending_ = src.mass_pending_;
-  slot_of_tile_.copy_from_host(host_slot_);
-  const size_t cells = size_t(slots_used_) * size_t(tile_cells());
+  mem::copy_on_device(device_, slot_of_tile_.data(), src.slot_of_tile_.data(), host_slot_.size() * sizeof(int32_t));
+  mem::copy_on_device(device_, slots_used_dev_.data(), src.slots_used_dev_.data(), sizeof(int32_t));
+  const size_t slots = size_t(bound_), cells = slots * size_t(tile_cells());
   if (cells == 0) return;
   mem::copy_on_device(device_, density_.data(), src.density_.data(), cells * sizeof(float));
   const DeviceBuffer<uint16_t>* from[] = {&src.pigment_r_, &src.pigment_y_, &src.pigment_b_, &src.oil_, &src.dryness_};
   DeviceBuffer<uint16_t>* to[] = {&pigment_r_, &pigment_y_, &pigment_b_, &oil_, &dryness_};
   for (int f = 0; f < 5; ++f) mem::copy_on_device(device_, to[f]->data(), from[f]->data(), cells * sizeof(uint16_t));
-  mem::copy_on_device(device_, dried_to_.data(), src.dried_to_.data(), size_t(slots_used_) * sizeof(float));
+  mem::copy_on_device(device_, dried_to_.data(), src.dried_to_.data(), slots * sizeof(float));
+  mem::copy_on_device(device_, tile_of_slot_dev_.data(), src.tile_of_slot_dev_.data(), slots * sizeof(int32_t));
 }
 
 size_t TileStore::memory_bytes() const {
@@ -221,6 +257,7 @@ size_t TileStore::memory_bytes() const {
 }
 
 double TileStore::recount_density(Workspace& ws) const {
+  sync_host();
   if (slots_used_ == 0) return 0.0;
   return reduce_sum(device_, density_.data(), int64_t(slots_used_) * tile_cells(), ws);
 }
@@ -228,6 +265,7 @@ double TileStore::recount_density(Workspace& ws) const {
 PaintCell TileStore::read_cell(int x, int y, int z) const {
   PaintCell c;
   if (x < 0 || y < 0 || z < 0 || x >= dims_.width || y >= dims_.height || z >= dims_.depth) return c;
+  sync_host();
   const int32_t slot = host_slot_[size_t(y / kTileSize) * tiles_x_ + x / kTileSize];
   if (slot < 0) return c;
   const size_t at = size_t(slot) * tile_cells() + size_t((z * kTileSize + y % kTileSize) * kTileSize + x % kTileSize);
@@ -247,10 +285,14 @@ PaintCell TileStore::read_cell(int x, int y, int z) const {
   return c;
 }
 
-std::vector<int> TileStore::allocated_tile_ids() const { return {tile_of_slot_.begin(), tile_of_slot_.end()}; }
+std::vector<int> TileStore::allocated_tile_ids() const {
+  sync_host();
+  return {tile_of_slot_.begin(), tile_of_slot_.end()};
+}
 
 TileData TileStore::read_tile(int tile_id) const {
   WB_REQUIRE(tile_id >= 0 && size_t(tile_id) < host_slot_.size(), "read_tile: tile id out of range");
+  sync_host();
   TileData d;
   d.tile_x = tile_id % tiles_x_;
   d.tile_y = tile_id / tiles_x_;

@@ -70,6 +70,13 @@ struct TileStoreView {
   }
 };
 
+/// The slot table as the device allocates it (tiles_allocate_painted).
+struct TileSlots {
+  int32_t* slot_of_tile;
+  int32_t* tile_of_slot;
+  int32_t* used;  ///< slots in use
+};
+
 /// The host copy of one tile, as stored.
 struct TileData {
   int tile_x = 0, tile_y = 0;
@@ -108,7 +115,15 @@ class TileStore {
   /// From another device the tiles come through the host, one at a time.
   void copy_from(const TileStore& src);
 
-  int allocated_tiles() const { return slots_used_; }
+  /// Tiles allocated (a read of the device's slot count where its scatters allocated since the
+  /// host last learnt it: see no_tiles for a step's question).
+  int allocated_tiles() const;
+  /// No tile is allocated, known without a read (the host's bound on the slots in use is 0).
+  bool no_tiles() const { return bound_ == 0; }
+  /// The device's count of slots in use, for a caller's step record ...
+  const int32_t* tiles_used() const { return slots_used_dev_.data(); }
+  /// ... and as the caller read it: the bound the pool is sized by before each scatter.
+  void take_tiles_used(int32_t used);
   /// Bytes held now: tile index (host and device) plus the pool's capacity.
   size_t memory_bytes() const;
   /// Sum of density over all cells (in cell units), in double: kept up to date by every write
@@ -134,45 +149,48 @@ class TileStore {
 
  private:
   int32_t ensure_slot(int tile_id);
+  /// Brings the host's slot table up to the device's, where scatters allocated tiles (one read).
+  void sync_host() const;
   void fold_mass_sums(const double sums[2]) const;  ///< the read sums into the total
   void grow_pool(int32_t slots);
-  /// Brings the stored dryness of these slots up to the clock (scatter writes partial tiles).
-  void settle_drying(const std::vector<int32_t>& slots);
   /// Drying the tile in `slot` is owed (clock less the clock its stored dryness includes).
   float owed_drying(int32_t slot) const { return float(clock_) - host_dried_to_[size_t(slot)]; }
 
   Device device_;
   CanvasDims dims_;
   int tiles_x_ = 0, tiles_y_ = 0;
-  std::vector<int32_t> host_slot_;  ///< mirror of slot_of_tile_
-  std::vector<int32_t> tile_of_slot_;
-  int32_t slots_used_ = 0;
+  // The slot table: the device's is the truth (a scatter allocates there); the host's mirrors
+  // it as of the last sync_host, and bound_ bounds the slots in use without a read.
+  mutable std::vector<int32_t> host_slot_;  ///< mirror of slot_of_tile_
+  mutable std::vector<int32_t> tile_of_slot_;
+  mutable int32_t slots_used_ = 0;
+  mutable bool host_stale_ = false;  ///< a scatter ran since the last sync_host
+  mutable int64_t bound_ = 0;        ///< at least the slots in use
+  DeviceBuffer<int32_t> tile_of_slot_dev_, slots_used_dev_;
   int32_t slot_capacity_ = 0;
   DeviceBuffer<int32_t> slot_of_tile_;
   DeviceBuffer<float> density_;
   DeviceBuffer<uint16_t> pigment_r_, pigment_y_, pigment_b_, oil_, dryness_;
-  DeviceBuffer<int32_t> tile_flags_;  ///< scratch of scatter: which window tiles hold paint
-  std::vector<int32_t> host_flags_;
+  DeviceBuffer<int32_t> tile_flags_;   ///< scratch of scatter: which window tiles hold paint
   double clock_ = 0.0;                 ///< drying clock
   mutable double mass_ = 0.0;          ///< sum of density over the pool, less mass_sums_
   mutable DeviceBuffer<double> mass_sums_;  ///< the scatters' written and overwritten sums since read
   mutable bool mass_pending_ = false;  ///< mass_sums_ may be non-zero
   Workspace ws_;                       ///< scratch of the scatter's mass difference
   DeviceBuffer<float> mass_before_, mass_after_;  ///< per window cell: density overwritten, written
-  std::vector<int32_t> touched_;       ///< scratch of scatter: slots of the window's tiles
-  std::vector<float> host_dried_to_;   ///< per slot, mirror of dried_to_
+  mutable std::vector<float> host_dried_to_;      ///< per slot, mirror of dried_to_ (sync_host)
   DeviceBuffer<float> dried_to_;
-  DeviceBuffer<int32_t> settle_slots_;  ///< scratch of settle_drying
 };
 
 // The tile store's backend drivers (gather_scatter_impl.h), one list (core/exec/dispatch.h).
 #define WB_TILE_STORE_KERNELS(X)                                                                               \
   X(void, tiles_gather_window, (TileStoreView t, PaintWindowView w), (t, w))                                   \
-  X(void, tiles_settle_drying, (TileStoreView t, const int32_t* slots, int64_t count), (t, slots, count))      \
-  X(void, tiles_mark_painted, (TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int32_t* flags), \
-      (t, w, tx0, ty0, ntx, flags))                                                                            \
+  X(void, tiles_settle_window, (TileStoreView t, int tx0, int ty0, int ntx, int nty), (t, tx0, ty0, ntx, nty)) \
+  X(void, tiles_allocate_painted,                                                                              \
+    (TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int nty, int32_t* flags, TileSlots slots), \
+    (t, w, tx0, ty0, ntx, nty, flags, slots))                                                                  \
   X(void, tiles_scatter_window, (TileStoreView t, PaintWindowView w, float* before, float* after),             \
-      (t, w, before, after))                                                                                   \
+    (t, w, before, after))                                                                                     \
   X(void, tiles_dry_all, (TileStoreView t, int64_t cells), (t, cells))                                         \
   X(void, tiles_lay_weave, (TileStoreView t, WeaveField w, int64_t cells), (t, w, cells))
 WB_DECLARE_KERNELS(WB_TILE_STORE_KERNELS)

@@ -439,10 +439,10 @@ void Grid::apply_viscosity(float dt) {
   // alpha, beta and the test of convergence are formed on the device from sums kept there
   // (cg_sums_: r.z of the current and the next iteration, p.Ap, b.D^-1 b, the iterations made),
   // so an iteration makes no host read and one launched past convergence moves nothing
-  // (CgGuard). The host launches as many as the last solve made, and a few more, then reads
-  // once; only a solve that needs more reads again, after kCgCheckEvery more iterations, then
-  // twice as many each time (a solve far past its plan reads a few times, not every 8).
-  constexpr int kCgCheckEvery = 8, kCgMargin = 2;
+  // (CgGuard; on the CPU backend its driver returns at once). The host launches twice as many
+  // as the last solve made and a few more, then reads once; a solve that needs more (as at a
+  // lift) has every iteration left launched at once and reads once more: two reads at most.
+  constexpr int kCgMargin = 8;
   constexpr int64_t kCgFirstCapacity = 4096;  // entries of the first solve's vectors
   const double tol2 = double(params_.viscosity_tolerance) * double(params_.viscosity_tolerance);
   const int max_it = params_.viscosity_max_iterations;
@@ -485,7 +485,7 @@ void Grid::apply_viscosity(float dt) {
     cur = 0;
     // Plans are even (pairs) but for an odd max_it, whose last iteration runs alone.
     const auto even = [](int k) { return k + (k & 1); };
-    for (int planned = std::min(max_it, even(cg_last_iterations_ + kCgMargin)), more = kCgCheckEvery;; more *= 2) {
+    for (int planned = std::min(max_it, even(2 * cg_last_iterations_ + kCgMargin));;) {
       for (; launched + 2 <= planned; launched += 2) cg_pair_.run(d, key, [&] {
           iterate(0);
           iterate(1);
@@ -500,7 +500,7 @@ void Grid::apply_viscosity(float dt) {
       if (need > n.capacity) break;  // nothing ran: size the vectors and solve again
       const double rz = host[cur];
       if (!(rz > tol2 * host[3] && rz > 0.0) || launched >= max_it) break;
-      planned = std::min(max_it, launched + more);
+      planned = max_it;
     }
     if (need <= int64_t(cg_x_.size())) break;
   }

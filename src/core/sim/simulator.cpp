@@ -134,13 +134,16 @@ PaintCensus Simulator::record_census(TransferRecord& rec) {
     ActiveWindow& win = grid_->window();
     mem::copy_on_device(device(), d->canvas_sums, canvas_->mass_sums(), 2 * sizeof(double));
     mem::copy_on_device(device(), &d->gathered, win.gathered_sum(), sizeof(double));
+    mem::copy_on_device(device(), &d->tiles_used, canvas_->tiles_used(), sizeof(int32_t));
     StepSums r{};
     step_sums_.copy_to_host(&r, 1);
     step_sums_.fill_zero();
+    canvas_->take_tiles_used(r.tiles_used);
     canvas_->take_mass_sums(r.canvas_sums);
     win.set_gathered_mass(r.gathered);
     if (take == 0) {
       h = r;
+      last_record_ = r;
       // Sub-steps the brush rolled back on the device (Brush::step) are non-finite events too.
       counters_.nonfinite_events += r.brush_rollbacks - brush_->rollbacks();
       brush_->rolled_back(r.brush_rollbacks);
@@ -333,26 +336,39 @@ void Simulator::replace_canvas(const std::function<void(TileStore&)>& write) {
 }
 
 std::array<float, 4> Simulator::samples_box() {
+  queue_samples_box(extent_.data());
+  float m[kExtentValues];
+  extent_.copy_to_host(m, kExtentValues);
+  return box_from(m);
+}
+
+void Simulator::queue_samples_box(float* out) {
   const SampleView s = brush_->samples();
   const int64_t n = s.count();
-  if (n == 0) return {};
   ActiveWindow& win = grid_->window();
   const Int3 o = win.origin(), wn = win.dims();
   const int64_t columns = int64_t(wn.x) * wn.y;
   if (extent_scratch_.size() < size_t(std::max(4 * n, columns))) extent_scratch_.resize(size_t(std::max(4 * n, columns)));
-  const float z_top = float(o.z + wn.z);
-  joint_sample_extent(device(), s.x, n, z_top, extent_scratch_.data());
-  for (int c = 0; c < 4; ++c) reduce_max_into(device(), extent_scratch_.data() + c * n, n, extent_.data() + c, ws_);
+  if (n > 0) {
+    const float z_top = float(o.z + wn.z);
+    joint_sample_extent(device(), s.x, n, z_top, extent_scratch_.data());
+    for (int c = 0; c < 4; ++c) reduce_max_into(device(), extent_scratch_.data() + c * n, n, out + c, ws_);
+  } else {  // no samples: box_from takes the tips' point
+    const float none[4] = {-1.f, -1.f, -1.f, -1.f};
+    mem::copy_from_host(device(), out, none, sizeof none);
+  }
   // The ground for the next step: the dried paint's top under the footprint (the disc of the
-  // brush's half width around where its tips meet the canvas), in the same copy.
+  // brush's half width around where its tips meet the canvas).
   const ParticleParams& pp = config_.params.particles;
   const Vec3 tip = footprint_centre(brush_->pose(), config_.brush.length);
   joint_ground_under(device(), win.paint().view(), config_.params.grid.dry_threshold, tip.x, tip.y,
                      0.5f * std::max(config_.brush.width, config_.brush.thickness), pp.floor_z, extent_scratch_.data());
-  reduce_max_into(device(), extent_scratch_.data(), columns, extent_.data() + 4, ws_);
-  float m[5];
-  extent_.copy_to_host(m, 5);
+  reduce_max_into(device(), extent_scratch_.data(), columns, out + 4, ws_);
+}
+
+std::array<float, 4> Simulator::box_from(const float m[kExtentValues]) {
   ground_ = std::isfinite(m[4]) ? std::max(m[4], 0.f) : 0.f;
+  const Vec3 tip = footprint_centre(brush_->pose(), config_.brush.length);
   if (!(m[0] >= -m[1] && m[2] >= -m[3])) return {tip.x, tip.x, tip.y, tip.y};  // none below the top: the tips' point
   return {-m[1], m[0], -m[3], m[2]};
 }
@@ -526,14 +542,32 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
 
   // --- 1-2. Brush (§4.1) in sub-steps, then its samples ------------------------------------
   const std::array<float, 4> box_before = box_;
+  const Vec3 tips_before = footprint_centre(brush_->pose(), config_.brush.length);
   brush_stage(poses, substeps, dt);
 
   // --- 3. Window: follow the brush; rasterise the bristles into it (boundary of §4.2) -----
   {
     WB_PROFILE_SCOPE("window");
-    box_ = samples_box();
+    // The samples' box at the step's end comes with the step's record. Here the last step's box
+    // goes where the pen took the brush's tips, and the window and D0 are placed on it. Widened
+    // by twice the last step's miss and a cell (the bristles' shape changes: a landing splays
+    // them, a drag bends them back), the box over the step must stay out of the window's rim;
+    // where it would not, the box is read instead (docs/TRANSFER.md "The particle zone").
+    const Vec3 moved = footprint_centre(brush_->pose(), config_.brush.length) - tips_before;
+    guess_ = {box_before[0] + moved.x, box_before[1] + moved.x, box_before[2] + moved.y, box_before[3] + moved.y};
+    box_ = guess_;
     float zone_room = 0.f;
-    const Int3 next = place_window(box_before, box_, zone_room);
+    Int3 next = place_window(box_before, box_, zone_room);
+    const float a = 2.f * box_miss_ + 1.f;
+    const Int3 n = grid_->window().dims();
+    const float wx = std::max(box_before[1], guess_[1]) - std::min(box_before[0], guess_[0]);
+    const float wy = std::max(box_before[3], guess_[3]) - std::min(box_before[2], guess_[2]);
+    if (0.5f * std::min(float(n.x) - wx, float(n.y) - wy) - a - 0.5f * float(config_.params.grid.window_snap) <
+        float(kKeepRim)) {
+      box_ = samples_box();
+      next = place_window(box_before, box_, zone_room);
+      ++counters_.box_reads;
+    }
     if (config_.particles) {
       counters_.zone_cut_steps += zone_room < 0.f;
       counters_.zone_room_min = std::min(counters_.zone_room_min, zone_room);
@@ -591,7 +625,11 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
     // census. Where something went non-finite, it is contained and the census taken again.
     WB_PROFILE_SCOPE("books");
     count_nonfinite(false);
+    queue_samples_box(step_sums_.data()->extent);
     books_.record(rec, record_census(rec));
+    box_ = box_from(last_record_.extent);
+    box_miss_ = 0.f;
+    for (int k = 0; k < 4; ++k) box_miss_ = std::max(box_miss_, std::abs(box_[k] - guess_[k]));
   }
   clamp_particles_to_canvas();
   last_dt_ = dt;
@@ -621,7 +659,7 @@ SolidField Simulator::solid_field() {
   SolidField s;
   s.tiles = canvas_->view();
   s.dryness_threshold = config_.params.grid.dry_threshold;
-  s.valid = canvas_->allocated_tiles() > 0;  // an empty canvas has no dried paint
+  s.valid = !canvas_->no_tiles();  // an empty canvas has no dried paint
   return s;
 }
 

@@ -47,6 +47,9 @@ struct SimCounters {
   /// Steps whose particle zone, at D0's floor, did not fit the window's kept box around the
   /// samples (the brush is too large for its window: Simulator::place_window).
   int64_t zone_cut_steps = 0;
+  /// Step parts whose window was placed on the samples' box read back at once, not on the last
+  /// step's box moved by the pen (the guess left the particle zone no room: step_part).
+  int64_t box_reads = 0;
   /// Steps whose brush swept farther than the window holds, simulated in parts (step()), and
   /// the parts they took in all.
   int64_t split_steps = 0;
@@ -180,7 +183,8 @@ class Simulator {
   void brush_stage(const BrushPose* poses, int substeps, float dt);
   void particle_stage(float dt);
   void deposit_leaving_particles(Int3 next_origin);
-  /// The step's transfer sums added to rec and the census after it, from one read of step_sums_.
+  /// The step's transfer sums added to rec and the census after it, from one read of step_sums_
+  /// (kept whole in last_record_).
   PaintCensus record_census(TransferRecord& rec);
   void joint_fields_stage();
   /// Counts, on the device, the non-finite values of every checked array (into step_sums_).
@@ -204,8 +208,16 @@ class Simulator {
   /// around the samples (transfer_env; set by place_window).
   float effective_D0() const { return zone_D0_; }
   /// Horizontal box of the samples below the window's top: x_lo, x_hi, y_lo, y_hi; also sets
-  /// ground_ for the next step. One read for both.
+  /// ground_ for the next step. One read for both (outside a step; a step's box comes with its
+  /// record).
   std::array<float, 4> samples_box();
+  /// The samples' box maxima (x, -x, y, -y) and the ground under the footprint into out[0..5),
+  /// on the device.
+  static constexpr int kExtentValues = 5;
+  void queue_samples_box(float* out);
+  /// The box of queue_samples_box's values (the tips' point where no sample is below the
+  /// window's top); sets ground_.
+  std::array<float, 4> box_from(const float m[kExtentValues]);
   /// Window origin for the samples' box over the step (the union of `before` and `after`), and
   /// the D0 that keeps the particle zone inside its kept box; `zone_room` is the room left for
   /// the zone at D0's floor, cells (negative: the window cuts it).
@@ -246,8 +258,11 @@ class Simulator {
     int64_t brush_rollbacks;
     double canvas_sums[2];  ///< the canvas's scatter sums not yet read (TileStore::mass_sums)
     double gathered;        ///< the window region's density at its last gather
+    float extent[kExtentValues];  ///< the samples' box and the ground at the step's end (queue_samples_box)
+    int32_t tiles_used;           ///< the canvas's slots in use (TileStore::tiles_used)
   };
   DeviceBuffer<StepSums> step_sums_;
+  StepSums last_record_{};            ///< the last read of step_sums_
   DeviceBuffer<float> solid_height_;  ///< dried-paint top per window column (particles' solid, Eq. 8)
   DeviceBuffer<float> wet_top_;       ///< wet-paint surface per window column (free particles land on it)
   DeviceBuffer<float> surface_;       ///< the ground per window column (paint_surface)
@@ -256,6 +271,8 @@ class Simulator {
   Int3 raster_origin_{};              ///< and the window origin it was made at
   DeviceBuffer<float> extent_scratch_, extent_;  ///< the samples' box and the ground (samples_box)
   std::array<float, 4> box_{};                   ///< the samples' box at the end of the last step
+  std::array<float, 4> guess_{};                 ///< this step's box as the pen's travel moves the last
+  float box_miss_ = 0.f;                         ///< the last step's largest miss of guess_, cells
   /// Top of the dried paint under the brush's footprint at the end of the last step, cells: the
   /// pen's pressure presses the brush into the surface it meets, not below the bare canvas.
   float ground_ = 0.f;
