@@ -29,6 +29,10 @@
 
 namespace wb {
 
+/// A particle the compaction keeps: not dead and not left weightless (a window move's return to
+/// the grid, transfer_to_grid_mark). A non-finite mass is kept, for the containment to count.
+WB_HD WB_INLINE bool particle_kept(uint32_t dead, float m) { return !dead && !(m == 0.f); }
+
 /// POD view of all particles: device pointers plus the live count. Passed by value.
 struct ParticleView {
 #define WB_X(type, name, doc) type* name;

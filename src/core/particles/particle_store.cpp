@@ -78,7 +78,7 @@ int64_t ParticleStore::compact(Workspace& ws) {
   const int64_t n = count_;
   if (n == 0) return 0;
   if (scan_.size() < size_t(n)) scan_.grow_keep(size_t(n));
-  particles_keep_flags(device_, dead.data(), scan_.data(), n);
+  particles_keep_flags(device_, dead.data(), m.data(), scan_.data(), n);
   const int64_t kept = int64_t(exclusive_scan(device_, scan_.data(), scan_.data(), n, ws));
   remove_dead(scan_.data(), kept);
   return n - kept;

@@ -102,16 +102,16 @@ void particles_flip_pic(ParticleView p, MacView before, MacView after, float gam
   });
 }
 
-/// Particles whose dead flag is clear; used by ParticleStore::compact.
-void particles_keep_flags(const uint32_t* dead, uint32_t* keep, int64_t n) {
-  parallel_for(n, [=] WB_HD(int64_t i) { keep[i] = dead[i] ? 0u : 1u; });
+/// Particles kept (particle_kept); used by ParticleStore::compact.
+void particles_keep_flags(const uint32_t* dead, const float* m, uint32_t* keep, int64_t n) {
+  parallel_for(n, [=] WB_HD(int64_t i) { keep[i] = particle_kept(dead[i], m[i]) ? 1u : 0u; });
 }
 
-/// to[pos[i]] = the state of particle i for every i < n with !dead[i]; pos is the exclusive scan
-/// of the keep flags (ParticleStore::compact).
+/// to[pos[i]] = the state of particle i for every kept i < n; pos is the exclusive scan of the
+/// keep flags (ParticleStore::compact).
 void particles_compact_state(ParticleView p, ParticleStateView to, const uint32_t* pos, int64_t n) {
   parallel_for(n, [=] WB_HD(int64_t i) {
-    if (p.dead[i]) return;
+    if (!particle_kept(p.dead[i], p.m[i])) return;
     const int64_t k = pos[i];
 #define WB_X(type, name, doc) to.name[k] = p.name[i];
     WB_PARTICLE_STATE_FIELDS(WB_X)

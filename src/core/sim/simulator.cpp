@@ -627,6 +627,7 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
     count_nonfinite(false);
     queue_samples_box(step_sums_.data()->extent);
     books_.record(rec, record_census(rec));
+    counters_.returned_at_moves += rec.to_grid_at_moves;
     box_ = box_from(last_record_.extent);
     box_miss_ = 0.f;
     for (int k = 0; k < 4; ++k) box_miss_ = std::max(box_miss_, std::abs(box_[k] - guess_[k]));
@@ -649,10 +650,9 @@ void Simulator::deposit_leaving_particles(Int3 next) {
                          Int3{std::min(cur.x, next.x) + n.x - cur.x - m, std::min(cur.y, next.y) + n.y - cur.y - m,
                               n.z - kKeepRimTop});
   env.only_leaving = true;
+  // Those returned are left weightless in place (transfer_to_grid_mark): the step's transfer
+  // compacts them away with its own, and its record counts them (returned_at_moves).
   transfer_->particles_to_grid(particles_, env);
-  const int64_t before = particles_.size();
-  particles_.compact(ws_);
-  counters_.returned_at_moves += before - particles_.size();
 }
 
 SolidField Simulator::solid_field() {

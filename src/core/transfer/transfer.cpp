@@ -172,7 +172,8 @@ void Transfer::add_sums(const TransferSums& s, double cm, TransferRecord& rec) {
   rec.emitted_into_particles += s.emitted_into_particles;
   rec.to_particles_from_grid += s.to_particles_from_grid * cm;
   rec.to_particles_into_particles += s.to_particles_into_particles;
-  rec.to_grid_count += s.to_grid_count;
+  rec.to_grid_count += s.to_grid_count + s.to_grid_at_moves;
+  rec.to_grid_at_moves += s.to_grid_at_moves;
   rec.to_grid_from_particles += s.to_grid_from_particles;
   rec.to_grid_into_grid += s.to_grid_into_grid * cm;
 }
@@ -332,7 +333,7 @@ void Transfer::particles_to_grid(ParticleStore& particles, const TransferEnv& en
   acc.added = c_f32_[0].data();
   c_f32_[0].fill_zero();
   acc.moved = p_moved_.data();
-  acc.counter = sum_field(&TransferSums::to_grid_count);
+  acc.counter = sum_field(env.only_leaving ? &TransferSums::to_grid_at_moves : &TransferSums::to_grid_count);
   acc.keep = env.keep;
   acc.only_leaving = env.only_leaving;
   acc.surface = env.surface;
@@ -377,7 +378,7 @@ void Transfer::make_particles(const SampleView* samples, BristleLoad* load, Part
     room_offset_.resize(size_t(n));
     uint32_t* count = room_count_.data();
     uint32_t* offset = room_offset_.data();
-    if (nk > 0) particles_keep_flags(device_, particles.dead.data(), count, nk);
+    if (nk > 0) particles_keep_flags(device_, particles.dead.data(), particles.m.data(), count, nk);
     if (ns > 0) {
       ensure_samples(ns);
       const EmitScratch e = emit_scratch();

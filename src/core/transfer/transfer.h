@@ -68,6 +68,7 @@ struct TransferRecord {
   int64_t to_particles_dropped = 0;  ///< candidates not created because the store was at its limit
   // Particle -> grid (Eq. 16).
   int64_t to_grid_count = 0;
+  int64_t to_grid_at_moves = 0;  ///< of them, the particles a window move left (only_leaving)
   double to_grid_from_particles = 0;
   double to_grid_into_grid = 0;
 
@@ -89,8 +90,8 @@ struct TransferSums {
   double to_particles_from_grid, to_particles_into_particles;
   double to_grid_from_particles, to_grid_into_grid;
   int32_t absorb_counts[2];  ///< absorbed, bleeding (AbsorbScratch::counters)
-  int32_t to_grid_count;     ///< DepositScratch::counter
-  int32_t unused;
+  int32_t to_grid_count;     ///< DepositScratch::counter of the step's passes ...
+  int32_t to_grid_at_moves;  ///< ... and of a window move's (only_leaving)
 };
 
 /// Scratch of the absorption pass, per sample (accumulators) and per particle (moved mass).

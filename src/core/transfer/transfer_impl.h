@@ -338,7 +338,12 @@ void transfer_to_grid_mark(ParticleView p, PaintWindowView pw, DistanceBlocks db
       atomic_add(&acc.dryness[id], to_fixed(add * dry));
     });
     if (cells > 0) {
-      p.dead[k] = 1u;
+      // A window move's pass leaves the particle weightless, in place, to the step's compaction
+      // (no count read back at the move); the step's own pass marks it dead.
+      if (acc.only_leaving)
+        p.m[k] = 0.f;
+      else
+        p.dead[k] = 1u;
       acc.moved[k] = mk;
       atomic_add(acc.counter, int32_t(1));
     }
