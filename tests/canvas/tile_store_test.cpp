@@ -150,6 +150,37 @@ TEST_F(TileStoreTest, MemoryGrowsWithPaintedArea) {
   EXPECT_EQ(canvas.read_cell(81, 144, 0).density, 0.f);
 }
 
+TEST_F(TileStoreTest, ScatterAllocatesOnTheDeviceAndItsPoolStaysBounded) {
+  // A scatter allocates the tiles its paint needs on the device and reads nothing back; the
+  // host learns the count when it asks (one read). Scatters with no step record between them
+  // (here: a window moving over bare canvas with one painted cell) keep the pool within a few
+  // windows' tiles, not a window more at every move.
+  TileStore canvas(device_, CanvasDims{1024, 256, 8});
+  PaintWindow w(device_, Int3{64, 64, 8});
+  std::vector<std::vector<float>> f(kPaintFieldCount, std::vector<float>(size_t(w.cell_count()), 0.f));
+  f[0][size_t(w.cell_count()) - 1] = 1.f;  // the window's top far corner
+  w.from_host(f);
+  const int64_t reads = mem::host_reads();
+  for (int m = 0; m < 40; ++m) {
+    w.set_origin({16 * m, 64, 0});
+    canvas.scatter(w);
+  }
+  const int64_t scatter_reads = mem::host_reads() - reads;
+  // Each placement paints the cell at (16 m + 63, 127, 7): a tile per move from x 63 on.
+  EXPECT_EQ(canvas.allocated_tiles(), 40);
+  const int window_tiles = 5 * 5;  // 64 cells over 16-cell tiles, one more where not aligned
+  const size_t tile_bytes = size_t(16 * 16 * 8) * size_t(kCellBytes);
+  EXPECT_LT(canvas.memory_bytes(), size_t(40 + 4 * window_tiles) * 3 / 2 * tile_bytes + (1u << 20))
+      << "the pool grew by a window at every move";
+  // The table is read (its count, new slots and clocks: 3 reads) once the bound is two windows
+  // past what the host knows: every third move here, where a step's record would do it each step.
+  EXPECT_LE(scatter_reads, 3 * (40 / 3 + 1));
+  EXPECT_FLOAT_EQ(canvas.read_cell(16 * 39 + 63, 127, 7).density, 1.f);
+  std::printf("[ tiles ] 40 scatters: %lld host reads, %d tiles, pool %.1f MiB\n",
+              static_cast<long long>(scatter_reads), canvas.allocated_tiles(),
+              double(canvas.memory_bytes()) / 1048576.0);
+}
+
 TEST_F(TileStoreTest, DryAllSolidifiesPaintOnly) {
   TileStore canvas(device_, CanvasDims{64, 64, 16});
   PaintWindow w(device_, Int3{64, 64, 16});

@@ -90,7 +90,7 @@ int TileStore::allocated_tiles() const {
   return slots_used_;
 }
 
-void TileStore::take_tiles_used(int32_t used) { bound_ = used; }
+void TileStore::take_tiles_used(int32_t used) { bound_ = known_used_ = used; }
 
 void TileStore::sync_host() const {
   if (!host_stale_) return;
@@ -106,7 +106,7 @@ void TileStore::sync_host() const {
   }
   if (used > 0) dried_to_.copy_range_to_host(host_dried_to_.data(), 0, size_t(used));
   slots_used_ = used;
-  bound_ = used;
+  bound_ = known_used_ = used;
   host_stale_ = false;
 }
 
@@ -117,6 +117,7 @@ int32_t TileStore::ensure_slot(int tile_id) {
   grow_pool(slots_used_ + 1);
   s = slots_used_++;
   bound_ = std::max<int64_t>(bound_, slots_used_);
+  known_used_ = slots_used_;
   tile_of_slot_.push_back(tile_id);
   slot_of_tile_.copy_range_from_host(&s, size_t(tile_id), 1);
   tile_of_slot_dev_.copy_range_from_host(&tile_id, size_t(s), 1);
@@ -144,6 +145,9 @@ void TileStore::scatter(PaintWindow& window) {
   // of the window the host does not know to be allocated: no read (docs/ARCHITECTURE.md "The
   // sparse canvas"). The record of the step tells the host how many were taken (take_tiles_used).
   const int nty = y1 / kTileSize - ty0 + 1;
+  // Scatters with no record between them (a grid stepped on its own, flushes) would raise the
+  // bound by a window's tiles each: past two windows' worth the host reads the table first.
+  if (bound_ > known_used_ + 2 * int64_t(ntx) * nty) sync_host();
   int64_t unknown = 0;
   for (int j = 0; j < nty; ++j)
     for (int i = 0; i < ntx; ++i) unknown += host_slot_[size_t((ty0 + j) * tiles_x_ + tx0 + i)] < 0;
@@ -187,7 +191,7 @@ void TileStore::lay_weave(const WeaveField& w) {
   tile_of_slot_.resize(size_t(n));
   for (int32_t s = 0; s < n; ++s) host_slot_[size_t(s)] = tile_of_slot_[size_t(s)] = s;
   slots_used_ = n;
-  bound_ = n;
+  bound_ = known_used_ = n;
   host_dried_to_.assign(size_t(n), float(clock_));
   slot_of_tile_.copy_from_host(host_slot_);
   tile_of_slot_dev_.copy_range_from_host(tile_of_slot_.data(), 0, size_t(n));
@@ -202,7 +206,7 @@ void TileStore::clear() {
   tile_of_slot_.clear();
   host_dried_to_.clear();
   slots_used_ = 0;
-  bound_ = 0;
+  bound_ = known_used_ = 0;
   host_stale_ = false;
   slots_used_dev_.fill_zero();
   mass_ = 0.0;
@@ -232,6 +236,7 @@ void TileStore::copy_from(const TileStore& src) {
   host_dried_to_ = src.host_dried_to_;
   slots_used_ = src.slots_used_;
   bound_ = src.bound_;
+  known_used_ = src.known_used_;
   host_stale_ = src.host_stale_;
   clock_ = src.clock_;
   mass_ = src.mass_;  // and the sums src has not read yet, on the device below

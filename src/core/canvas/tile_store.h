@@ -166,6 +166,7 @@ class TileStore {
   mutable int32_t slots_used_ = 0;
   mutable bool host_stale_ = false;  ///< a scatter ran since the last sync_host
   mutable int64_t bound_ = 0;        ///< at least the slots in use
+  mutable int64_t known_used_ = 0;   ///< the slots in use when the host last learnt it
   DeviceBuffer<int32_t> tile_of_slot_dev_, slots_used_dev_;
   int32_t slot_capacity_ = 0;
   DeviceBuffer<int32_t> slot_of_tile_;
