@@ -48,7 +48,8 @@ struct SimCounters {
   /// samples (the brush is too large for its window: Simulator::place_window).
   int64_t zone_cut_steps = 0;
   /// Step parts whose window was placed on the samples' box read back at once, not on the last
-  /// step's box moved by the pen (the guess left the particle zone no room: step_part).
+  /// step's box moved by the pen (that box, widened by its last miss, would reach the window's
+  /// rim: a brush nearly as large as its window; step_part).
   int64_t box_reads = 0;
   /// Steps whose brush swept farther than the window holds, simulated in parts (step()), and
   /// the parts they took in all.
