@@ -80,8 +80,7 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
   for (auto* b : {&extent_scratch_, &extent_}) b->set_device(d);
   extent_.resize(5);
   box_ = samples_box();
-  float zone_room = 0.f;
-  grid_->move_window(place_window(box_, box_, zone_room));
+  grid_->move_window(place_window(box_, box_).origin);
   step_sums_ = DeviceBuffer<StepSums>(d, 1);
   step_sums_.fill_zero();
   transfer_->set_sums(&step_sums_.data()->transfer);
@@ -349,14 +348,9 @@ void Simulator::queue_samples_box(float* out) {
   const Int3 o = win.origin(), wn = win.dims();
   const int64_t columns = int64_t(wn.x) * wn.y;
   if (extent_scratch_.size() < size_t(std::max(4 * n, columns))) extent_scratch_.resize(size_t(std::max(4 * n, columns)));
-  if (n > 0) {
-    const float z_top = float(o.z + wn.z);
-    joint_sample_extent(device(), s.x, n, z_top, extent_scratch_.data());
-    for (int c = 0; c < 4; ++c) reduce_max_into(device(), extent_scratch_.data() + c * n, n, out + c, ws_);
-  } else {  // no samples: box_from takes the tips' point
-    const float none[4] = {-1.f, -1.f, -1.f, -1.f};
-    mem::copy_from_host(device(), out, none, sizeof none);
-  }
+  // No sample below the top (or none at all) leaves -inf maxima: box_from takes the tips' point.
+  joint_sample_extent(device(), s.x, n, float(o.z + wn.z), extent_scratch_.data());
+  for (int c = 0; c < 4; ++c) reduce_max_into(device(), extent_scratch_.data() + c * n, n, out + c, ws_);
   // The ground for the next step: the dried paint's top under the footprint (the disc of the
   // brush's half width around where its tips meet the canvas).
   const ParticleParams& pp = config_.params.particles;
@@ -373,8 +367,7 @@ std::array<float, 4> Simulator::box_from(const float m[kExtentValues]) {
   return {-m[1], m[0], -m[3], m[2]};
 }
 
-Int3 Simulator::place_window(const std::array<float, 4>& before, const std::array<float, 4>& after,
-                             float& zone_room) {
+Simulator::WindowPlace Simulator::place_window(const std::array<float, 4>& before, const std::array<float, 4>& after) {
   // The window holds the samples' box over the step (the swept contact lays paint from where
   // each sample was to where it is), centred on it. The particle zone must end inside the kept
   // box: a zone cut by it returns its particles in a strip at every move of the window, a band
@@ -387,12 +380,17 @@ Int3 Simulator::place_window(const std::array<float, 4>& before, const std::arra
   const float x0 = std::min(before[0], after[0]), x1 = std::max(before[1], after[1]);
   const float y0 = std::min(before[2], after[2]), y1 = std::max(before[3], after[3]);
   const Int3 n = grid_->window().dims();
-  const float room = 0.5f * std::min(float(n.x) - (x1 - x0), float(n.y) - (y1 - y0)) - window_margin();
+  const TransferParams& tp = config_.params.transfer;
+  WindowPlace w;
+  w.rim_room = 0.5f * std::min(float(n.x) - (x1 - x0), float(n.y) - (y1 - y0)) - float(kKeepRim) -
+               0.5f * float(config_.params.grid.window_snap);
+  const float room = w.rim_room - tp.return_margin - distance_error(tp);  // the zone's D0 fits in it
   const float D0 = config_.params.particles.D0;
-  const float floor_D0 = std::min(D0, transfer_->params().absorb_range() + distance_error(config_.params.transfer));
+  const float floor_D0 = std::min(D0, transfer_->params().absorb_range() + distance_error(tp));
   zone_D0_ = std::clamp(room, floor_D0, D0);
-  zone_room = room - floor_D0;
-  return grid_->window().origin_for(Vec3(0.5f * (x0 + x1), 0.5f * (y0 + y1), 0.f), config_.params.grid.window_snap);
+  w.zone_room = room - floor_D0;
+  w.origin = grid_->window().origin_for(Vec3(0.5f * (x0 + x1), 0.5f * (y0 + y1), 0.f), config_.params.grid.window_snap);
+  return w;
 }
 
 const float* Simulator::paint_surface() {
@@ -485,11 +483,6 @@ ParticleOverlay Simulator::particle_overlay() {
   return o;
 }
 
-float Simulator::window_margin() const {
-  const TransferParams& tp = config_.params.transfer;
-  return float(kKeepRim) + tp.return_margin + distance_error(tp) + 0.5f * float(config_.params.grid.window_snap);
-}
-
 int Simulator::parts_of_step(const BrushPose* poses, int substeps) const {
   // The swept contact lays paint from where each sample was to where it is, inside the window
   // (place_window centres it on the samples' box over the step). A sweep longer than the window
@@ -556,24 +549,18 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
     const Vec3 moved = footprint_centre(brush_->pose(), config_.brush.length) - tips_before;
     guess_ = {box_before[0] + moved.x, box_before[1] + moved.x, box_before[2] + moved.y, box_before[3] + moved.y};
     box_ = guess_;
-    float zone_room = 0.f;
-    Int3 next = place_window(box_before, box_, zone_room);
-    const float a = 2.f * box_miss_ + 1.f;
-    const Int3 n = grid_->window().dims();
-    const float wx = std::max(box_before[1], guess_[1]) - std::min(box_before[0], guess_[0]);
-    const float wy = std::max(box_before[3], guess_[3]) - std::min(box_before[2], guess_[2]);
-    if (0.5f * std::min(float(n.x) - wx, float(n.y) - wy) - a - 0.5f * float(config_.params.grid.window_snap) <
-        float(kKeepRim)) {
+    WindowPlace w = place_window(box_before, box_);
+    if (w.rim_room < 2.f * box_miss_ + 1.f) {
       box_ = samples_box();
-      next = place_window(box_before, box_, zone_room);
+      w = place_window(box_before, box_);
       ++counters_.box_reads;
     }
     if (config_.particles) {
-      counters_.zone_cut_steps += zone_room < 0.f;
-      counters_.zone_room_min = std::min(counters_.zone_room_min, zone_room);
+      counters_.zone_cut_steps += w.zone_room < 0.f;
+      counters_.zone_room_min = std::min(counters_.zone_room_min, w.zone_room);
     }
-    if (particles_.size() > 0) deposit_leaving_particles(next);
-    grid_->move_window(next);
+    if (particles_.size() > 0) deposit_leaving_particles(w.origin);
+    grid_->move_window(w.origin);
     brush_->rasterize(grid_->window().origin(), grid_->window().dims(), psi_.data(), bristle_v_[0].data(),
                       bristle_v_[1].data(), bristle_v_[2].data());
     grid_->set_bristles(BristleField{psi_.data(), bristle_v_[0].data(), bristle_v_[1].data(), bristle_v_[2].data()});

@@ -219,13 +219,16 @@ class Simulator {
   /// The box of queue_samples_box's values (the tips' point where no sample is below the
   /// window's top); sets ground_.
   std::array<float, 4> box_from(const float m[kExtentValues]);
-  /// Window origin for the samples' box over the step (the union of `before` and `after`), and
-  /// the D0 that keeps the particle zone inside its kept box; `zone_room` is the room left for
-  /// the zone at D0's floor, cells (negative: the window cuts it).
-  Int3 place_window(const std::array<float, 4>& before, const std::array<float, 4>& after, float& zone_room);
-  /// What the window keeps around the samples' box on each side, cells: the kept rim, the
-  /// particles' return margin, the distance blocks' error and half a snap.
-  float window_margin() const;
+  /// Where the window goes for the samples' box over the step (place_window), and the room it
+  /// leaves, cells.
+  struct WindowPlace {
+    Int3 origin;
+    float rim_room;   ///< between the box and the window's rim, less half a snap (the centre's error)
+    float zone_room;  ///< for the particle zone at D0's floor (negative: the window cuts it)
+  };
+  /// The window for the samples' box over the step (the union of `before` and `after`), and the
+  /// D0 that keeps the particle zone inside its kept box (zone_D0_).
+  WindowPlace place_window(const std::array<float, 4>& before, const std::array<float, 4>& after);
   /// How many parts of a step keep each part's sweep of the brush inside the window (step()).
   int parts_of_step(const BrushPose* poses, int substeps) const;
   /// One part of a step: step() in full for the poses' sub-steps.

@@ -273,8 +273,8 @@ void Transfer::update_distance(const SampleView& samples, const TransferEnv& env
   db.block = B;
   db.margin = margin;
   db.D0 = env.D0;
-  // The lattice's shift: the R3 low-discrepancy sequence (Roberts 2018; the plastic number's
-  // powers) over the steps, the same on every backend and for a replay of the same steps.
+  // The lattice's shift: the R3 low-discrepancy sequence (Roberts 2018; the powers of phi_3,
+  // the root of x^4 = x + 1) over the steps, the same on every backend and for a replay of the same steps.
   const double g = 1.2207440846057594, a[3] = {1.0 / g, 1.0 / (g * g), 1.0 / (g * g * g)};
   float sh[3];
   for (int c = 0; c < 3; ++c) {

@@ -339,7 +339,8 @@ void transfer_to_grid_mark(ParticleView p, PaintWindowView pw, DistanceBlocks db
     });
     if (cells > 0) {
       // A window move's pass leaves the particle weightless, in place, to the step's compaction
-      // (no count read back at the move); the step's own pass marks it dead.
+      // (no count read back at the move; the sort after it moves the state, not the dead flags);
+      // the step's own pass marks it dead.
       if (acc.only_leaving)
         p.m[k] = 0.f;
       else
