@@ -35,6 +35,7 @@ FlowRun advect_in_flow(Grid& g, const std::vector<float>& u, const std::vector<f
     g.window().velocity(2).copy_from_host(w);
     g.classify();
     g.advect(dt);
+    g.read_advect_plan();
     const auto rho = host_density(g);
     run.worst = std::max(run.worst, std::fabs(sum(rho) - m0) / m0);
     for (float r : rho) {
@@ -668,6 +669,7 @@ TEST_F(GridStepTest, AdvectionKeepsMassWithoutAnyCorrection) {
     worst = std::max(worst, std::fabs(sum(after) - m0) / m0);
     for (float r : after) lowest = std::min(lowest, double(r));
     if (s > 0) EXPECT_NE(before, after) << "paint frozen at step " << s;  // step 0 has no velocity yet
+    g.read_advect_plan();
     most = std::max(most, g.stats().advect_courant);
     x0 += 0.5f;
   }

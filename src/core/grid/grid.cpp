@@ -204,6 +204,9 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   cg_ticket_.fill_zero();
   advect_max_.set_device(d);
   advect_max_.resize(kAdvectMaxSlots);
+  advect_plan_.set_device(d);
+  advect_plan_.resize(1);
+  advect_plan_.fill_zero();
   const size_t tiles = size_t((g.nx + kPaintTile - 1) / kPaintTile) * size_t((g.ny + kPaintTile - 1) / kPaintTile);
   for (auto* b : {&tile_mark_, &tile_active_, &tile_halo_, &tile_painted_[0], &tile_painted_[1], &tile_process_}) {
     b->set_device(d);
@@ -272,48 +275,27 @@ void Grid::advect(float dt) {
   const int64_t cells = g.cells();
   // The classes and face fractions the advection reads (solids, dried paint never moved) lie in
   // the cells of the paint and particles and a few beyond: those of the columns and layers
-  // holding them first, found on the device, for the outflow rates; the rest once the one read
-  // has told how far the paint moves (below). Beyond, nothing in the step reads them
+  // holding them first, found on the device, for the outflow rates; the rest once the plan
+  // (below) has told how far the paint moves. Beyond, nothing in the step reads them
   // (docs/GRID.md).
   column_maxima(kTraceDensity, kPaintTop);
   grid_first_extent(d, g, advect_max_.data() + kJointTop, advect_extent_.data());
   within(advect_extent_.data(), [&] { classify(); });
   grid_paint_outflow(d, view(), paint.density.data(), face_tmp_.data());
-  // The maxima in one copy: the outflow rate along each axis, the layers holding paint and
-  // those holding paint or particles.
-  // (face_tmp_, one value per face, holds the three rates: there are more faces than 3 cells.)
+  // The outflow rate along each axis (face_tmp_, one value per face, holds the three rates:
+  // there are more faces than 3 cells) make, with the layers holding paint and those holding
+  // paint or particles, the step's plan on the device: the paint's reach along each axis, the
+  // layers and columns its passes visit, and the box the velocity's advection classifies. The
+  // passes run over the device's counts, so the host reads none of it (docs/GRID.md "Work in
+  // proportion to the paint").
   for (int a = 0; a < 3; ++a)
     reduce_max_into(d, face_tmp_.data() + a * cells, cells, advect_max_.data() + kRateX + a, ws_);
-  float maxima[kJointTop + 5];
-  advect_max_.copy_to_host(maxima, kJointTop + 5);
-  // The paint's reach along each axis, cells: the most a painted cell's face carries in the
-  // step, rounded up, and the cell the last part comes from. None where no painted cell's face
-  // carries flow along the axis: its pass would copy.
-  int reach[3];
-  float courant = 0.f;
-  const float longest = float(std::max({g.nx, g.ny, g.nz}));
-  for (int a = 0; a < 3; ++a) {
-    const float c = std::isfinite(maxima[kRateX + a]) ? std::min(maxima[kRateX + a] * dt, longest) : 0.f;
-    reach[a] = c > 0.f ? int(std::ceil(c)) + 1 : 0;
-    courant = std::max(courant, c);
-  }
-  const int top = int(maxima[kPaintTop]), joint_top = int(maxima[kJointTop]);
-  // The velocity's layers (below): the paint's and particles', risen by the paint's reach up,
-  // and the stencils that reach them. Across, the paint's and particles' columns, as far as the
-  // paint reaches along x and y, and the stencils' two cells beyond: the box whose faces the
-  // paint's passes read, and which bounds their walks.
-  const int layers = std::min(g.nz, joint_top + reach[2] + 2);
-  int box[4];
-  column_box(g, maxima + kJointTop + 1, std::max(reach[0], reach[1]) + 2, box);
-  {
-    GridExtent e{};
-    set_extent(e, g, layers, box[0], box[1], box[2], box[3]);
-    advect_extent_.copy_range_from_host(&e, 1, 1);
-    within(advect_extent_.data() + 1, [&] { classify(); });
-  }
-  stats_.advect_passes = (reach[0] > 0) + (reach[1] > 0) + (reach[2] > 0);
-  stats_.advect_courant = courant;
-  if (stats_.advect_passes > 0) within(advect_extent_.data() + 1, [&] { advect_paint(dt, reach, top); });
+  grid_advect_plan(d, g, advect_max_.data() + kRateX, advect_max_.data() + kPaintTop, advect_max_.data() + kJointTop,
+                   dt, advect_plan_.data(), advect_extent_.data() + 1);
+  within(advect_extent_.data() + 1, [&] {
+    classify();
+    advect_paint(dt);
+  });
   // Velocity: backtrace every open face through a copy of the field, up to the layers that can
   // hold liquid in this step. Above, no face is fluid before the projection's extrapolation
   // writes it again, and nothing in the step reads it where there is no paint (docs/GRID.md).
@@ -323,28 +305,27 @@ void Grid::advect(float dt) {
          [&] { grid_advect_velocity(d, view(), vel_tmp_[0].data(), vel_tmp_[1].data(), vel_tmp_[2].data(), dt); });
 }
 
-void Grid::advect_paint(float dt, const int reach[3], int top) {
+void Grid::read_advect_plan() {
+  AdvectPlan p{};
+  advect_plan_.copy_to_host(&p, 1);
+  take_advect_plan(p);
+}
+
+void Grid::advect_paint(float dt) {
   const Device& d = device();
   const GridDims g = dims();
   PaintWindow& paint = window_.paint();
   const GridView v = view();
-  // Work in proportion to the paint: in this step's passes the paint moves at most reach[a]
-  // cells along a, so no cell farther from it (in tiles, and above top + reach[z]) computes a
-  // flux. A pass's walks read at most reach[a] cells beyond a cell it advects, and the last
-  // one's upwind neighbour: the ring of halo tiles and the layers above, which the scratch copy
-  // takes from the paint once (docs/GRID.md "Work in proportion to the paint").
-  const int layers = std::min(g.nz, top + reach[2]);
-  const int deep = std::min(g.nz, layers + reach[2] + 1);
-  const int across = std::max(reach[0], reach[1]);
-  const int reach_tiles = (across + kPaintTile - 1) / kPaintTile;
-  const int halo_tiles = std::max(1, (across + 1 + kPaintTile - 1) / kPaintTile);
+  // Work in proportion to the paint: the plan's tiles within the paint's reach (and the layers
+  // up to its reach up) compute fluxes; the scratch copy takes the ring of halo tiles and the
+  // layers above, which the passes' walks read, from the paint once (docs/GRID.md "Work in
+  // proportion to the paint").
   tile_counts_.fill_zero();
-  grid_paint_tiles(d, g, paint.density.data(), paint.dryness.data(), params_.dry_threshold, top, layers, reach_tiles,
-                   halo_tiles, deep, tile_mark_.data(), tile_active_.data(), tile_halo_.data(), tile_counts_.data(),
-                   pass_below_.data());
+  grid_paint_tiles(d, g, paint.density.data(), paint.dryness.data(), params_.dry_threshold, advect_plan_.data(),
+                   tile_mark_.data(), tile_active_.data(), tile_halo_.data(), tile_counts_.data(), pass_below_.data());
   const int tiles_x = (g.nx + kPaintTile - 1) / kPaintTile, tiles_y = (g.ny + kPaintTile - 1) / kPaintTile;
-  const PaintTiles tiles{tile_active_.data(), tile_halo_.data(), tile_counts_.data(), layers, deep, tiles_x,
-                         int64_t(tiles_x) * tiles_y * kPaintTile * g.nz};
+  const PaintTiles tiles{tile_active_.data(), tile_halo_.data(), tile_counts_.data(),
+                         advect_plan_.data(), tiles_x,           int64_t(tiles_x) * tiles_y * kPaintTile * g.nz};
   grid_copy_paint_tiles(d, g, tiles, paint.view(), paint_tmp_.view(), true);
   // Which tiles held paint that can move after the last pass (before the first: the paint's) and
   // after this one; which the step's passes visit; the layers holding paint after each pass.
@@ -353,32 +334,28 @@ void Grid::advect_paint(float dt, const int reach[3], int top) {
   const size_t tile_bytes = tile_mark_.size() * sizeof(int32_t);
   mem::copy_on_device(d, painted[0], tile_mark_.data(), tile_bytes);
   mem::fill_zero(d, tile_process_.data(), tile_bytes);
-  int made = 0;
+  // A pass along each axis, each the plan's (one along an axis the paint does not flow along
+  // copies: the host does not know which, and the buffers alternate the same way).
   for (int n = 0; n < 3; ++n) {
     const int axis = advect_order_ == 0 ? n : 2 - n;
-    if (reach[axis] == 0) continue;
-    grid_paint_tiles_pass(d, g, tiles, painted[0], axis, (reach[axis] + kPaintTile - 1) / kPaintTile,
-                          tile_process_.data());
+    grid_paint_tiles_pass(d, g, tiles, painted[0], axis, tile_process_.data());
     mem::fill_zero(d, painted[1], tile_bytes);
     mem::copy_on_device(d, below[1], below[0], sizeof(int32_t));
-    grid_advect_paint_axis(d, v, paint.view(), paint_tmp_.view(), axis, dt, reach[axis], params_.dry_threshold, tiles,
+    grid_advect_paint_axis(d, v, paint.view(), paint_tmp_.view(), axis, dt, params_.dry_threshold, tiles,
                            tile_process_.data(), painted[1], below[0], below[1]);
     std::swap(painted[0], painted[1]);
     std::swap(below[0], below[1]);
-    ++made;
 #define WB_X(name, doc) paint.name.swap(paint_tmp_.name);
     WB_PAINT_FIELDS(WB_X)
 #undef WB_X
   }
   advect_order_ = 1 - advect_order_;
-  if (made % 2 == 1) {
-    // An odd number of passes left the result in the scratch buffers, complete only where the
-    // passes wrote: the paint's own buffers are complete elsewhere, so they take the tiles back.
+  // Three passes left the result in the scratch buffers, complete only where the passes wrote:
+  // the paint's own buffers are complete elsewhere, so they take the tiles back.
 #define WB_X(name, doc) paint.name.swap(paint_tmp_.name);
-    WB_PAINT_FIELDS(WB_X)
+  WB_PAINT_FIELDS(WB_X)
 #undef WB_X
-    grid_copy_paint_tiles(d, g, tiles, paint_tmp_.view(), paint.view(), false);
-  }
+  grid_copy_paint_tiles(d, g, tiles, paint_tmp_.view(), paint.view(), false);
 }
 
 void Grid::column_maxima(float trace, int slot) {

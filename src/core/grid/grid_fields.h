@@ -147,15 +147,31 @@ struct CgGuard {
 /// Columns of the window in tiles of kPaintTile x kPaintTile: the paint's advection visits the
 /// tiles within its reach of the paint (docs/GRID.md "Work in proportion to the paint").
 constexpr int kPaintTile = 8;
+/// The paint advection's plan for a step, made on the device from the step's maxima
+/// (grid_advect_plan) so that the host launches the passes without reading them: how far the
+/// paint moves along each axis and the layers and tiles its passes visit. It comes back to the
+/// host with the step's record (Grid::take_advect_plan).
+struct AdvectPlan {
+  int32_t reach[3];  ///< cells a pass along the axis walks: the paint's largest outflow over the step, rounded up, and
+                     ///< 1; 0: the pass copies
+  int32_t top;       ///< the layers holding paint
+  int32_t layers;    ///< the layers the passes advect: top and the reach up
+  int32_t deep;      ///< the layers the passes read: layers, the reach up and a cell more
+  int32_t reach_tiles;  ///< tiles the passes reach across (x or y)
+  int32_t halo_tiles;   ///< the ring of tiles beyond them the passes read
+  int32_t passes;       ///< the axes along which paint flows (reach > 0)
+  float courant;        ///< the largest one-axis outflow of a painted cell over the step, cells
+};
+
 /// The tiles the advection visits (device lists and counts, grid.cpp). counts: the active tiles,
-/// the halo tiles around them, then the cells of the active tiles below `layers`, of the active
-/// tiles below `deep` and of the halo tiles below `deep`, in rows of kPaintTile cells.
+/// the halo tiles around them, then the cells of the active tiles below the plan's `layers`, of
+/// the active tiles below its `deep` and of the halo tiles below `deep`, in rows of kPaintTile
+/// cells.
 struct PaintTiles {
   const int32_t* active;
   const int32_t* halo;
   const int64_t* counts;
-  int layers;  ///< the advection's layers
-  int deep;    ///< the layers its passes read: the paint's reach up and a cell more
+  const AdvectPlan* plan;  ///< the step's reach and layers (device)
   int tiles_x;
   int64_t capacity;  ///< every tile's rows, the window's depth deep (tiles overhang its edges)
 };

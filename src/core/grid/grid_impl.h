@@ -144,6 +144,45 @@ void grid_first_extent(GridDims d, const float* maxima, GridExtent* e) {
   });
 }
 
+void grid_advect_plan(GridDims d, const float* rates, const float* paint_top, const float* joint, float dt,
+                      AdvectPlan* plan, GridExtent* e) {
+  parallel_for(1, [=] WB_HD(int64_t) {
+    // The paint's reach along each axis, cells: the most a painted cell's face carries in the
+    // step, rounded up, and the cell the last part comes from. None where no painted cell's face
+    // carries flow along the axis: its pass copies.
+    AdvectPlan p{};
+    const float longest = float(imax(imax(d.nx, d.ny), d.nz));
+    for (int a = 0; a < 3; ++a) {
+      const float c = isfinite(rates[a]) ? minf(maxf(rates[a] * dt, 0.f), longest) : 0.f;
+      p.reach[a] = c > 0.f ? int(ceilf(c)) + 1 : 0;
+      p.courant = maxf(p.courant, c);
+      p.passes += p.reach[a] > 0;
+    }
+    const int top = int(minf(maxf(*paint_top, 0.f), float(d.nz)));
+    const int joint_top = int(minf(maxf(joint[0], 0.f), float(d.nz)));
+    // The velocity's layers: the paint's and particles', risen by the paint's reach up, and the
+    // stencils that reach them. Across, the paint's and particles' columns, as far as the paint
+    // reaches along x and y, and the stencils' two cells beyond: the box whose faces the paint's
+    // passes read, and which bounds their walks.
+    const int across = imax(p.reach[0], p.reach[1]);
+    int box[4];
+    column_box(d, joint + 1, across + 2, box);
+    GridExtent x{};
+    set_extent(x, d, imin(d.nz, joint_top + p.reach[2] + 2), box[0], box[1], box[2], box[3]);
+    *e = x;
+    // The paint's passes (Grid::advect_paint): in them the paint moves at most reach[a] cells
+    // along a, so no cell farther from it (in tiles, and above top + reach[z]) computes a flux.
+    // Their walks read at most reach[a] cells beyond a cell they advect, and the last one's
+    // upwind neighbour: the ring of halo tiles and the layers above.
+    p.top = top;
+    p.layers = imin(d.nz, top + p.reach[2]);
+    p.deep = imin(d.nz, p.layers + p.reach[2] + 1);
+    p.reach_tiles = (across + kPaintTile - 1) / kPaintTile;
+    p.halo_tiles = imax(1, (across + 1 + kPaintTile - 1) / kPaintTile);
+    *plan = p;
+  });
+}
+
 void grid_paint_outflow(GridView g, const float* rho, float* out) {
   const GridDims d = g.d;
   const int64_t n = d.cells();
@@ -163,27 +202,28 @@ void grid_paint_outflow(GridView g, const float* rho, float* out) {
 }
 
 namespace detail {
-/// Row q of the tiles in `list`, `layers` deep: each element is a row of kPaintTile cells along x
+/// Row q of the tiles in `list`, *layers deep: each element is a row of kPaintTile cells along x
 /// (tile-major, then k, then the tile's rows), so the index arithmetic is paid once a row and the
 /// row's cells are contiguous. fn(t, c) for each of its cells inside the window (t its tile);
 /// with `process`, only in the tiles it flags; with `below`, only in the layers under *below +
-/// rise.
+/// *rise. The depths are the step's plan's, on the device.
 template <class F>
 struct TileCells {
   GridDims d;
   const int32_t* list;
-  int tiles_x, layers;
+  int tiles_x;
+  const int32_t* layers;
   F fn;
   const int32_t* process = nullptr;
   const int32_t* below = nullptr;
-  int rise = 0;
+  const int32_t* rise = nullptr;
   WB_HD void operator()(int64_t q) const {
-    const uint32_t per_tile = uint32_t(kPaintTile) * uint32_t(layers), e = uint32_t(q);
+    const uint32_t per_tile = uint32_t(kPaintTile) * uint32_t(*layers), e = uint32_t(q);
     const int32_t t = list[e / per_tile];
     if (process && !process[t]) return;
     const uint32_t r = e % per_tile;
     const int k = int(r / kPaintTile), j = (t / tiles_x) * kPaintTile + int(r % kPaintTile);
-    if (j >= d.ny || (below && k >= *below + rise)) return;
+    if (j >= d.ny || (below && k >= *below + (rise ? *rise : 0))) return;
     const int i0 = (t % tiles_x) * kPaintTile, i1 = i0 + kPaintTile < d.nx ? i0 + kPaintTile : d.nx;
     const int64_t row = d.cell(0, j, k);
     for (int i = i0; i < i1; ++i) fn(t, row + i);
@@ -191,45 +231,52 @@ struct TileCells {
 };
 }  // namespace detail
 
-void grid_paint_tiles(GridDims d, const float* rho, const float* dryness, float dry_threshold, int top, int layers,
-                      int reach, int halo_width, int deep, int32_t* mark, int32_t* active, int32_t* halo,
-                      int64_t* counts, int32_t* below) {
+void grid_paint_tiles(GridDims d, const float* rho, const float* dryness, float dry_threshold, const AdvectPlan* plan,
+                      int32_t* mark, int32_t* active, int32_t* halo, int64_t* counts, int32_t* below) {
   const int tx = (d.nx + kPaintTile - 1) / kPaintTile, ty = (d.ny + kPaintTile - 1) / kPaintTile;
-  parallel_for(int64_t(tx) * ty, [=] WB_HD(int64_t t) {
-    const int i0 = int(t % tx) * kPaintTile, j0 = int(t / tx) * kPaintTile;
-    int32_t any = 0;
-    // Paint that can move: dried solid paint (a canvas's ground, a dried layer) stays put.
-    for (int k = 0; k < layers && !any; ++k)
-      for (int j = j0; j < j0 + kPaintTile && j < d.ny && !any; ++j)
-        for (int i = i0; i < i0 + kPaintTile && i < d.nx; ++i) {
-          const int64_t c = d.cell(i, j, k);
-          if (rho[c] > 0.f && !dried_solid(rho[c], dryness[c], dry_threshold)) {
-            any = 1;
-            break;
-          }
-        }
-    mark[t] = any;
-  }, 1);
-  // A tile within `reach` tiles of paint is advected; the ring of `halo_width` tiles beyond it
+  parallel_for(
+      int64_t(tx) * ty,
+      [=] WB_HD(int64_t t) {
+        const int i0 = int(t % tx) * kPaintTile, j0 = int(t / tx) * kPaintTile, layers = plan->layers;
+        int32_t any = 0;
+        // Paint that can move: dried solid paint (a canvas's ground, a dried layer) stays put.
+        for (int k = 0; k < layers && !any; ++k)
+          for (int j = j0; j < j0 + kPaintTile && j < d.ny && !any; ++j)
+            for (int i = i0; i < i0 + kPaintTile && i < d.nx; ++i) {
+              const int64_t c = d.cell(i, j, k);
+              if (rho[c] > 0.f && !dried_solid(rho[c], dryness[c], dry_threshold)) {
+                any = 1;
+                break;
+              }
+            }
+        mark[t] = any;
+      },
+      1);
+  // A tile within the plan's reach_tiles of paint is advected; the ring of halo_tiles beyond it
   // is the halo the advected cells read (their faces' walks and the last cell's slope).
-  parallel_for(int64_t(tx) * ty, [=] WB_HD(int64_t t) {
-    const int x = int(t % tx), y = int(t / tx), far = reach + halo_width;
-    int best = far + 1;
-    for (int b = y - far; b <= y + far; ++b)
-      for (int a = x - far; a <= x + far; ++a) {
-        if (a < 0 || b < 0 || a >= tx || b >= ty || !mark[int64_t(b) * tx + a]) continue;
-        const int dx = a > x ? a - x : x - a, dy = b > y ? b - y : y - b;
-        const int dist = dx > dy ? dx : dy;
-        best = best < dist ? best : dist;
-      }
-    if (best <= reach) active[atomic_add(&counts[0], int64_t(1))] = int32_t(t);
-    else if (best <= far) halo[atomic_add(&counts[1], int64_t(1))] = int32_t(t);
-  }, 1);
+  parallel_for(
+      int64_t(tx) * ty,
+      [=] WB_HD(int64_t t) {
+        const int reach = plan->reach_tiles, x = int(t % tx), y = int(t / tx), far = reach + plan->halo_tiles;
+        int best = far + 1;
+        for (int b = y - far; b <= y + far; ++b)
+          for (int a = x - far; a <= x + far; ++a) {
+            if (a < 0 || b < 0 || a >= tx || b >= ty || !mark[int64_t(b) * tx + a]) continue;
+            const int dx = a > x ? a - x : x - a, dy = b > y ? b - y : y - b;
+            const int dist = dx > dy ? dx : dy;
+            best = best < dist ? best : dist;
+          }
+        if (best <= reach)
+          active[atomic_add(&counts[0], int64_t(1))] = int32_t(t);
+        else if (best <= far)
+          halo[atomic_add(&counts[1], int64_t(1))] = int32_t(t);
+      },
+      1);
   parallel_for(1, [=] WB_HD(int64_t) {
-    counts[2] = counts[0] * kPaintTile * layers;  // rows of kPaintTile cells (TileCells)
-    counts[3] = counts[0] * kPaintTile * deep;
-    counts[4] = counts[1] * kPaintTile * deep;
-    *below = top;  // the layers holding paint before the first pass
+    counts[2] = counts[0] * kPaintTile * plan->layers;  // rows of kPaintTile cells (TileCells)
+    counts[3] = counts[0] * kPaintTile * plan->deep;
+    counts[4] = counts[1] * kPaintTile * plan->deep;
+    *below = plan->top;  // the layers holding paint before the first pass
   });
 }
 
@@ -243,24 +290,24 @@ void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, Pa
   // reads: every cell the passes read (the listed and halo tiles, `deep` layers); else the cells
   // they write.
   using Rows = detail::TileCells<decltype(copy)>;
+  const int32_t* deep = &tiles.plan->deep;
   parallel_for_count(tiles.counts + (reads ? 3 : 2), tiles.capacity,
-                     Rows{d, tiles.active, tiles.tiles_x, reads ? tiles.deep : tiles.layers, copy});
-  if (reads)
-    parallel_for_count(tiles.counts + 4, tiles.capacity, Rows{d, tiles.halo, tiles.tiles_x, tiles.deep, copy});
+                     Rows{d, tiles.active, tiles.tiles_x, reads ? deep : &tiles.plan->layers, copy});
+  if (reads) parallel_for_count(tiles.counts + 4, tiles.capacity, Rows{d, tiles.halo, tiles.tiles_x, deep, copy});
 }
 
-void grid_paint_tiles_pass(GridDims d, PaintTiles tiles, const int32_t* before, int axis, int reach_tiles,
-                           int32_t* process) {
-  // A pass along an axis moves paint only along it, at most reach_tiles tiles: a tile with no
+void grid_paint_tiles_pass(GridDims d, PaintTiles tiles, const int32_t* before, int axis, int32_t* process) {
+  // A pass along an axis moves paint only along it, at most its reach in tiles: a tile with no
   // paint that far along the axis (after the last pass; before the first: the paint's) gets
   // none and gives none. It is skipped when no pass of the step has visited it either: then the
   // buffer it would write holds its cells already (the scratch copy's, or those of two passes
   // ago, which the pass between left unchanged). So the flags gather over the step's passes.
   const int tx = tiles.tiles_x, ty = (d.ny + kPaintTile - 1) / kPaintTile;
   const int32_t* active = tiles.active;
+  const AdvectPlan* plan = tiles.plan;
   parallel_for_count(tiles.counts, tiles.capacity, [=] WB_HD(int64_t slot) {
     const int32_t t = active[slot];
-    const int x = t % tx, y = t / tx;
+    const int x = t % tx, y = t / tx, reach_tiles = (plan->reach[axis] + kPaintTile - 1) / kPaintTile;
     const int rx = axis == 0 ? reach_tiles : 0, ry = axis == 1 ? reach_tiles : 0;
     int32_t busy = process[t];
     for (int b = y - ry; b <= y + ry && !busy; ++b)
@@ -273,13 +320,15 @@ void grid_paint_tiles_pass(GridDims d, PaintTiles tiles, const int32_t* before, 
   });
 }
 
-void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt, int reach,
+void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt,
                             float dry_threshold, PaintTiles tiles, const int32_t* process, int32_t* painted,
                             const int32_t* below, int32_t* below_next) {
   WB_REQUIRE(g.extent, "grid advection: the paint's box is not set");
   const GridDims d = g.d;
   const GridExtent* box = g.extent;
+  const int32_t* reach_at = &tiles.plan->reach[axis];
   auto cell = [=] WB_HD(int32_t t, int64_t c) {
+    const int reach = *reach_at;
     int i, j, k;
     d.decompose_cell(c, i, j, k);
     // The cells whose faces were classified this step: paint moves within them (Grid::advect).
@@ -291,6 +340,18 @@ void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst
     // A pass along z may change every layer it visits: the passes after it visit them too, so
     // that none is left with what the buffer held two passes ago.
     if (axis == 2 && k + 1 > atomic_load(below_next)) atomic_max(below_next, k + 1);
+    if (reach == 0) {
+      // No painted cell's face carries flow along the axis: the pass copies, and its paint that
+      // can move is where the next passes look for it.
+#define WB_X(name, doc) dst.name[c] = src.name[c];
+      WB_PAINT_FIELDS(WB_X)
+#undef WB_X
+      if (src.density[c] > 0.f && !dried_solid(src.density[c], src.dryness[c], dry_threshold)) {
+        if (!atomic_load(&painted[t])) atomic_or(&painted[t], 1);
+        if (k + 1 > atomic_load(below_next)) atomic_max(below_next, k + 1);
+      }
+      return;
+    }
     // Air stays air: no walk of the cell's faces can reach paint when none lies within the reach.
     bool near = false;
     for (int o = -reach; o <= reach && inside && !near; ++o)
@@ -330,10 +391,10 @@ void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst
     carry(src.oil, in.oil, out.oil, dst.oil);
     dst.dryness[c] = dry_new;
   };
-  // A pass along z lifts paint at most `reach` layers above those holding it.
+  // A pass along z lifts paint at most its reach in layers above those holding it.
   parallel_for_count(tiles.counts + 2, tiles.capacity,
-                     detail::TileCells<decltype(cell)>{d, tiles.active, tiles.tiles_x, tiles.layers, cell, process,
-                                                       below, axis == 2 ? reach : 0});
+                     detail::TileCells<decltype(cell)>{d, tiles.active, tiles.tiles_x, &tiles.plan->layers, cell,
+                                                       process, below, axis == 2 ? reach_at : nullptr});
 }
 
 void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt) {

@@ -134,10 +134,12 @@ PaintCensus Simulator::record_census(TransferRecord& rec) {
     mem::copy_on_device(device(), d->canvas_sums, canvas_->mass_sums(), 2 * sizeof(double));
     mem::copy_on_device(device(), &d->gathered, win.gathered_sum(), sizeof(double));
     mem::copy_on_device(device(), &d->tiles_used, canvas_->tiles_used(), sizeof(int32_t));
+    mem::copy_on_device(device(), &d->advect, grid_->advect_plan(), sizeof(AdvectPlan));
     StepSums r{};
     step_sums_.copy_to_host(&r, 1);
     step_sums_.fill_zero();
     canvas_->take_tiles_used(r.tiles_used);
+    grid_->take_advect_plan(r.advect);
     canvas_->take_mass_sums(r.canvas_sums);
     win.set_gathered_mass(r.gathered);
     if (take == 0) {

@@ -264,6 +264,7 @@ class Simulator {
     double gathered;        ///< the window region's density at its last gather
     float extent[kExtentValues];  ///< the samples' box and the ground at the step's end (queue_samples_box)
     int32_t tiles_used;           ///< the canvas's slots in use (TileStore::tiles_used)
+    AdvectPlan advect;            ///< the grid's advection plan (Grid::take_advect_plan)
   };
   DeviceBuffer<StepSums> step_sums_;
   StepSums last_record_{};            ///< the last read of step_sums_
