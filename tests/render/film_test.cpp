@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <optional>
 
 #include "backend_fixture.h"
 #include "core/color/ryb.h"
@@ -377,6 +378,56 @@ TEST_F(FilmTest, IncrementalCacheMatchesFullRenderOverFilms) {
   for (int y = 0; y < 256; ++y)
     for (int x = 0; x < 256; ++x)
       ASSERT_EQ(std::memcmp(inc.at(x, y), full.at(x, y), 4), 0) << "incremental differs from full at " << x << "," << y;
+}
+
+TEST_F(FilmTest, PaintTooLittleToSeeIsNotSeen) {
+  // Paint of subnormal density (below 1.2e-38 of a cell: the traces a flux or a return leaves) in
+  // columns with one pigment channel at 0, beside a thin film and on bare canvas: a mean weighted
+  // by so little paint taken as a product with its reciprocal (which overflows) gave 0 x inf = NaN,
+  // black specks on a raking-light view of press-and-drag, and an infinite oil that sent the
+  // pigment's gather below the surface down an endless ray (this canvas's render had not ended
+  // after 13 minutes). Every output is finite, and on bare canvas the traces render as the canvas
+  // without them.
+  const Vec3 red(0.9f, 0.15f, 0.f);
+  TileStore bare(device_, CanvasDims{kN, kN, 16});
+  fill_volume(bare, kLo, kLo, kHi, kHi, [=](int x, int, int z) { return layer(x < 32 ? 0.3f : 0.f, z, red, 0.3f); });
+  TileStore traces(device_, CanvasDims{kN, kN, 16});
+  fill_volume(traces, kLo, kLo, kHi, kHi, [=](int x, int y, int z) {
+    PaintCell p = layer(x < 32 ? 0.3f : 0.f, z, red, 0.3f);
+    // Every fourth column right of the film holds a trace, from 1e-45 (the least subnormal) up.
+    if (x >= 32 && (x + y) % 4 == 0 && z < 2) {
+      p = layer(1.f, 0, red, 0.3f);
+      p.density = (y % 3 == 0 ? 1e-45f : (y % 3 == 1 ? 1e-40f : 3e-39f)) * float(z + 1);
+    }
+    return p;
+  });
+  Renderer r(device_);
+  r.params().light_dir = Vec3(-1.f, 0.2f, 0.2f);
+  const FloatImage a = r.render_albedo(traces), n = r.render_normal_map(traces), h = r.render_height_map(traces);
+  for (int y = 0; y < kN; ++y)
+    for (int x = 0; x < kN; ++x)
+      for (int k = 0; k < 3; ++k) {
+        ASSERT_TRUE(std::isfinite(a.at(x, y, k))) << "albedo at " << x << "," << y;
+        ASSERT_TRUE(std::isfinite(n.at(x, y, k))) << "normal at " << x << "," << y;
+      }
+  for (int y = 0; y < kN; ++y)
+    for (int x = 0; x < kN; ++x) ASSERT_TRUE(std::isfinite(h.at(x, y))) << "height at " << x << "," << y;
+  for (int y = kLo; y < kHi; y += 3)
+    for (int x = 32; x < kHi; ++x) {
+      const std::optional<Vec3> p = r.pigment_at(traces, x, y);
+      if (p) ASSERT_TRUE(std::isfinite(p->x) && std::isfinite(p->y) && std::isfinite(p->z)) << x << "," << y;
+    }
+  for (float zoom : {1.f, 4.f}) {
+    const Image with = r.render(traces, Camera::top_region(0, 0, kN, kN, zoom));
+    const Image without = r.render(bare, Camera::top_region(0, 0, kN, kN, zoom));
+    int worst = 0;
+    // Away from the film's edge (a trace beside it takes the edge's slope, as any paint there does).
+    for (int y = 0; y < with.height; ++y)
+      for (int x = int(34 * zoom); x < with.width; ++x)
+        for (int k = 0; k < 3; ++k) worst = std::max(worst, std::abs(int(with.at(x, y)[k]) - int(without.at(x, y)[k])));
+    std::printf("zoom %.0f: the largest difference the traces make, %d of 255\n", zoom, worst);
+    EXPECT_LE(worst, 2) << "zoom " << zoom;
+  }
 }
 
 TEST_F(FilmTest, GoldenFilms) {

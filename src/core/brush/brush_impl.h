@@ -380,10 +380,9 @@ void samples_rasterize_finish(int64_t cells, float* psi, float* vx, float* vy, f
   parallel_for(cells, [=] WB_HD(int64_t i) {
     const float p = psi[i];
     if (p <= 0.f) return;
-    const float inv = 1.f / p;
-    vx[i] *= inv;
-    vy[i] *= inv;
-    vz[i] *= inv;
+    vx[i] /= p;  // divided: p may be subnormal
+    vy[i] /= p;
+    vz[i] /= p;
     psi[i] = minf(p, 1.f);
   });
 }

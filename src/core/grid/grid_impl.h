@@ -460,14 +460,15 @@ void grid_film_columns(GridDims d, const GridExtent* e, PaintWindowView pw, Bris
       h += rho, oil += rho * pw.oil[id], dry += rho * pw.dryness[id];
       r += rho * pw.pigment_r[id], y += rho * pw.pigment_y[id], b += rho * pw.pigment_b[id];
     }
-    const float w = h > 0.f ? 1.f / h : 0.f;
+    // Means by division (a trace's h may be subnormal: its reciprocal overflows).
+    const auto mean = [h](float q) { return h > 0.f ? q / h : 0.f; };
     // The bristles and the particles' paint are the grid's and the transfer's business; a bare
     // column is a film of nothing that paint may flow onto.
     col[kFilmH * n + c] = (h <= film_max && !touched) ? h : -1.f;
     col[kFilmBase * n + c] = base;
     col[kFilmAbove * n + c] = float(above);
-    col[kFilmOil * n + c] = oil * w, col[kFilmDry * n + c] = dry * w;
-    col[kFilmR * n + c] = r * w, col[kFilmY * n + c] = y * w, col[kFilmB * n + c] = b * w;
+    col[kFilmOil * n + c] = mean(oil), col[kFilmDry * n + c] = mean(dry);
+    col[kFilmR * n + c] = mean(r), col[kFilmY * n + c] = mean(y), col[kFilmB * n + c] = mean(b);
   });
 }
 
@@ -522,10 +523,9 @@ void grid_film_update(GridDims d, const float* col, FilmFlow f, float* next) {
       oil += in[s] * col[kFilmOil * n + o], dry += in[s] * col[kFilmDry * n + o];
       m += in[s];
     }
-    const float w = m > 0.f ? 1.f / m : 0.f;
     next[kFilmH * n + c] = m;
     next[kFilmR * n + c] = p.x, next[kFilmY * n + c] = p.y, next[kFilmB * n + c] = p.z;
-    next[kFilmOil * n + c] = oil * w, next[kFilmDry * n + c] = dry * w;
+    next[kFilmOil * n + c] = m > 0.f ? oil / m : 0.f, next[kFilmDry * n + c] = m > 0.f ? dry / m : 0.f;
     next[kFilmMoved * n + c] = col[kFilmMoved * n + c] + out + gain;
   });
 }

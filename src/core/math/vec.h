@@ -21,7 +21,9 @@ WB_HD WB_INLINE Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a
 WB_HD WB_INLINE Vec3 operator-(Vec3 a) { return {-a.x, -a.y, -a.z}; }
 WB_HD WB_INLINE Vec3 operator*(Vec3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
 WB_HD WB_INLINE Vec3 operator*(float s, Vec3 a) { return {a.x * s, a.y * s, a.z * s}; }
-WB_HD WB_INLINE Vec3 operator/(Vec3 a, float s) { return a * (1.f / s); }
+// Each component divided: a weighted mean of paint divides by a weight that may be subnormal,
+// whose reciprocal overflows (0 x inf = NaN where a component is 0).
+WB_HD WB_INLINE Vec3 operator/(Vec3 a, float s) { return {a.x / s, a.y / s, a.z / s}; }
 WB_HD WB_INLINE Vec3& operator+=(Vec3& a, Vec3 b) { return a = a + b; }
 WB_HD WB_INLINE Vec3& operator-=(Vec3& a, Vec3 b) { return a = a - b; }
 WB_HD WB_INLINE Vec3& operator*=(Vec3& a, float s) { return a = a * s; }

@@ -269,11 +269,10 @@ WB_HD WB_INLINE FilmSample film_at(const RenderVolume& v, float x, float y, bool
     }
   }
   if (f.height > 0.f) {
-    if (f.thin > 0.f) {
-      const float s = 1.f / f.thin;
-      f.paint.ryb = f.paint.ryb * s;
-      f.paint.oil *= s;
-      f.paint.dryness *= s;
+    if (f.thin > 0.f) {  // divided, not multiplied by 1 / thin: the weights may be subnormal
+      f.paint.ryb = f.paint.ryb / f.thin;
+      f.paint.oil /= f.thin;
+      f.paint.dryness /= f.thin;
     }
     f.thin /= f.height;
     f.paint.density = f.height;
@@ -282,10 +281,9 @@ WB_HD WB_INLINE FilmSample film_at(const RenderVolume& v, float x, float y, bool
     f.coat = stack;
     f.coat_paint.density /= wc;
     if (with_paint) {
-      const float s = 1.f / wc;
-      f.coat_paint.ryb = f.coat_paint.ryb * s;
-      f.coat_paint.oil *= s;
-      f.coat_paint.dryness *= s;
+      f.coat_paint.ryb = f.coat_paint.ryb / wc;
+      f.coat_paint.oil /= wc;
+      f.coat_paint.dryness /= wc;
     }
   }
   return f;
@@ -396,7 +394,8 @@ WB_HD WB_INLINE void pixel_ray(const CameraBasis& cam, float i, float j, Vec3& g
 /// converts it to RGB once.
 WB_HD WB_INLINE Vec3 gather_pigment(const RenderVolume& v, const RenderParams& P, Vec3 hit, Vec3 dir, Vec3 n,
                                     PaintSample surf) {
-  const float L = surf.oil * P.penetration_per_oil;
+  // The oil is a fraction: its domain keeps the walk finite whatever a cell holds.
+  const float L = clampf(surf.oil, 0.f, 1.f) * P.penetration_per_oil;
   if (!(L > P.penetration_step)) return surf.ryb;
   Vec3 acc = surf.ryb;
   float wsum = 1.f;

@@ -93,9 +93,16 @@ void render_top_map(RenderVolume v, RenderParams P, int x0, int y0, int w, int h
         oil += c.density * c.oil;
         dry += c.density * c.dryness;
       }
-      const float s = 1.f / total;
-      f = FilmColumn{sum, encode_unorm16(r * s), encode_unorm16(yy * s), encode_unorm16(b * s),
-                     encode_unorm16(oil * s), encode_unorm16(dry * s), encode_unorm16(thin), 0.f, 0.f};
+      // Divided, not multiplied by 1 / total: a trace's total may be subnormal.
+      f = FilmColumn{sum,
+                     encode_unorm16(r / total),
+                     encode_unorm16(yy / total),
+                     encode_unorm16(b / total),
+                     encode_unorm16(oil / total),
+                     encode_unorm16(dry / total),
+                     encode_unorm16(thin),
+                     0.f,
+                     0.f};
       if (coat) f.coat_thick = above;
     }
     // Every thick column's stack (the paint from the bottom of its top thick cell): a coat's

@@ -157,8 +157,7 @@ WB_HD WB_INLINE int for_each_kernel_cell(const PaintWindowView& pw, Vec3 q, floa
     ++n;
   });
   if (!(sum > 0.f)) return 0;
-  const float inv = 1.f / sum;
-  visit([&](int64_t id, float w) { f(id, w * inv); });
+  visit([&](int64_t id, float w) { f(id, w / sum); });  // divided: sum may be subnormal
   return n;
 }
 
