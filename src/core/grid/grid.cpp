@@ -334,27 +334,23 @@ void Grid::advect_paint(float dt) {
   const size_t tile_bytes = tile_mark_.size() * sizeof(int32_t);
   mem::copy_on_device(d, painted[0], tile_mark_.data(), tile_bytes);
   mem::fill_zero(d, tile_process_.data(), tile_bytes);
-  // A pass along each axis, each the plan's (one along an axis the paint does not flow along
-  // copies: the host does not know which, and the buffers alternate the same way).
+  // A pass along each axis. The host does not know along which the paint flows: a pass along an
+  // axis without flow (the plan's reach 0) writes nothing and hands its flags on, and each pass
+  // that moves paint reads the buffers the last one wrote (advect_in_scratch), on the device.
   for (int n = 0; n < 3; ++n) {
     const int axis = advect_order_ == 0 ? n : 2 - n;
-    grid_paint_tiles_pass(d, g, tiles, painted[0], axis, tile_process_.data());
     mem::fill_zero(d, painted[1], tile_bytes);
     mem::copy_on_device(d, below[1], below[0], sizeof(int32_t));
-    grid_advect_paint_axis(d, v, paint.view(), paint_tmp_.view(), axis, dt, params_.dry_threshold, tiles,
-                           tile_process_.data(), painted[1], below[0], below[1]);
+    grid_paint_tiles_pass(d, g, tiles, painted[0], axis, tile_process_.data(), painted[1]);
+    grid_advect_paint_axis(d, v, paint.view(), paint_tmp_.view(), axis, n, advect_order_, dt, params_.dry_threshold,
+                           tiles, tile_process_.data(), painted[1], below[0], below[1]);
     std::swap(painted[0], painted[1]);
     std::swap(below[0], below[1]);
-#define WB_X(name, doc) paint.name.swap(paint_tmp_.name);
-    WB_PAINT_FIELDS(WB_X)
-#undef WB_X
   }
   advect_order_ = 1 - advect_order_;
-  // Three passes left the result in the scratch buffers, complete only where the passes wrote:
-  // the paint's own buffers are complete elsewhere, so they take the tiles back.
-#define WB_X(name, doc) paint.name.swap(paint_tmp_.name);
-  WB_PAINT_FIELDS(WB_X)
-#undef WB_X
+  // An odd number of passes that moved paint left the result in the scratch buffers, complete
+  // only where the passes wrote: the paint's own buffers are complete elsewhere, so they take
+  // those tiles back (the copy does nothing after an even number).
   grid_copy_paint_tiles(d, g, tiles, paint_tmp_.view(), paint.view(), false);
 }
 

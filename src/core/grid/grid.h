@@ -239,11 +239,13 @@ class Grid {
     (d, rates, paint_top, joint, dt, plan, e))                                                                         \
   X(void, grid_paint_outflow, (GridView g, const float* rho, float* out), (g, rho, out))                               \
   X(void, grid_advect_paint_axis,                                                                                      \
-    (GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt, float dry_threshold, PaintTiles tiles,  \
-     const int32_t* process, int32_t* painted, const int32_t* below, int32_t* below_next),                             \
-    (g, src, dst, axis, dt, dry_threshold, tiles, process, painted, below, below_next))                                \
-  X(void, grid_paint_tiles_pass, (GridDims d, PaintTiles tiles, const int32_t* before, int axis, int32_t* process),    \
-    (d, tiles, before, axis, process))                                                                                 \
+    (GridView g, PaintWindowView paint, PaintWindowView scratch, int axis, int pass, int order, float dt,              \
+     float dry_threshold, PaintTiles tiles, const int32_t* process, int32_t* painted, const int32_t* below,            \
+     int32_t* below_next),                                                                                             \
+    (g, paint, scratch, axis, pass, order, dt, dry_threshold, tiles, process, painted, below, below_next))             \
+  X(void, grid_paint_tiles_pass,                                                                                       \
+    (GridDims d, PaintTiles tiles, const int32_t* before, int axis, int32_t* process, int32_t* after),                 \
+    (d, tiles, before, axis, process, after))                                                                          \
   X(void, grid_paint_tiles,                                                                                            \
     (GridDims d, const float* rho, const float* dryness, float dry_threshold, const AdvectPlan* plan, int32_t* mark,   \
      int32_t* active, int32_t* halo, int64_t* counts, int32_t* below),                                                 \

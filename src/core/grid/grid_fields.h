@@ -163,6 +163,15 @@ struct AdvectPlan {
   float courant;        ///< the largest one-axis outflow of a painted cell over the step, cells
 };
 
+/// Whether the passes of a step before its pass n (the axes in `order`: 0 x y z, 1 z y x) left
+/// the paint in the scratch buffers: each pass along an axis with flow writes the buffers the
+/// last one read from; one along an axis without flow writes nothing.
+WB_HD WB_INLINE bool advect_in_scratch(const AdvectPlan& p, int order, int n) {
+  int made = 0;
+  for (int m = 0; m < n; ++m) made += p.reach[order == 0 ? m : 2 - m] > 0 ? 1 : 0;
+  return made % 2 == 1;
+}
+
 /// The tiles the advection visits (device lists and counts, grid.cpp). counts: the active tiles,
 /// the halo tiles around them, then the cells of the active tiles below the plan's `layers`, of
 /// the active tiles below its `deep` and of the halo tiles below `deep`, in rows of kPaintTile

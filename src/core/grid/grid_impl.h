@@ -282,13 +282,16 @@ void grid_paint_tiles(GridDims d, const float* rho, const float* dryness, float 
 
 void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst,
                            bool reads) {
+  const AdvectPlan* plan = tiles.plan;
   auto copy = [=] WB_HD(int32_t, int64_t c) {
+    // The passes' result comes back only where an odd number of them left it in the scratch.
+    if (!reads && plan->passes % 2 == 0) return;
 #define WB_X(name, doc) dst.name[c] = src.name[c];
     WB_PAINT_FIELDS(WB_X)
 #undef WB_X
   };
-  // reads: every cell the passes read (the listed and halo tiles, `deep` layers); else the cells
-  // they write.
+  // reads: every cell the passes read (the listed and halo tiles, `deep` layers), copied from the
+  // paint into the scratch; else the cells they write, back from the scratch.
   using Rows = detail::TileCells<decltype(copy)>;
   const int32_t* deep = &tiles.plan->deep;
   parallel_for_count(tiles.counts + (reads ? 3 : 2), tiles.capacity,
@@ -296,7 +299,8 @@ void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, Pa
   if (reads) parallel_for_count(tiles.counts + 4, tiles.capacity, Rows{d, tiles.halo, tiles.tiles_x, deep, copy});
 }
 
-void grid_paint_tiles_pass(GridDims d, PaintTiles tiles, const int32_t* before, int axis, int32_t* process) {
+void grid_paint_tiles_pass(GridDims d, PaintTiles tiles, const int32_t* before, int axis, int32_t* process,
+                           int32_t* after) {
   // A pass along an axis moves paint only along it, at most its reach in tiles: a tile with no
   // paint that far along the axis (after the last pass; before the first: the paint's) gets
   // none and gives none. It is skipped when no pass of the step has visited it either: then the
@@ -307,6 +311,10 @@ void grid_paint_tiles_pass(GridDims d, PaintTiles tiles, const int32_t* before, 
   const AdvectPlan* plan = tiles.plan;
   parallel_for_count(tiles.counts, tiles.capacity, [=] WB_HD(int64_t slot) {
     const int32_t t = active[slot];
+    if (plan->reach[axis] == 0) {
+      after[t] = before[t];  // no flow along the axis: the pass moves nothing, and visits nothing
+      return;
+    }
     const int x = t % tx, y = t / tx, reach_tiles = (plan->reach[axis] + kPaintTile - 1) / kPaintTile;
     const int rx = axis == 0 ? reach_tiles : 0, ry = axis == 1 ? reach_tiles : 0;
     int32_t busy = process[t];
@@ -320,15 +328,21 @@ void grid_paint_tiles_pass(GridDims d, PaintTiles tiles, const int32_t* before, 
   });
 }
 
-void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst, int axis, float dt,
-                            float dry_threshold, PaintTiles tiles, const int32_t* process, int32_t* painted,
+void grid_advect_paint_axis(GridView g, PaintWindowView paint, PaintWindowView scratch, int axis, int pass, int order,
+                            float dt, float dry_threshold, PaintTiles tiles, const int32_t* process, int32_t* painted,
                             const int32_t* below, int32_t* below_next) {
   WB_REQUIRE(g.extent, "grid advection: the paint's box is not set");
   const GridDims d = g.d;
   const GridExtent* box = g.extent;
-  const int32_t* reach_at = &tiles.plan->reach[axis];
+  const AdvectPlan* plan = tiles.plan;
+  const int32_t* reach_at = &plan->reach[axis];
   auto cell = [=] WB_HD(int32_t t, int64_t c) {
     const int reach = *reach_at;
+    if (reach == 0) return;  // no flow along the axis: the next pass reads where this one would have
+    // The buffers alternate with the passes that move paint (advect_in_scratch).
+    const bool flip = advect_in_scratch(*plan, order, pass);
+    const PaintWindowView& src = flip ? scratch : paint;
+    const PaintWindowView& dst = flip ? paint : scratch;
     int i, j, k;
     d.decompose_cell(c, i, j, k);
     // The cells whose faces were classified this step: paint moves within them (Grid::advect).
@@ -340,18 +354,6 @@ void grid_advect_paint_axis(GridView g, PaintWindowView src, PaintWindowView dst
     // A pass along z may change every layer it visits: the passes after it visit them too, so
     // that none is left with what the buffer held two passes ago.
     if (axis == 2 && k + 1 > atomic_load(below_next)) atomic_max(below_next, k + 1);
-    if (reach == 0) {
-      // No painted cell's face carries flow along the axis: the pass copies, and its paint that
-      // can move is where the next passes look for it.
-#define WB_X(name, doc) dst.name[c] = src.name[c];
-      WB_PAINT_FIELDS(WB_X)
-#undef WB_X
-      if (src.density[c] > 0.f && !dried_solid(src.density[c], src.dryness[c], dry_threshold)) {
-        if (!atomic_load(&painted[t])) atomic_or(&painted[t], 1);
-        if (k + 1 > atomic_load(below_next)) atomic_max(below_next, k + 1);
-      }
-      return;
-    }
     // Air stays air: no walk of the cell's faces can reach paint when none lies within the reach.
     bool near = false;
     for (int o = -reach; o <= reach && inside && !near; ++o)
