@@ -324,8 +324,12 @@ void Grid::advect_paint(float dt) {
   grid_paint_tiles(d, g, paint.density.data(), paint.dryness.data(), params_.dry_threshold, advect_plan_.data(),
                    tile_mark_.data(), tile_active_.data(), tile_halo_.data(), tile_counts_.data(), pass_below_.data());
   const int tiles_x = (g.nx + kPaintTile - 1) / kPaintTile, tiles_y = (g.ny + kPaintTile - 1) / kPaintTile;
-  const PaintTiles tiles{tile_active_.data(), tile_halo_.data(), tile_counts_.data(),
-                         advect_plan_.data(), tiles_x,           int64_t(tiles_x) * tiles_y * kPaintTile * g.nz};
+  const PaintTiles tiles{.active = tile_active_.data(),
+                         .halo = tile_halo_.data(),
+                         .counts = tile_counts_.data(),
+                         .plan = advect_plan_.data(),
+                         .tiles_x = tiles_x,
+                         .capacity = int64_t(tiles_x) * tiles_y * kPaintTile * g.nz};
   grid_copy_paint_tiles(d, g, tiles, paint.view(), paint_tmp_.view(), true);
   // Which tiles held paint that can move after the last pass (before the first: the paint's) and
   // after this one; which the step's passes visit; the layers holding paint after each pass.

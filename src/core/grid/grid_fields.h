@@ -152,8 +152,9 @@ constexpr int kPaintTile = 8;
 /// paint moves along each axis and the layers and tiles its passes visit. It comes back to the
 /// host with the step's record (Grid::take_advect_plan).
 struct AdvectPlan {
-  int32_t reach[3];  ///< cells a pass along the axis walks: the paint's largest outflow over the step, rounded up, and
-                     ///< 1; 0: the pass copies
+  /// Cells a pass along each axis walks: the paint's largest outflow over the step, rounded up,
+  /// and 1; 0: no flow along the axis, and its pass writes nothing.
+  int32_t reach[3];
   int32_t top;       ///< the layers holding paint
   int32_t layers;    ///< the layers the passes advect: top and the reach up
   int32_t deep;      ///< the layers the passes read: layers, the reach up and a cell more

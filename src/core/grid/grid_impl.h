@@ -149,7 +149,7 @@ void grid_advect_plan(GridDims d, const float* rates, const float* paint_top, co
   parallel_for(1, [=] WB_HD(int64_t) {
     // The paint's reach along each axis, cells: the most a painted cell's face carries in the
     // step, rounded up, and the cell the last part comes from. None where no painted cell's face
-    // carries flow along the axis: its pass copies.
+    // carries flow along the axis: its pass writes nothing.
     AdvectPlan p{};
     const float longest = float(imax(imax(d.nx, d.ny), d.nz));
     for (int a = 0; a < 3; ++a) {
