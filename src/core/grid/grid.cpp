@@ -256,7 +256,7 @@ bool Grid::move_window(Int3 new_origin) {
 
 void Grid::classify() {
   WB_PROFILE_SCOPE("grid.classify");
-  grid_classify(device(), view(), window_.paint().view(), bristles_, particle_density_, window_.canvas().dims(),
+  grid_classify(device(), view(), window_.paint().view(), bristles_, particle_density_, window_.canvas().dims(), flow_,
                 params_.liquid_threshold, params_.dry_threshold);
 }
 
@@ -545,7 +545,7 @@ void Grid::flow_film(float dt) {
   const Vec3 gv = params_.gravity_vector();
   FilmFlow f{stiff, oily, rho0 * -gv.z * cell, rho0 * gv.y * cell, cell, dt / float(substeps)};
   // The columns are read from the cells once, flow in their own planes, and are written back once.
-  grid_film_columns(device(), g, extent_.data(), window_.paint().view(), bristles_, particle_density_,
+  grid_film_columns(device(), g, extent_.data(), window_.paint().view(), bristles_, particle_density_, flow_,
                     params_.dry_threshold, params_.film_max, film_[0].data());
   int cur = 0;
   for (int s = 0; s < substeps; ++s, cur = 1 - cur)

@@ -81,6 +81,10 @@ class Grid {
     particle_density_ = density;
     particle_oil_ = density ? oil : nullptr;
   }
+  /// The columns where paint flows from now on (canvas cells; FlowColumns): outside them the
+  /// window's cells are walls. The simulator keeps them a fixed distance from the brush.
+  void set_flow_columns(const FlowColumns& f) { flow_ = f; }
+  const FlowColumns& flow_columns() const { return flow_; }
   /// This step's particle density on the window (cell fractions), or null before the joint fields.
   const float* particle_density() const { return particle_density_; }
 
@@ -154,6 +158,7 @@ class Grid {
   GridParams params_;
   ActiveWindow window_;
   BristleField bristles_{};
+  FlowColumns flow_{};
   const float* particle_density_ = nullptr;
   const float* particle_oil_ = nullptr;
   DeviceBuffer<float> theta_[3], solid_vel_[3], vel_pre_[3], vel_tmp_[3];
@@ -228,8 +233,8 @@ class Grid {
 #define WB_GRID_KERNELS(X)                                                                                             \
   X(void, grid_classify,                                                                                               \
     (GridView g, PaintWindowView pw, BristleField br, const float* particle_density, CanvasDims canvas,                \
-     float liquid_threshold, float dry_threshold),                                                                     \
-    (g, pw, br, particle_density, canvas, liquid_threshold, dry_threshold))                                            \
+     FlowColumns flow, float liquid_threshold, float dry_threshold),                                                   \
+    (g, pw, br, particle_density, canvas, flow, liquid_threshold, dry_threshold))                                      \
   X(void, grid_column_tops, (GridDims d, const float* rho, const float* particle_density, float trace, float* out),    \
     (d, rho, particle_density, trace, out))                                                                            \
   X(void, grid_first_extent, (GridDims d, const float* maxima, GridExtent* e), (d, maxima, e))                         \
@@ -256,8 +261,8 @@ class Grid {
     (g, u, v, w, dt))                                                                                                  \
   X(void, grid_film_columns,                                                                                           \
     (GridDims d, const GridExtent* e, PaintWindowView pw, BristleField br, const float* particle_density,              \
-     float dry_threshold, float film_max, float* col),                                                                 \
-    (d, e, pw, br, particle_density, dry_threshold, film_max, col))                                                    \
+     FlowColumns flow, float dry_threshold, float film_max, float* col),                                               \
+    (d, e, pw, br, particle_density, flow, dry_threshold, film_max, col))                                              \
   X(void, grid_film_update, (GridDims d, const float* col, FilmFlow f, float* next), (d, col, f, next))                \
   X(void, grid_film_write, (GridDims d, PaintWindowView pw, const float* col), (d, pw, col))                           \
   X(void, grid_gravity, (GridView g, float* ph, float g_dt, float g_dt_y), (g, ph, g_dt, g_dt_y))                      \

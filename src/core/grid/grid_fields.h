@@ -20,6 +20,15 @@ enum CellClass : uint8_t {
   kCellSolid = 2,   ///< dried paint, or off the canvas: never moved, closed faces
 };
 
+/// The columns where paint flows, canvas cells [x0, x1) x [y0, y1): the window's less a band along
+/// its walls, so that the region follows the brush cell by cell while the window moves in snaps
+/// (Grid::set_flow_columns; docs/GRID.md "The window's walls"). Cells outside are walls, as cells
+/// off the canvas are. The default holds every column.
+struct FlowColumns {
+  int x0 = -(1 << 30), x1 = 1 << 30, y0 = -(1 << 30), y1 = 1 << 30;
+  WB_HD bool contains(int x, int y) const { return x >= x0 && x < x1 && y >= y0 && y < y1; }
+};
+
 /// Rasterised bristles from the brush, cell-centred on the window grid (device pointers;
 /// psi == nullptr means no brush). psi is the bristle volume fraction (min(psi,1) is the
 /// solid fraction); vx, vy, vz the psi-weighted mean bristle velocity, cells/s.

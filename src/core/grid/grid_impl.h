@@ -80,14 +80,15 @@ void for_faces(const GridDims& d, const GridExtent* e, F fn) {
 }
 
 void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float* particle_density, CanvasDims canvas,
-                   float liquid_threshold, float dry_threshold) {
+                   FlowColumns flow, float liquid_threshold, float dry_threshold) {
   const int canvas_w = canvas.width, canvas_h = canvas.height, canvas_d = canvas.depth;
   const GridDims d = g.d;
   const auto cell = [=] WB_HD(int64_t c) {
     int i, j, k;
     d.decompose_cell(c, i, j, k);
     const int cx = i + pw.ox, cy = j + pw.oy, cz = k + pw.oz;
-    const bool on = cx >= 0 && cy >= 0 && cz >= 0 && cx < canvas_w && cy < canvas_h && cz < canvas_d;
+    const bool on =
+        cx >= 0 && cy >= 0 && cz >= 0 && cx < canvas_w && cy < canvas_h && cz < canvas_d && flow.contains(cx, cy);
     // Joint density (§4.3): the particles' rasterised volume counts as liquid too.
     const float joint = pw.density[c] + (particle_density ? particle_density[c] : 0.f);
     g.cls[c] = classify_cell(joint, pw.dryness[c], on, liquid_threshold, dry_threshold);
@@ -444,13 +445,15 @@ void grid_gravity(GridView g, float* ph, float g_dt, float g_dt_y) {
 // --- thin films (docs/GRID.md "Thin films") --------------------------------------------------
 
 void grid_film_columns(GridDims d, const GridExtent* e, PaintWindowView pw, BristleField br,
-                       const float* particle_density, float dry_threshold, float film_max, float* col) {
+                       const float* particle_density, FlowColumns flow, float dry_threshold, float film_max,
+                       float* col) {
   const int64_t n = int64_t(d.nx) * d.ny;
   parallel_for(n, [=] WB_HD(int64_t c) {
     const int i = int(c % d.nx), j = int(c / d.nx);
     col[kFilmH * n + c] = -1.f;
     col[kFilmMoved * n + c] = 0.f;
     if (e && (i < e->x0 || i >= e->x1 || j < e->y0 || j >= e->y1)) return;  // no paint there
+    if (!flow.contains(i + pw.ox, j + pw.oy)) return;                       // a wall (FlowColumns)
     int above = 0;
     const float base = column_solid_top(pw, c, dry_threshold, 0.f, above);
     float h = 0.f, oil = 0.f, r = 0.f, y = 0.f, b = 0.f, dry = 0.f;

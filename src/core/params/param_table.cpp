@@ -125,6 +125,8 @@ std::vector<ParamInfo> build_table() {
                "A cell near the bristles is sampled into up to this cubed particles a step (the paper: 3, 27 candidates)"),
       WB_PARAM(transfer.slow_speed, "Slow speed", "cells/s", "§5.2", 0, 1e4, "Particles slower than this go back to the grid"),
       WB_PARAM(transfer.return_margin, "Return margin", "cells", "§5.2", 0, 100, "Particles go back to the grid only this far beyond D0"),
+      WB_PARAM(transfer.distance_block, "Distance block", "cells", "§5.2", 1, 16,
+               "Edge of the blocks the distance to the bristles (D0) is measured on"),
       WB_PARAM(transfer.wick_rate, "Wicking", "1/s", "", 0, 1e6, "Capillary flow of paint along a bristle towards its emptier samples"),
       WB_PARAM(transfer.wick_slide, "Drag pumping", "1/cell", "", 0, 1e5, "Paint drawn along a bristle towards its contact per cell the bristle slides"),
       WB_PARAM(transfer.dip_depth, "Dip depth", "of the length", "", 0, 1,

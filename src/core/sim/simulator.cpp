@@ -24,6 +24,9 @@ float distance_error(const TransferParams& tp) { return float(tp.distance_block)
 constexpr int kKeepRim = 8;
 /// Rim under the window's lid, cells: paint rises slowly, the kernel of Eq. 16 needs 3.
 constexpr int kKeepRimTop = 3;
+/// A samples' box whose centre moved less than this over a step (cells) is a brush at rest: a
+/// lifted brush's bristles sway by 0.01-0.1 cells a step; the slowest stroke tested, 5 mm/s, moves 0.42.
+constexpr float kRestingBox = 0.1f;
 /// An empty keep box: every particle goes to the grid (settle, grid-only paint).
 KeepBox nowhere() { return KeepBox::of(Int3{}, Int3{}); }
 
@@ -391,7 +394,23 @@ Simulator::WindowPlace Simulator::place_window(const std::array<float, 4>& befor
   const float floor_D0 = std::min(D0, transfer_->params().absorb_range() + distance_error(tp));
   zone_D0_ = std::clamp(room, floor_D0, D0);
   w.zone_room = room - floor_D0;
-  w.origin = grid_->window().origin_for(Vec3(0.5f * (x0 + x1), 0.5f * (y0 + y1), 0.f), config_.params.grid.window_snap);
+  const float cx = 0.5f * (x0 + x1), cy = 0.5f * (y0 + y1);
+  const int snap = std::max(config_.params.grid.window_snap, 1);
+  w.origin = grid_->window().origin_for(Vec3(cx, cy, 0.f), snap);
+  // Paint flows in the columns whose centres lie within the window's half-size less half a snap
+  // of the box's centre: always inside the window (its origin is off by at most half a snap),
+  // and moving with the brush cell by cell. Paint a window wall leaves behind stops where it
+  // is; were the walls the limit, each move of a snap would stop at once a strip of paint laid
+  // over a snap of the brush's travel, still settling, and the body would set in steps of the
+  // snap's length (docs/GRID.md "The window's walls"). A brush at rest moves no wall: the whole
+  // window flows.
+  const float moved = std::max(std::abs(after[0] + after[1] - before[0] - before[1]),
+                               std::abs(after[2] + after[3] - before[2] - before[3]));
+  if (0.5f * moved > kRestingBox) {
+    const float hx = 0.5f * float(n.x - snap), hy = 0.5f * float(n.y - snap);
+    w.flow = FlowColumns{int(std::ceil(cx - hx - 0.5f)), int(std::ceil(cx + hx - 0.5f)), int(std::ceil(cy - hy - 0.5f)),
+                         int(std::ceil(cy + hy - 0.5f))};
+  }
   return w;
 }
 
@@ -417,6 +436,7 @@ TransferEnv Simulator::transfer_env() {
   env.floor_z = config_.params.particles.floor_z;
   env.dry_threshold = config_.params.grid.dry_threshold;
   env.D0 = config_.particles ? effective_D0() : 0.f;
+  env.lattice_anchor = brush_->pose().position;
   env.surface = paint_surface();
   // Particles live inside the window less a rim of kKeepRim cells (beyond the reach of Eq. 16's
   // kernel): one that enters the rim goes to the grid, and rim paint is never sampled into
@@ -563,6 +583,7 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
     }
     if (particles_.size() > 0) deposit_leaving_particles(w.origin);
     grid_->move_window(w.origin);
+    grid_->set_flow_columns(w.flow);
     brush_->rasterize(grid_->window().origin(), grid_->window().dims(), psi_.data(), bristle_v_[0].data(),
                       bristle_v_[1].data(), bristle_v_[2].data());
     grid_->set_bristles(BristleField{psi_.data(), bristle_v_[0].data(), bristle_v_[1].data(), bristle_v_[2].data()});

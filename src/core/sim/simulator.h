@@ -225,6 +225,7 @@ class Simulator {
     Int3 origin;
     float rim_room;   ///< between the box and the window's rim, less half a snap (the centre's error)
     float zone_room;  ///< for the particle zone at D0's floor (negative: the window cuts it)
+    FlowColumns flow;  ///< the columns where paint flows: centred on the box, whatever the snap
   };
   /// The window for the samples' box over the step (the union of `before` and `after`), and the
   /// D0 that keeps the particle zone inside its kept box (zone_D0_).

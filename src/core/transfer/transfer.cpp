@@ -273,12 +273,16 @@ void Transfer::update_distance(const SampleView& samples, const TransferEnv& env
   db.block = B;
   db.margin = margin;
   db.D0 = env.D0;
-  // The lattice's shift: the R3 low-discrepancy sequence (Roberts 2018; the powers of phi_3,
-  // the root of x^4 = x + 1) over the steps, the same on every backend and for a replay of the same steps.
-  const double g = 1.2207440846057594, a[3] = {1.0 / g, 1.0 / (g * g), 1.0 / (g * g * g)};
+  // The lattice lies on the brush: its blocks' edges at the anchor plus whole blocks. It travels
+  // with the bristles, so the blocks they mark, and the distance, move with them as the brush
+  // moves; a lattice held by the window (or shifted along a sequence over the steps) has the
+  // marked blocks change as the bristles cross its edges, and the D0 front jump by up to a block
+  // at moments set by the lattice, not the paint: ridges across a slow stroke.
+  const double o[3] = {double(pw.ox), double(pw.oy), double(pw.oz)},
+               anchor[3] = {env.lattice_anchor.x, env.lattice_anchor.y, env.lattice_anchor.z};
   float sh[3];
   for (int c = 0; c < 3; ++c) {
-    const double u = 0.5 + double(step_index_) * a[c];
+    const double u = (o[c] - anchor[c]) / double(B);
     sh[c] = float((u - std::floor(u)) * double(B));
   }
   db.shift = Vec3(sh[0], sh[1], sh[2]);

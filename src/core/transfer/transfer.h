@@ -35,6 +35,9 @@ struct TransferEnv {
   float dry_threshold = 0.95f; ///< dryness at which paint is solid (GridParams::dry_threshold)
   float D0 = 50.f;             ///< particle range around the bristles, cells (ParticleParams::D0)
   float dt = 0.f;              ///< step length, s, for the wicking along the bristles (0: none)
+  /// A point that moves with the brush (canvas cells): the distance blocks' lattice is laid on
+  /// it, so that it travels with the bristles (docs/TRANSFER.md "Ribs on slow strokes").
+  Vec3 lattice_anchor{};
   /// Window box the particles may stay in (off: the whole window); the simulator sets it every
   /// step and, before the window moves, to the part that stays (docs/TRANSFER.md).
   KeepBox keep{};
