@@ -309,4 +309,48 @@ TEST_F(RheologyTest, ThinOilyPaintLevelsStiffPaintKeepsItsGrooves) {
   EXPECT_LE(std::fabs(stiff_mass), 1e-5);
 }
 
+TEST_F(RheologyTest, PaintFlowsOnlyInTheFlowColumns) {
+  // Grid::set_flow_columns (docs/GRID.md "The window's walls"): the oily grooved layer of the
+  // test above, its window's columns x >= 24 outside the flow: there the paint is kept cell for
+  // cell (walls, as off the canvas), while the grooves inside level as they do in a whole window.
+  TileStore canvas(device_, CanvasDims{64, 32, 16});
+  GridParams p;
+  Grid g(canvas, p, Int3{48, 16, 8}, Int3{0, 0, 0});
+  g.set_flow_columns(FlowColumns{-100, 24, -100, 100});
+  const auto column = [](int i) { return i % 2 ? 1.3f : 0.7f; };
+  paint_cells(
+      g,
+      [&](int i, int, int k) {
+        return k == 0 ? std::min(1.f, column(i)) : (k == 1 ? std::max(0.f, column(i) - 1.f) : 0.f);
+      },
+      0.95f);
+  const GridDims d = g.dims();
+  const std::vector<float> before = host_density(g);
+  for (int s = 0; s < int(std::lround(2.f / p.dt)); ++s) g.step(p.dt);
+  const std::vector<float> after = host_density(g);
+  const auto grooves = [&](const std::vector<float>& rho, int i0, int i1) {
+    double sum = 0;
+    int n = 0;
+    for (int j = 4; j < 12; ++j)
+      for (int i = i0; i < i1; ++i, ++n) {
+        double a = 0, b = 0;
+        for (int k = 0; k < d.nz; ++k) a += rho[size_t(d.cell(i, j, k))], b += rho[size_t(d.cell(i + 1, j, k))];
+        sum += std::fabs(a - b);
+      }
+    return sum / n;
+  };
+  int changed = 0;
+  for (int k = 0; k < d.nz; ++k)
+    for (int j = 0; j < d.ny; ++j)
+      for (int i = 24; i < d.nx; ++i) changed += after[size_t(d.cell(i, j, k))] != before[size_t(d.cell(i, j, k))];
+  double m0 = 0, m1 = 0;
+  for (size_t c = 0; c < before.size(); ++c) m0 += before[c], m1 += after[c];
+  const double inside = grooves(after, 4, 20) / grooves(before, 4, 20);
+  std::printf("inside the flow columns the grooves keep %.1f %%; outside %d cells changed; mass %+.2g\n", 100 * inside,
+              changed, (m1 - m0) / m0);
+  EXPECT_LE(inside, 0.5) << "the grooves inside level";
+  EXPECT_EQ(changed, 0) << "the paint outside is kept as it is";
+  EXPECT_LE(std::fabs((m1 - m0) / m0), 1e-5);
+}
+
 }  // namespace wb::test

@@ -97,6 +97,48 @@ TEST_F(GridParticleTest, DistanceFieldMatchesBruteForceOverBlocks) {
   }
 }
 
+TEST_F(GridParticleTest, DistanceFieldTravelsWithTheBrush) {
+  // The blocks' lattice lies on the brush (TransferEnv::lattice_anchor): a brush moved by d, its
+  // anchor with it, gives at p + d the distance it gave at p, to rounding, whatever d and the
+  // window. A lattice held by the window (or shifted over the steps) gives up to a block's error
+  // that changes as the brush crosses its edges: the D0 front jumps (docs/TRANSFER.md "Ribs on
+  // slow strokes").
+  const HostSamples h0 = vertical_brush(3, 12, 0.8f, 124.f, 224.f, 3.f, 1.f);
+  PaintWindow w = make_window(
+      {48, 48, 8}, {100, 200, 0}, [](int, int, int) { return 0.f; }, Vec3());
+  TransferParams prm;
+  prm.distance_block = 4;
+  const float D0 = 12.f;
+  const auto field = [&](Transfer& t, Vec3 d, bool on_brush) {
+    HostSamples h = h0;
+    for (Vec3& x : h.x) x = x + d;
+    DeviceSamples s(device_);
+    s.upload(h);
+    TransferEnv env = env_for(w, D0);
+    env.lattice_anchor = on_brush ? Vec3(124.f, 224.f, 3.f) + d : Vec3();
+    t.update_distance(s.view(), env);
+    return t.distance_view();
+  };
+  Transfer at_rest(device_, prm), moved(device_, prm), held(device_, prm);
+  const DistanceBlocks a = field(at_rest, Vec3(), true);
+  double worst_on_brush = 0.0, worst_on_window = 0.0;
+  for (const Vec3 d : {Vec3(0.4f, 0.f, 0.f), Vec3(1.3f, 0.f, 0.f), Vec3(2.5f, -0.7f, 0.f), Vec3(3.9f, 1.1f, 0.f)}) {
+    const DistanceBlocks b = field(moved, d, true), c = field(held, d, false);
+    for (float x = 6.f; x < 42.f; x += 0.75f)
+      for (float z = 0.5f; z < 6.f; z += 1.f) {
+        const Vec3 p(x, 24.f, z), q = p + d;  // window positions (the window's origin is its own)
+        const float da = a.distance(p);
+        if (!(da < 2.f * D0)) continue;
+        worst_on_brush = std::max(worst_on_brush, double(std::fabs(b.distance(q) - da)));
+        worst_on_window = std::max(worst_on_window, double(std::fabs(c.distance(q) - da)));
+      }
+  }
+  std::printf("distance at the moved point: off by %.4f cells with the lattice on the brush, %.2f on the window\n",
+              worst_on_brush, worst_on_window);
+  EXPECT_LT(worst_on_brush, 1e-3);
+  EXPECT_GT(worst_on_window, 0.5) << "the test must see a lattice held still";
+}
+
 TEST_F(GridParticleTest, LayerNearTheBristlesBecomesParticlesWithExactMass) {
   const Int3 origin{100, 200, 0};
   PaintWindow w = make_window({48, 48, 8}, origin, [](int, int, int k) { return k < 2 ? 0.8f : 0.f; },
