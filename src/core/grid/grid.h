@@ -84,7 +84,6 @@ class Grid {
   /// The columns where paint flows from now on (canvas cells; FlowColumns): outside them the
   /// window's cells are walls. The simulator keeps them a fixed distance from the brush.
   void set_flow_columns(const FlowColumns& f) { flow_ = f; }
-  const FlowColumns& flow_columns() const { return flow_; }
   /// This step's particle density on the window (cell fractions), or null before the joint fields.
   const float* particle_density() const { return particle_density_; }
 
