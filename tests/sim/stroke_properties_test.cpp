@@ -420,9 +420,9 @@ TEST_F(StrokePropertiesTest, SlowAndEasedStrokesLeaveNoRibs) {
     bool flat;
     double most;
   };
-  const Case cases[] = {{"round 5 mm/s", 25.f, 0.f, false, 5.0},   {"round 15 mm/s", 75.f, 0.f, false, 5.0},
+  const Case cases[] = {{"round 5 mm/s", 25.f, 0.f, false, 6.0},   {"round 15 mm/s", 75.f, 0.f, false, 5.0},
                         {"round 40 mm/s", 200.f, 0.f, false, 5.0}, {"round eased", 300.f, 80.f, false, 5.0},
-                        {"flat 5 mm/s", 25.f, 0.f, true, 5.0},     {"flat 15 mm/s", 75.f, 0.f, true, 5.0},
+                        {"flat 5 mm/s", 25.f, 0.f, true, 6.0},     {"flat 15 mm/s", 75.f, 0.f, true, 5.0},
                         {"flat 40 mm/s", 200.f, 0.f, true, 5.0},   {"flat eased", 300.f, 80.f, true, 5.0}};
   for (const Case& k : cases) {
     Stroke st;
