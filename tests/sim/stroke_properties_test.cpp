@@ -408,8 +408,8 @@ TEST_F(StrokePropertiesTest, SlowAndEasedStrokesLeaveNoRibs) {
   // distance blocks' period (4 cells), where the D0 front's steps laid ridges on a lattice held by
   // the window (at 5 mm/s 2.6-5.8x round, 6.1-11.3x flat). With the lattice shifted each step and
   // the walls stopping paint a snap at a time, the flat at 5 mm/s scored 3.7-8.8x. With the
-  // lattice on the brush and the paint stopping with it, six runs: 1.4-3.1x at 40 mm/s and from
-  // rest, 2.1-4.0x at 15 mm/s, 2.4-5.1x at 5 mm/s; 0.7-1.8x at the blocks' period. The ratio is
+  // lattice on the brush and the paint stopping with it, eight runs: 1.4-3.1x at 40 mm/s and from
+  // rest, 2.1-4.0x at 15 mm/s, 2.4-5.1x at 5 mm/s; 0.6-2.2x at the blocks' period. The ratio is
   // of a texture with no period left, and its spread between runs (the particles' order on the
   // CPU's threads) is that of the largest of 29 bins; at 5 mm/s the body also steps down once,
   // by 0.15-0.3 cells about 22 cells in (the same place every run, as before these changes),
