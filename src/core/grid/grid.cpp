@@ -330,7 +330,7 @@ void Grid::advect_paint(float dt) {
                          .plan = advect_plan_.data(),
                          .tiles_x = tiles_x,
                          .capacity = int64_t(tiles_x) * tiles_y * kPaintTile * g.nz};
-  grid_copy_paint_tiles(d, g, tiles, paint.view(), paint_tmp_.view(), true);
+  grid_copy_paint_tiles(d, g, tiles, paint.view(), paint_tmp_.view(), TileCopy::kIntoScratch);
   // Which tiles held paint that can move after the last pass (before the first: the paint's) and
   // after this one; which the step's passes visit; the layers holding paint after each pass.
   int32_t* painted[2] = {tile_painted_[0].data(), tile_painted_[1].data()};
@@ -355,7 +355,7 @@ void Grid::advect_paint(float dt) {
   // An odd number of passes that moved paint left the result in the scratch buffers, complete
   // only where the passes wrote: the paint's own buffers are complete elsewhere, so they take
   // those tiles back (the copy does nothing after an even number).
-  grid_copy_paint_tiles(d, g, tiles, paint_tmp_.view(), paint.view(), false);
+  grid_copy_paint_tiles(d, g, tiles, paint_tmp_.view(), paint.view(), TileCopy::kResultBack);
 }
 
 void Grid::column_maxima(float trace, int slot) {

@@ -182,6 +182,12 @@ WB_HD WB_INLINE bool advect_in_scratch(const AdvectPlan& p, int order, int n) {
   return made % 2 == 1;
 }
 
+/// What grid_copy_paint_tiles copies: the paint into the scratch buffers, every cell the
+/// advection's passes read (the listed and halo tiles, the plan's `deep` layers); or the passes'
+/// result back, the cells they write (the listed tiles, `layers`), and only where an odd number of
+/// passes that moved paint left it in the scratch (advect_in_scratch).
+enum class TileCopy : int { kIntoScratch, kResultBack };
+
 /// The tiles the advection visits (device lists and counts, grid.cpp). counts: the active tiles,
 /// the halo tiles around them, then the cells of the active tiles below the plan's `layers`, of
 /// the active tiles below its `deep` and of the halo tiles below `deep`, in rows of kPaintTile

@@ -281,18 +281,15 @@ void grid_paint_tiles(GridDims d, const float* rho, const float* dryness, float 
   });
 }
 
-void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst,
-                           bool reads) {
+void grid_copy_paint_tiles(GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst, TileCopy what) {
   const AdvectPlan* plan = tiles.plan;
+  const bool reads = what == TileCopy::kIntoScratch;
   auto copy = [=] WB_HD(int32_t, int64_t c) {
-    // The passes' result comes back only where an odd number of them left it in the scratch.
-    if (!reads && plan->passes % 2 == 0) return;
+    if (!reads && plan->passes % 2 == 0) return;  // an even number left the result in the paint
 #define WB_X(name, doc) dst.name[c] = src.name[c];
     WB_PAINT_FIELDS(WB_X)
 #undef WB_X
   };
-  // reads: every cell the passes read (the listed and halo tiles, `deep` layers), copied from the
-  // paint into the scratch; else the cells they write, back from the scratch.
   using Rows = detail::TileCells<decltype(copy)>;
   const int32_t* deep = &tiles.plan->deep;
   parallel_for_count(tiles.counts + (reads ? 3 : 2), tiles.capacity,

@@ -237,9 +237,9 @@ struct DistanceBlocks {
   int block;
   int margin;
   float D0;  ///< cells
-  /// The lattice's offset this step, cells in [0, block) on each axis: a low-discrepancy sequence
-  /// over the transfer's steps (Transfer::update_distance), so the blocks' error does not stand
-  /// still under a slow stroke (docs/TRANSFER.md "Ribs on slow strokes").
+  /// The lattice's offset this step, cells in [0, block) on each axis: its blocks' edges lie at
+  /// the brush's anchor plus whole blocks (Transfer::update_distance), so the lattice travels with
+  /// the bristles (docs/TRANSFER.md "Ribs on slow strokes").
   Vec3 shift;
   WB_HD int64_t index(int i, int j, int k) const { return (int64_t(k) * by + j) * bx + i; }
   /// Block of window position q (may fall outside: then -1).
@@ -252,9 +252,9 @@ struct DistanceBlocks {
   }
   /// Distance from window position q to the bristles, cells: the block centres' distances
   /// (exact between block centres, so within +-block*sqrt(3) of the true distance) interpolated
-  /// trilinearly, so the D0 front has no block's steps in space. A block is marked or not, so the
-  /// front steps a block in time as samples enter the next block; the lattice's shift, another
-  /// each step, spreads those steps over the track instead of a block apart.
+  /// trilinearly, so the D0 front has no block's steps in space. A block is marked or not; on a
+  /// lattice that travels with the brush the marked blocks change only as the bristles change
+  /// shape, not as they cross the lattice's edges, so the front has no steps in time either.
   /// Huge outside the field or with no bristle in it.
   WB_HD float distance(Vec3 q) const {
     if (block_of(q) < 0) return 1e30f;
