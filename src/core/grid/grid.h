@@ -229,90 +229,90 @@ class Grid {
 };
 
 // The grid stage's backend drivers (grid_impl.h), one list (core/exec/dispatch.h).
-#define WB_GRID_KERNELS(X)                                                                                            \
-  X(void, grid_classify,                                                                                              \
-    (GridView g, PaintWindowView pw, BristleField br, const float* particle_density, CanvasDims canvas,               \
-     FlowColumns flow, float liquid_threshold, float dry_threshold),                                                  \
-    (g, pw, br, particle_density, canvas, flow, liquid_threshold, dry_threshold))                                     \
-  X(void, grid_column_tops, (GridDims d, const float* rho, const float* particle_density, float trace, float* out),   \
-    (d, rho, particle_density, trace, out))                                                                           \
-  X(void, grid_first_extent, (GridDims d, const float* maxima, GridExtent* e), (d, maxima, e))                        \
-  X(void, grid_advect_plan,                                                                                           \
-    (GridDims d, const float* rates, const float* paint_top, const float* joint, float dt, AdvectPlan* plan,          \
-     GridExtent* e),                                                                                                  \
-    (d, rates, paint_top, joint, dt, plan, e))                                                                        \
-  X(void, grid_paint_outflow, (GridView g, const float* rho, float* out), (g, rho, out))                              \
-  X(void, grid_advect_paint_axis,                                                                                     \
-    (GridView g, PaintWindowView paint, PaintWindowView scratch, int axis, int pass, int order, float dt,             \
-     float dry_threshold, PaintTiles tiles, const int32_t* process, int32_t* painted, const int32_t* below,           \
-     int32_t* below_next),                                                                                            \
-    (g, paint, scratch, axis, pass, order, dt, dry_threshold, tiles, process, painted, below, below_next))            \
-  X(void, grid_paint_tiles_pass,                                                                                      \
-    (GridDims d, PaintTiles tiles, const int32_t* before, int axis, int32_t* process, int32_t* after),                \
-    (d, tiles, before, axis, process, after))                                                                         \
-  X(void, grid_paint_tiles,                                                                                           \
-    (GridDims d, const float* rho, const float* dryness, float dry_threshold, const AdvectPlan* plan, int32_t* mark,  \
-     int32_t* active, int32_t* halo, int64_t* counts, int32_t* below),                                                \
-    (d, rho, dryness, dry_threshold, plan, mark, active, halo, counts, below))                                        \
-  X(void, grid_copy_paint_tiles,                                                                                      \
-    (GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst, TileCopy what),                          \
-    (d, tiles, src, dst, what))                                                                                       \
-  X(void, grid_advect_velocity, (GridView g, const float* u, const float* v, const float* w, float dt),               \
-    (g, u, v, w, dt))                                                                                                 \
-  X(void, grid_film_columns,                                                                                          \
-    (GridDims d, const GridExtent* e, PaintWindowView pw, BristleField br, const float* particle_density,             \
-     FlowColumns flow, float dry_threshold, float film_max, float* col),                                              \
-    (d, e, pw, br, particle_density, flow, dry_threshold, film_max, col))                                             \
-  X(void, grid_film_update, (GridDims d, const float* col, FilmFlow f, float* next), (d, col, f, next))               \
-  X(void, grid_film_write, (GridDims d, PaintWindowView pw, const float* col), (d, pw, col))                          \
-  X(void, grid_gravity, (GridView g, float* ph, float g_dt, float g_dt_y), (g, ph, g_dt, g_dt_y))                     \
-  X(void, grid_effective_viscosity,                                                                                   \
-    (GridView g, JointOil oil, HerschelBulkley stiff, HerschelBulkley oily, float m, float* mu),                      \
-    (g, oil, stiff, oily, m, mu))                                                                                     \
-  X(void, grid_viscous_flags, (GridView g, uint32_t * flag), (g, flag))                                               \
-  X(void, grid_viscous_list, (GridView g, const uint32_t* idx, uint32_t* list), (g, idx, list))                       \
-  X(void, grid_viscous_count, (GridView g, const uint32_t* idx, int64_t capacity, int64_t* run, double* total),       \
-    (g, idx, capacity, run, total))                                                                                   \
-  X(void, grid_viscous_setup,                                                                                         \
-    (GridView g, const uint32_t* list, ListCount n, const uint32_t* idx, const float* mu, float nu_scale, float* nu,  \
-     int32_t* nb, double* diag, double* b, double* x),                                                                \
-    (g, list, n, idx, mu, nu_scale, nu, nb, diag, b, x))                                                              \
-  X(void, grid_viscous_apply,                                                                                         \
-    (ListCount n, const float* nu, const int32_t* nb, const double* diag, const double* p, double* q, double* pq,     \
-     CgGuard guard, SumScratch s),                                                                                    \
-    (n, nu, nb, diag, p, q, pq, guard, s))                                                                            \
-  X(void, grid_pcg_start,                                                                                             \
-    (ListCount n, const double* b, const double* ax, const double* diag, double* r, double* z, double* p, double* rz, \
-     double* bz, SumScratch s),                                                                                       \
-    (n, b, ax, diag, r, z, p, rz, bz, s))                                                                             \
-  X(void, grid_pcg_update,                                                                                            \
-    (ListCount n, CgGuard guard, const double* pq, const double* p, const double* q, const double* diag, double* x,   \
-     double* r, double* z, double* rz, double* iterations, SumScratch s),                                             \
-    (n, guard, pq, p, q, diag, x, r, z, rz, iterations, s))                                                           \
-  X(void, grid_pcg_direction, (ListCount n, CgGuard guard, const double* rz_new, const double* z, double* p),         \
-    (n, guard, rz_new, z, p))                                                                                         \
-  X(void, grid_viscous_write, (GridView g, const uint32_t* list, ListCount n, const double* x), (g, list, n, x))      \
-  X(void, grid_rhs, (GridView g, const float* rho, float inv_dt, float* b), (g, rho, inv_dt, b))                      \
-  X(void, poisson_jacobi, (PoissonView s, const float* b, const float* x, float* out, float omega),                   \
-    (s, b, x, out, omega))                                                                                            \
-  X(void, poisson_residual, (PoissonView s, const float* b, const float* x, float* r), (s, b, x, r))                  \
-  X(void, poisson_chebyshev,                                                                                          \
-    (PoissonView s, const float* b, const float* x, const float* x_prev, float* out, float omega_k),                  \
-    (s, b, x, x_prev, out, omega_k))                                                                                  \
-  X(void, poisson_fixed_point_first, (PoissonView s, const float* r, const float* y, float* out, float alpha),        \
-    (s, r, y, out, alpha))                                                                                            \
-  X(void, poisson_fixed_point_second, (PoissonView s, const float* r, const float* z, float* y_out, float* x),        \
-    (s, r, z, y_out, x))                                                                                              \
-  X(void, poisson_apply_all, (PoissonView s, const float* x, float* out), (s, x, out))                                \
-  X(void, grid_apply_pressure, (GridView g, const float* p), (g, p))                                                  \
-  X(void, grid_extrapolate, (GridView g), (g))                                                                        \
-  X(void, grid_extent, (GridDims d, const float* before, const float* after, GridExtent* e), (d, before, after, e))   \
-  X(void, grid_dry, (PaintWindowView pw, float amount), (pw, amount))                                                 \
-  X(void, grid_shift_lattice, (const float* src, float* dst, int ex, int ey, int ez, int dx, int dy, int dz),         \
-    (src, dst, ex, ey, ez, dx, dy, dz))                                                                               \
-  X(void, grid_max_abs_fluid_velocity, (GridView g, float* out), (g, out))                                            \
-  X(void, grid_square, (const float* x, float* out, int64_t n), (x, out, n))                                          \
-  X(void, grid_scale, (float* x, float s, int64_t n), (x, s, n))                                                      \
+#define WB_GRID_KERNELS(X)                                                                                             \
+  X(void, grid_classify,                                                                                               \
+    (GridView g, PaintWindowView pw, BristleField br, const float* particle_density, CanvasDims canvas,                \
+     FlowColumns flow, float liquid_threshold, float dry_threshold),                                                   \
+    (g, pw, br, particle_density, canvas, flow, liquid_threshold, dry_threshold))                                      \
+  X(void, grid_column_tops, (GridDims d, const float* rho, const float* particle_density, float trace, float* out),    \
+    (d, rho, particle_density, trace, out))                                                                            \
+  X(void, grid_first_extent, (GridDims d, const float* maxima, GridExtent* e), (d, maxima, e))                         \
+  X(void, grid_advect_plan,                                                                                            \
+    (GridDims d, const float* rates, const float* paint_top, const float* joint, float dt, AdvectPlan* plan,           \
+     GridExtent* e),                                                                                                   \
+    (d, rates, paint_top, joint, dt, plan, e))                                                                         \
+  X(void, grid_paint_outflow, (GridView g, const float* rho, float* out), (g, rho, out))                               \
+  X(void, grid_advect_paint_axis,                                                                                      \
+    (GridView g, PaintWindowView paint, PaintWindowView scratch, int axis, int pass, int order, float dt,              \
+     float dry_threshold, PaintTiles tiles, const int32_t* process, int32_t* painted, const int32_t* below,            \
+     int32_t* below_next),                                                                                             \
+    (g, paint, scratch, axis, pass, order, dt, dry_threshold, tiles, process, painted, below, below_next))             \
+  X(void, grid_paint_tiles_pass,                                                                                       \
+    (GridDims d, PaintTiles tiles, const int32_t* before, int axis, int32_t* process, int32_t* after),                 \
+    (d, tiles, before, axis, process, after))                                                                          \
+  X(void, grid_paint_tiles,                                                                                            \
+    (GridDims d, const float* rho, const float* dryness, float dry_threshold, const AdvectPlan* plan, int32_t* mark,   \
+     int32_t* active, int32_t* halo, int64_t* counts, int32_t* below),                                                 \
+    (d, rho, dryness, dry_threshold, plan, mark, active, halo, counts, below))                                         \
+  X(void, grid_copy_paint_tiles,                                                                                       \
+    (GridDims d, PaintTiles tiles, PaintWindowView src, PaintWindowView dst, TileCopy what),                           \
+    (d, tiles, src, dst, what))                                                                                        \
+  X(void, grid_advect_velocity, (GridView g, const float* u, const float* v, const float* w, float dt),                \
+    (g, u, v, w, dt))                                                                                                  \
+  X(void, grid_film_columns,                                                                                           \
+    (GridDims d, const GridExtent* e, PaintWindowView pw, BristleField br, const float* particle_density,              \
+     FlowColumns flow, float dry_threshold, float film_max, float* col),                                               \
+    (d, e, pw, br, particle_density, flow, dry_threshold, film_max, col))                                              \
+  X(void, grid_film_update, (GridDims d, const float* col, FilmFlow f, float* next), (d, col, f, next))                \
+  X(void, grid_film_write, (GridDims d, PaintWindowView pw, const float* col), (d, pw, col))                           \
+  X(void, grid_gravity, (GridView g, float* ph, float g_dt, float g_dt_y), (g, ph, g_dt, g_dt_y))                      \
+  X(void, grid_effective_viscosity,                                                                                    \
+    (GridView g, JointOil oil, HerschelBulkley stiff, HerschelBulkley oily, float m, float* mu),                       \
+    (g, oil, stiff, oily, m, mu))                                                                                      \
+  X(void, grid_viscous_flags, (GridView g, uint32_t * flag), (g, flag))                                                \
+  X(void, grid_viscous_list, (GridView g, const uint32_t* idx, uint32_t* list), (g, idx, list))                        \
+  X(void, grid_viscous_count, (GridView g, const uint32_t* idx, int64_t capacity, int64_t* run, double* total),        \
+    (g, idx, capacity, run, total))                                                                                    \
+  X(void, grid_viscous_setup,                                                                                          \
+    (GridView g, const uint32_t* list, ListCount n, const uint32_t* idx, const float* mu, float nu_scale, float* nu,   \
+     int32_t* nb, double* diag, double* b, double* x),                                                                 \
+    (g, list, n, idx, mu, nu_scale, nu, nb, diag, b, x))                                                               \
+  X(void, grid_viscous_apply,                                                                                          \
+    (ListCount n, const float* nu, const int32_t* nb, const double* diag, const double* p, double* q, double* pq,      \
+     CgGuard guard, SumScratch s),                                                                                     \
+    (n, nu, nb, diag, p, q, pq, guard, s))                                                                             \
+  X(void, grid_pcg_start,                                                                                              \
+    (ListCount n, const double* b, const double* ax, const double* diag, double* r, double* z, double* p, double* rz,  \
+     double* bz, SumScratch s),                                                                                        \
+    (n, b, ax, diag, r, z, p, rz, bz, s))                                                                              \
+  X(void, grid_pcg_update,                                                                                             \
+    (ListCount n, CgGuard guard, const double* pq, const double* p, const double* q, const double* diag, double* x,    \
+     double* r, double* z, double* rz, double* iterations, SumScratch s),                                              \
+    (n, guard, pq, p, q, diag, x, r, z, rz, iterations, s))                                                            \
+  X(void, grid_pcg_direction, (ListCount n, CgGuard guard, const double* rz_new, const double* z, double* p),          \
+    (n, guard, rz_new, z, p))                                                                                          \
+  X(void, grid_viscous_write, (GridView g, const uint32_t* list, ListCount n, const double* x), (g, list, n, x))       \
+  X(void, grid_rhs, (GridView g, const float* rho, float inv_dt, float* b), (g, rho, inv_dt, b))                       \
+  X(void, poisson_jacobi, (PoissonView s, const float* b, const float* x, float* out, float omega),                    \
+    (s, b, x, out, omega))                                                                                             \
+  X(void, poisson_residual, (PoissonView s, const float* b, const float* x, float* r), (s, b, x, r))                   \
+  X(void, poisson_chebyshev,                                                                                           \
+    (PoissonView s, const float* b, const float* x, const float* x_prev, float* out, float omega_k),                   \
+    (s, b, x, x_prev, out, omega_k))                                                                                   \
+  X(void, poisson_fixed_point_first, (PoissonView s, const float* r, const float* y, float* out, float alpha),         \
+    (s, r, y, out, alpha))                                                                                             \
+  X(void, poisson_fixed_point_second, (PoissonView s, const float* r, const float* z, float* y_out, float* x),         \
+    (s, r, z, y_out, x))                                                                                               \
+  X(void, poisson_apply_all, (PoissonView s, const float* x, float* out), (s, x, out))                                 \
+  X(void, grid_apply_pressure, (GridView g, const float* p), (g, p))                                                   \
+  X(void, grid_extrapolate, (GridView g), (g))                                                                         \
+  X(void, grid_extent, (GridDims d, const float* before, const float* after, GridExtent* e), (d, before, after, e))    \
+  X(void, grid_dry, (PaintWindowView pw, float amount), (pw, amount))                                                  \
+  X(void, grid_shift_lattice, (const float* src, float* dst, int ex, int ey, int ez, int dx, int dy, int dz),          \
+    (src, dst, ex, ey, ez, dx, dy, dz))                                                                                \
+  X(void, grid_max_abs_fluid_velocity, (GridView g, float* out), (g, out))                                             \
+  X(void, grid_square, (const float* x, float* out, int64_t n), (x, out, n))                                           \
+  X(void, grid_scale, (float* x, float s, int64_t n), (x, s, n))                                                       \
   X(void, grid_fill_hash, (float* x, const uint8_t* cls, int64_t n, uint32_t seed), (x, cls, n, seed))
 WB_DECLARE_KERNELS(WB_GRID_KERNELS)
 
