@@ -84,6 +84,10 @@ class Grid {
   /// The columns where paint flows from now on (canvas cells; FlowColumns): outside them the
   /// window's cells are walls. The simulator keeps them a fixed distance from the brush.
   void set_flow_columns(const FlowColumns& f) { flow_ = f; }
+  /// The box of the columns whose wet paint moves faster than `speed` (cells/s) on any face of
+  /// its cells, as the maxima of x, -x, y and -y (canvas cells; -inf where none), into out[0..4)
+  /// on the device: where paint still flows, for the window of a brush at rest to hold it.
+  void moving_box_into(float* out, float speed);
   /// This step's particle density on the window (cell fractions), or null before the joint fields.
   const float* particle_density() const { return particle_density_; }
 
@@ -237,6 +241,8 @@ class Grid {
   X(void, grid_column_tops, (GridDims d, const float* rho, const float* particle_density, float trace, float* out),    \
     (d, rho, particle_density, trace, out))                                                                            \
   X(void, grid_first_extent, (GridDims d, const float* maxima, GridExtent* e), (d, maxima, e))                         \
+  X(void, grid_moving_columns, (GridView g, PaintWindowView pw, float dry_threshold, float speed, float* out),         \
+    (g, pw, dry_threshold, speed, out))                                                                                \
   X(void, grid_advect_plan,                                                                                            \
     (GridDims d, const float* rates, const float* paint_top, const float* joint, float dt, AdvectPlan* plan,           \
      GridExtent* e),                                                                                                   \

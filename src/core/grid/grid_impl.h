@@ -134,6 +134,30 @@ void grid_column_tops(GridDims d, const float* rho, const float* particle_densit
   });
 }
 
+void grid_moving_columns(GridView g, PaintWindowView pw, float dry_threshold, float speed, float* out) {
+  // A column moves where a cell of wet paint has a face faster than `speed`: its x, -x, y, -y
+  // (canvas cells, the column's centre) for the maxima that make the box of such columns.
+  const GridDims d = g.d;
+  const int64_t n = int64_t(d.nx) * d.ny;
+  parallel_for(n, [=] WB_HD(int64_t col) {
+    const int i = int(col % d.nx), j = int(col / d.nx);
+    bool moving = false;
+    for (int k = 0; k < d.nz && !moving; ++k) {
+      const int64_t c = d.cell(i, j, k);
+      if (!(pw.density[c] > 0.f) || pw.dryness[c] >= dry_threshold) continue;
+      const float u = fmaxf(fabsf(g.vel[0][d.uidx(i, j, k)]), fabsf(g.vel[0][d.uidx(i + 1, j, k)]));
+      const float v = fmaxf(fabsf(g.vel[1][d.vidx(i, j, k)]), fabsf(g.vel[1][d.vidx(i, j + 1, k)]));
+      const float w = fmaxf(fabsf(g.vel[2][d.widx(i, j, k)]), fabsf(g.vel[2][d.widx(i, j, k + 1)]));
+      moving = fmaxf(fmaxf(u, v), w) > speed;
+    }
+    const float none = -INFINITY, x = float(i + pw.ox) + 0.5f, y = float(j + pw.oy) + 0.5f;
+    out[col] = moving ? x : none;
+    out[n + col] = moving ? -x : none;
+    out[2 * n + col] = moving ? y : none;
+    out[3 * n + col] = moving ? -y : none;
+  });
+}
+
 void grid_first_extent(GridDims d, const float* maxima, GridExtent* e) {
   parallel_for(1, [=] WB_HD(int64_t) {
     // The cells holding paint or particles and a cell around them: the faces of their cells

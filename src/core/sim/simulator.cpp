@@ -27,6 +27,10 @@ constexpr int kKeepRimTop = 3;
 /// A samples' box whose centre moved less than this over a step (cells) is a brush at rest: a
 /// lifted brush's bristles sway by 0.01-0.1 cells a step; the slowest stroke tested, 5 mm/s, moves 0.42.
 constexpr float kRestingBox = 0.1f;
+/// Wet paint with a face faster than this (cells/s, 0.2 mm/s) still flows, and the window of a
+/// brush at rest slides toward it (place_window): a bead of stiff paint (oil 0.1) at rest on an
+/// upright canvas stays below 0.03, one of oily paint (oil 0.9) runs at about 80.
+constexpr float kMovingPaint = 1.f;
 /// An empty keep box: every particle goes to the grid (settle, grid-only paint).
 KeepBox nowhere() { return KeepBox::of(Int3{}, Int3{}); }
 
@@ -100,6 +104,7 @@ void Simulator::reset_brush(const BrushPose& pose) {
   p.position.z += ground_;
   brush_->reset(p);
   box_ = samples_box();  // the next step's window holds where the brush is now, not the path to it
+  moving_.reset();
 }
 
 bool Simulator::paint_at_rest() const {
@@ -394,8 +399,24 @@ Simulator::WindowPlace Simulator::place_window(const std::array<float, 4>& befor
   const float floor_D0 = std::min(D0, transfer_->params().absorb_range() + distance_error(tp));
   zone_D0_ = std::clamp(room, floor_D0, D0);
   w.zone_room = room - floor_D0;
-  const float cx = 0.5f * (x0 + x1), cy = 0.5f * (y0 + y1);
+  float cx = 0.5f * (x0 + x1), cy = 0.5f * (y0 + y1);
   const int snap = std::max(config_.params.grid.window_snap, 1);
+  const float moved = std::max(std::abs(after[0] + after[1] - before[0] - before[1]),
+                               std::abs(after[2] + after[3] - before[2] - before[3]));
+  w.resting = 0.5f * moved <= kRestingBox;
+  if (w.resting && moving_) {
+    // Paint flows only inside the window. A brush at rest leaves the window free to slide off its
+    // box's centre toward the paint that still flowed last step (drips down an easel, an oily
+    // pool spreading), as far as the particle zone at D0's floor and the box's miss allow.
+    const std::array<float, 4>& m = *moving_;
+    const float slack = std::max(0.f, std::min(w.zone_room, w.rim_room - 2.f * box_miss_ - 1.f));
+    const float dx = std::clamp(0.5f * (std::min(x0, m[0]) + std::max(x1, m[1])) - cx, -slack, slack);
+    const float dy = std::clamp(0.5f * (std::min(y0, m[2]) + std::max(y1, m[3])) - cy, -slack, slack);
+    const float off = std::max(std::abs(dx), std::abs(dy));
+    cx += dx, cy += dy;
+    w.rim_room -= off, w.zone_room -= off;
+    zone_D0_ = std::clamp(room - off, floor_D0, D0);
+  }
   w.origin = grid_->window().origin_for(Vec3(cx, cy, 0.f), snap);
   // Paint flows in the columns whose centres lie within the window's half-size less half a snap
   // of the box's centre: always inside the window (its origin is off by at most half a snap),
@@ -404,9 +425,7 @@ Simulator::WindowPlace Simulator::place_window(const std::array<float, 4>& befor
   // over a snap of the brush's travel, still settling, and the body would set in steps of the
   // snap's length (docs/GRID.md "The window's walls"). A brush at rest moves no wall: the whole
   // window flows.
-  const float moved = std::max(std::abs(after[0] + after[1] - before[0] - before[1]),
-                               std::abs(after[2] + after[3] - before[2] - before[3]));
-  if (0.5f * moved > kRestingBox) {
+  if (!w.resting) {
     const float hx = 0.5f * float(n.x - snap), hy = 0.5f * float(n.y - snap);
     w.flow = FlowColumns{int(std::ceil(cx - hx - 0.5f)), int(std::ceil(cx + hx - 0.5f)), int(std::ceil(cy - hy - 0.5f)),
                          int(std::ceil(cy + hy - 0.5f))};
@@ -559,6 +578,7 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
   const std::array<float, 4> box_before = box_;
   const Vec3 tips_before = footprint_centre(brush_->pose(), config_.brush.length);
   brush_stage(poses, substeps, dt);
+  bool resting = false;
 
   // --- 3. Window: follow the brush; rasterise the bristles into it (boundary of §4.2) -----
   {
@@ -577,6 +597,7 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
       w = place_window(box_before, box_);
       ++counters_.box_reads;
     }
+    resting = w.resting;
     if (config_.particles) {
       counters_.zone_cut_steps += w.zone_room < 0.f;
       counters_.zone_room_min = std::min(counters_.zone_room_min, w.zone_room);
@@ -636,7 +657,11 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
     WB_PROFILE_SCOPE("books");
     count_nonfinite(false);
     queue_samples_box(step_sums_.data()->extent);
+    if (resting) grid_->moving_box_into(step_sums_.data()->moving, kMovingPaint);
     books_.record(rec, record_census(rec));
+    const float* m = last_record_.moving;
+    moving_.reset();
+    if (resting && m[0] >= -m[1] && m[2] >= -m[3]) moving_ = std::array<float, 4>{-m[1], m[0], -m[3], m[2]};
     counters_.returned_at_moves += rec.to_grid_at_moves;
     box_ = box_from(last_record_.extent);
     box_miss_ = 0.f;

@@ -5,20 +5,21 @@
 #include <array>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <utility>
 #include <vector>
 
 #include "core/brush/brush.h"
 #include "core/canvas/tile_store.h"
-#include "core/exec/device.h"
 #include "core/exec/atomics.h"
+#include "core/exec/device.h"
 #include "core/exec/profile.h"
 #include "core/exec/workspace.h"
 #include "core/grid/grid.h"
 #include "core/io/stroke.h"
 #include "core/params/sim_params.h"
-#include "core/particles/sample_grid.h"
 #include "core/particles/particle_store.h"
+#include "core/particles/sample_grid.h"
 #include "core/render/renderer.h"
 #include "core/transfer/paint_books.h"
 #include "core/transfer/transfer.h"
@@ -226,6 +227,7 @@ class Simulator {
     float rim_room;   ///< between the box and the window's rim, less half a snap (the centre's error)
     float zone_room;  ///< for the particle zone at D0's floor (negative: the window cuts it)
     FlowColumns flow;  ///< the columns where paint flows: centred on the box, whatever the snap
+    bool resting = false;  ///< the box stood still over the step: no wall moves, the window may slide
   };
   /// The window for the samples' box over the step (the union of `before` and `after`), and the
   /// D0 that keeps the particle zone inside its kept box (zone_D0_).
@@ -264,6 +266,7 @@ class Simulator {
     double canvas_sums[2];  ///< the canvas's scatter sums not yet read (TileStore::mass_sums)
     double gathered;        ///< the window region's density at its last gather
     float extent[kExtentValues];  ///< the samples' box and the ground at the step's end (queue_samples_box)
+    float moving[4];              ///< the box of paint still flowing, on a resting step (Grid::moving_box_into)
     int32_t tiles_used;           ///< the canvas's slots in use (TileStore::tiles_used)
     AdvectPlan advect;            ///< the grid's advection plan (Grid::take_advect_plan)
   };
@@ -277,6 +280,9 @@ class Simulator {
   Int3 raster_origin_{};              ///< and the window origin it was made at
   DeviceBuffer<float> extent_scratch_, extent_;  ///< the samples' box and the ground (samples_box)
   std::array<float, 4> box_{};                   ///< the samples' box at the end of the last step
+  /// The box (x_lo, x_hi, y_lo, y_hi) of the paint that still flowed at the end of the last step,
+  /// measured where the brush rested (place_window slides the window toward it).
+  std::optional<std::array<float, 4>> moving_;
   std::array<float, 4> guess_{};                 ///< this step's box as the pen's travel moves the last
   float box_miss_ = 0.f;                         ///< the last step's largest miss of guess_, cells
   /// Top of the dried paint under the brush's footprint at the end of the last step, cells: the
