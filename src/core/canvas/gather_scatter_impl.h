@@ -23,10 +23,14 @@ WB_HD WB_INLINE CanvasCellRef locate(const TileStoreView& t, int cx, int cy, int
   r.at = int64_t(slot) * t.tile_cells() + t.cell_offset(cx % kTileSize, cy % kTileSize, cz);
   return r;
 }
+/// A window's cells number fewer than 2^32 (PaintWindow requires it): two 32-bit divisions, a
+/// fraction of the three 64-bit ones' cost (a GPU emulates those in software).
 WB_HD WB_INLINE void decompose(const PaintWindowView& w, int64_t i, int& x, int& y, int& z) {
-  x = int(i % w.nx);
-  y = int((i / w.nx) % w.ny);
-  z = int(i / (int64_t(w.nx) * w.ny));
+  const uint32_t t = uint32_t(i), nx = uint32_t(w.nx), ny = uint32_t(w.ny);
+  const uint32_t row = t / nx, layer = row / ny;
+  x = int(t - row * nx);
+  y = int(row - layer * ny);
+  z = int(layer);
 }
 }  // namespace detail
 
