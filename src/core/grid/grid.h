@@ -84,9 +84,9 @@ class Grid {
   /// The columns where paint flows from now on (canvas cells; FlowColumns): outside them the
   /// window's cells are walls. The simulator keeps them a fixed distance from the brush.
   void set_flow_columns(const FlowColumns& f) { flow_ = f; }
-  /// The box of the columns whose wet paint moves faster than `speed` (cells/s) on any face of
-  /// its cells, as the maxima of x, -x, y and -y (canvas cells; -inf where none), into out[0..4)
-  /// on the device: where paint still flows, for the window of a brush at rest to hold it.
+  /// The box of the columns whose wet paint runs faster than `speed` (cells/s) on a face of its
+  /// cells across the canvas (u, v), as the maxima of x, -x, y and -y (canvas cells; -inf where
+  /// none), into out[0..4) on the device: where paint runs, for the window of a resting brush.
   void moving_box_into(float* out, float speed);
   /// This step's particle density on the window (cell fractions), or null before the joint fields.
   const float* particle_density() const { return particle_density_; }

@@ -135,8 +135,9 @@ void grid_column_tops(GridDims d, const float* rho, const float* particle_densit
 }
 
 void grid_moving_columns(GridView g, PaintWindowView pw, float dry_threshold, float speed, float* out) {
-  // A column moves where a cell of wet paint has a face faster than `speed`: its x, -x, y, -y
-  // (canvas cells, the column's centre) for the maxima that make the box of such columns.
+  // A column moves where a cell of wet paint has a face across the canvas (u or v) faster than
+  // `speed`: paint sinking as it settles (w) does not run. Its x, -x, y, -y (canvas cells, the
+  // column's centre) for the maxima that make the box of such columns.
   const GridDims d = g.d;
   const int64_t n = int64_t(d.nx) * d.ny;
   parallel_for(n, [=] WB_HD(int64_t col) {
@@ -147,8 +148,7 @@ void grid_moving_columns(GridView g, PaintWindowView pw, float dry_threshold, fl
       if (!(pw.density[c] > 0.f) || pw.dryness[c] >= dry_threshold) continue;
       const float u = fmaxf(fabsf(g.vel[0][d.uidx(i, j, k)]), fabsf(g.vel[0][d.uidx(i + 1, j, k)]));
       const float v = fmaxf(fabsf(g.vel[1][d.vidx(i, j, k)]), fabsf(g.vel[1][d.vidx(i, j + 1, k)]));
-      const float w = fmaxf(fabsf(g.vel[2][d.widx(i, j, k)]), fabsf(g.vel[2][d.widx(i, j, k + 1)]));
-      moving = fmaxf(fmaxf(u, v), w) > speed;
+      moving = fmaxf(u, v) > speed;
     }
     const float none = -INFINITY, x = float(i + pw.ox) + 0.5f, y = float(j + pw.oy) + 0.5f;
     out[col] = moving ? x : none;

@@ -27,10 +27,12 @@ constexpr int kKeepRimTop = 3;
 /// A samples' box whose centre moved less than this over a step (cells) is a brush at rest: a
 /// lifted brush's bristles sway by 0.01-0.1 cells a step; the slowest stroke tested, 5 mm/s, moves 0.42.
 constexpr float kRestingBox = 0.1f;
-/// Wet paint with a face faster than this (cells/s, 0.2 mm/s) still flows, and the window of a
-/// brush at rest slides toward it (place_window): a bead of stiff paint (oil 0.1) at rest on an
-/// upright canvas stays below 0.03, one of oily paint (oil 0.9) runs at about 80.
-constexpr float kMovingPaint = 1.f;
+/// Wet paint with a face across the canvas faster than this (cells/s, 2 mm/s) runs, and the window
+/// of a brush at rest slides toward it where it nears a wall (place_window). A bead of oily paint
+/// (oil 0.9) runs down an upright canvas at about 80, stiff-and-oily's pool spreads its edge
+/// faster than 10; a stiff bead at rest stays below 0.03, and a stroke's body settling behind the
+/// lifted brush (the rib test's flat at 5 mm/s) runs between 3 and 10.
+constexpr float kRunningPaint = 10.f;
 /// An empty keep box: every particle goes to the grid (settle, grid-only paint).
 KeepBox nowhere() { return KeepBox::of(Int3{}, Int3{}); }
 
@@ -105,6 +107,7 @@ void Simulator::reset_brush(const BrushPose& pose) {
   brush_->reset(p);
   box_ = samples_box();  // the next step's window holds where the brush is now, not the path to it
   moving_.reset();
+  slid_ = {0.f, 0.f};
 }
 
 bool Simulator::paint_at_rest() const {
@@ -404,14 +407,31 @@ Simulator::WindowPlace Simulator::place_window(const std::array<float, 4>& befor
   const float moved = std::max(std::abs(after[0] + after[1] - before[0] - before[1]),
                                std::abs(after[2] + after[3] - before[2] - before[3]));
   w.resting = 0.5f * moved <= kRestingBox;
-  if (w.resting && moving_) {
+  if (!w.resting) slid_ = {0.f, 0.f};
+  if (w.resting && (moving_ || slid_[0] != 0.f || slid_[1] != 0.f)) {
     // Paint flows only inside the window. A brush at rest leaves the window free to slide off its
-    // box's centre toward the paint that still flowed last step (drips down an easel, an oily
-    // pool spreading), as far as the particle zone at D0's floor and the box's miss allow.
-    const std::array<float, 4>& m = *moving_;
+    // box's centre toward paint that ran at the last step's end within the rim of a wall of the
+    // window centred on the box (drips down an easel, an oily pool spreading): along each axis,
+    // far enough to give that paint a rim's room beyond the rim, as far as the paint at the other
+    // wall keeps out of its own rim and the particle zone at D0's floor and the box's miss allow.
+    // The window stays slid while the brush rests (a window swinging back and forth would stop
+    // and free the paint at its walls by turns). A wall that slid back over a stroke's body would
+    // set its frozen part flowing again, a step where the freeze resumed: paint settling runs
+    // slower than kRunningPaint, and paint away from the walls moves no wall.
     const float slack = std::max(0.f, std::min(w.zone_room, w.rim_room - 2.f * box_miss_ - 1.f));
-    const float dx = std::clamp(0.5f * (std::min(x0, m[0]) + std::max(x1, m[1])) - cx, -slack, slack);
-    const float dy = std::clamp(0.5f * (std::min(y0, m[2]) + std::max(y1, m[3])) - cy, -slack, slack);
+    if (moving_) {
+      const std::array<float, 4>& m = *moving_;
+      const Int3 o = grid_->window().origin_for(Vec3(cx, cy, 0.f), snap);
+      const auto slide = [&](float mlo, float mhi, int wall, int side, float was) {
+        const float lo = float(wall + kKeepRim) - mlo, hi = mhi - float(wall + side - kKeepRim);  // > 0: in the rim
+        float d = 0.f;
+        if (lo > 0.f && hi < 0.f) d = -std::min(lo + float(kKeepRim), -hi);
+        if (hi > 0.f && lo < 0.f) d = std::min(hi + float(kKeepRim), -lo);
+        return std::abs(was) > std::abs(d) && was * d >= 0.f ? was : d;
+      };
+      slid_ = {slide(m[0], m[1], o.x, n.x, slid_[0]), slide(m[2], m[3], o.y, n.y, slid_[1])};
+    }
+    const float dx = std::clamp(slid_[0], -slack, slack), dy = std::clamp(slid_[1], -slack, slack);
     const float off = std::max(std::abs(dx), std::abs(dy));
     cx += dx, cy += dy;
     w.rim_room -= off, w.zone_room -= off;
@@ -657,7 +677,7 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
     WB_PROFILE_SCOPE("books");
     count_nonfinite(false);
     queue_samples_box(step_sums_.data()->extent);
-    if (resting) grid_->moving_box_into(step_sums_.data()->moving, kMovingPaint);
+    if (resting) grid_->moving_box_into(step_sums_.data()->moving, kRunningPaint);
     books_.record(rec, record_census(rec));
     const float* m = last_record_.moving;
     moving_.reset();

@@ -283,6 +283,8 @@ class Simulator {
   /// The box (x_lo, x_hi, y_lo, y_hi) of the paint that still flowed at the end of the last step,
   /// measured where the brush rested (place_window slides the window toward it).
   std::optional<std::array<float, 4>> moving_;
+  /// How far the window of the resting brush has slid off its box's centre (x, y), cells.
+  std::array<float, 2> slid_{};
   std::array<float, 4> guess_{};                 ///< this step's box as the pen's travel moves the last
   float box_miss_ = 0.f;                         ///< the last step's largest miss of guess_, cells
   /// Top of the dried paint under the brush's footprint at the end of the last step, cells: the
