@@ -366,10 +366,10 @@ void Grid::column_maxima(float trace, int slot) {
     reduce_max_into(device(), cell_tmp_.data() + s * columns, columns, advect_max_.data() + slot + s, ws_);
 }
 
-void Grid::moving_box_into(float* out, float speed) {
+void Grid::running_box_into(float* out, float speed) {
   const GridDims g = dims();
   const int64_t columns = int64_t(g.nx) * g.ny;
-  grid_moving_columns(device(), view(), window_.paint().view(), params_.dry_threshold, speed, cell_tmp_.data());
+  grid_running_columns(device(), view(), window_.paint().view(), params_.dry_threshold, speed, cell_tmp_.data());
   for (int s = 0; s < 4; ++s) reduce_max_into(device(), cell_tmp_.data() + s * columns, columns, out + s, ws_);
 }
 

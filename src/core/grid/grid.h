@@ -87,7 +87,7 @@ class Grid {
   /// The box of the columns whose wet paint runs faster than `speed` (cells/s) on a face of its
   /// cells across the canvas (u, v), as the maxima of x, -x, y and -y (canvas cells; -inf where
   /// none), into out[0..4) on the device: where paint runs, for the window of a resting brush.
-  void moving_box_into(float* out, float speed);
+  void running_box_into(float* out, float speed);
   /// This step's particle density on the window (cell fractions), or null before the joint fields.
   const float* particle_density() const { return particle_density_; }
 
@@ -241,7 +241,7 @@ class Grid {
   X(void, grid_column_tops, (GridDims d, const float* rho, const float* particle_density, float trace, float* out),    \
     (d, rho, particle_density, trace, out))                                                                            \
   X(void, grid_first_extent, (GridDims d, const float* maxima, GridExtent* e), (d, maxima, e))                         \
-  X(void, grid_moving_columns, (GridView g, PaintWindowView pw, float dry_threshold, float speed, float* out),         \
+  X(void, grid_running_columns, (GridView g, PaintWindowView pw, float dry_threshold, float speed, float* out),         \
     (g, pw, dry_threshold, speed, out))                                                                                \
   X(void, grid_advect_plan,                                                                                            \
     (GridDims d, const float* rates, const float* paint_top, const float* joint, float dt, AdvectPlan* plan,           \

@@ -134,27 +134,27 @@ void grid_column_tops(GridDims d, const float* rho, const float* particle_densit
   });
 }
 
-void grid_moving_columns(GridView g, PaintWindowView pw, float dry_threshold, float speed, float* out) {
-  // A column moves where a cell of wet paint has a face across the canvas (u or v) faster than
+void grid_running_columns(GridView g, PaintWindowView pw, float dry_threshold, float speed, float* out) {
+  // A column runs where a cell of wet paint has a face across the canvas (u or v) faster than
   // `speed`: paint sinking as it settles (w) does not run. Its x, -x, y, -y (canvas cells, the
   // column's centre) for the maxima that make the box of such columns.
   const GridDims d = g.d;
   const int64_t n = int64_t(d.nx) * d.ny;
   parallel_for(n, [=] WB_HD(int64_t col) {
     const int i = int(col % d.nx), j = int(col / d.nx);
-    bool moving = false;
-    for (int k = 0; k < d.nz && !moving; ++k) {
+    bool running = false;
+    for (int k = 0; k < d.nz && !running; ++k) {
       const int64_t c = d.cell(i, j, k);
       if (!(pw.density[c] > 0.f) || pw.dryness[c] >= dry_threshold) continue;
       const float u = fmaxf(fabsf(g.vel[0][d.uidx(i, j, k)]), fabsf(g.vel[0][d.uidx(i + 1, j, k)]));
       const float v = fmaxf(fabsf(g.vel[1][d.vidx(i, j, k)]), fabsf(g.vel[1][d.vidx(i, j + 1, k)]));
-      moving = fmaxf(u, v) > speed;
+      running = fmaxf(u, v) > speed;
     }
     const float none = -INFINITY, x = float(i + pw.ox) + 0.5f, y = float(j + pw.oy) + 0.5f;
-    out[col] = moving ? x : none;
-    out[n + col] = moving ? -x : none;
-    out[2 * n + col] = moving ? y : none;
-    out[3 * n + col] = moving ? -y : none;
+    out[col] = running ? x : none;
+    out[n + col] = running ? -x : none;
+    out[2 * n + col] = running ? y : none;
+    out[3 * n + col] = running ? -y : none;
   });
 }
 

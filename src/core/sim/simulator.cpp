@@ -28,7 +28,7 @@ constexpr int kKeepRimTop = 3;
 /// lifted brush's bristles sway by 0.01-0.1 cells a step; the slowest stroke tested, 5 mm/s, moves 0.42.
 constexpr float kRestingBox = 0.1f;
 /// Wet paint with a face across the canvas faster than this (cells/s, 2 mm/s) runs, and the window
-/// of a brush at rest slides toward it where it nears a wall (place_window). A bead of oily paint
+/// of a brush at rest slides away from a wall it nears (place_window). A bead of oily paint
 /// (oil 0.9) runs down an upright canvas at about 80, stiff-and-oily's pool spreads its edge
 /// faster than 10; a stiff bead at rest stays below 0.03, and a stroke's body settling behind the
 /// lifted brush (the rib test's flat at 5 mm/s) runs between 3 and 10.
@@ -106,7 +106,7 @@ void Simulator::reset_brush(const BrushPose& pose) {
   p.position.z += ground_;
   brush_->reset(p);
   box_ = samples_box();  // the next step's window holds where the brush is now, not the path to it
-  moving_.reset();
+  running_.reset();
   slid_ = {0.f, 0.f};
 }
 
@@ -408,7 +408,7 @@ Simulator::WindowPlace Simulator::place_window(const std::array<float, 4>& befor
                                std::abs(after[2] + after[3] - before[2] - before[3]));
   w.resting = 0.5f * moved <= kRestingBox;
   if (!w.resting) slid_ = {0.f, 0.f};
-  if (w.resting && (moving_ || slid_[0] != 0.f || slid_[1] != 0.f)) {
+  if (w.resting && (running_ || slid_[0] != 0.f || slid_[1] != 0.f)) {
     // Paint flows only inside the window. A brush at rest leaves the window free to slide off its
     // box's centre toward paint that ran at the last step's end within the rim of a wall of the
     // window centred on the box (drips down an easel, an oily pool spreading): along each axis,
@@ -419,8 +419,8 @@ Simulator::WindowPlace Simulator::place_window(const std::array<float, 4>& befor
     // set its frozen part flowing again, a step where the freeze resumed: paint settling runs
     // slower than kRunningPaint, and paint away from the walls moves no wall.
     const float slack = std::max(0.f, std::min(w.zone_room, w.rim_room - 2.f * box_miss_ - 1.f));
-    if (moving_) {
-      const std::array<float, 4>& m = *moving_;
+    if (running_) {
+      const std::array<float, 4>& m = *running_;
       const Int3 o = grid_->window().origin_for(Vec3(cx, cy, 0.f), snap);
       const auto slide = [&](float mlo, float mhi, int wall, int side, float was) {
         const float lo = float(wall + kKeepRim) - mlo, hi = mhi - float(wall + side - kKeepRim);  // > 0: in the rim
@@ -677,11 +677,11 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
     WB_PROFILE_SCOPE("books");
     count_nonfinite(false);
     queue_samples_box(step_sums_.data()->extent);
-    if (resting) grid_->moving_box_into(step_sums_.data()->moving, kRunningPaint);
+    if (resting) grid_->running_box_into(step_sums_.data()->running, kRunningPaint);
     books_.record(rec, record_census(rec));
-    const float* m = last_record_.moving;
-    moving_.reset();
-    if (resting && m[0] >= -m[1] && m[2] >= -m[3]) moving_ = std::array<float, 4>{-m[1], m[0], -m[3], m[2]};
+    const float* m = last_record_.running;
+    running_.reset();
+    if (resting && m[0] >= -m[1] && m[2] >= -m[3]) running_ = std::array<float, 4>{-m[1], m[0], -m[3], m[2]};
     counters_.returned_at_moves += rec.to_grid_at_moves;
     box_ = box_from(last_record_.extent);
     box_miss_ = 0.f;

@@ -266,7 +266,7 @@ class Simulator {
     double canvas_sums[2];  ///< the canvas's scatter sums not yet read (TileStore::mass_sums)
     double gathered;        ///< the window region's density at its last gather
     float extent[kExtentValues];  ///< the samples' box and the ground at the step's end (queue_samples_box)
-    float moving[4];              ///< the box of paint still flowing, on a resting step (Grid::moving_box_into)
+    float running[4];             ///< the box of running paint, on a resting step (Grid::running_box_into)
     int32_t tiles_used;           ///< the canvas's slots in use (TileStore::tiles_used)
     AdvectPlan advect;            ///< the grid's advection plan (Grid::take_advect_plan)
   };
@@ -280,9 +280,9 @@ class Simulator {
   Int3 raster_origin_{};              ///< and the window origin it was made at
   DeviceBuffer<float> extent_scratch_, extent_;  ///< the samples' box and the ground (samples_box)
   std::array<float, 4> box_{};                   ///< the samples' box at the end of the last step
-  /// The box (x_lo, x_hi, y_lo, y_hi) of the paint that still flowed at the end of the last step,
-  /// measured where the brush rested (place_window slides the window toward it).
-  std::optional<std::array<float, 4>> moving_;
+  /// The box (x_lo, x_hi, y_lo, y_hi) of the paint that ran at the end of the last step, measured
+  /// where the brush rested (place_window slides the window away from a wall it nears).
+  std::optional<std::array<float, 4>> running_;
   /// How far the window of the resting brush has slid off its box's centre (x, y), cells.
   std::array<float, 2> slid_{};
   std::array<float, 4> guess_{};                 ///< this step's box as the pen's travel moves the last
