@@ -241,7 +241,7 @@ class Grid {
   X(void, grid_column_tops, (GridDims d, const float* rho, const float* particle_density, float trace, float* out),    \
     (d, rho, particle_density, trace, out))                                                                            \
   X(void, grid_first_extent, (GridDims d, const float* maxima, GridExtent* e), (d, maxima, e))                         \
-  X(void, grid_running_columns, (GridView g, PaintWindowView pw, float dry_threshold, float speed, float* out),         \
+  X(void, grid_running_columns, (GridView g, PaintWindowView pw, float dry_threshold, float speed, float* out),        \
     (g, pw, dry_threshold, speed, out))                                                                                \
   X(void, grid_advect_plan,                                                                                            \
     (GridDims d, const float* rates, const float* paint_top, const float* joint, float dt, AdvectPlan* plan,           \
