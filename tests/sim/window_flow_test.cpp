@@ -1,6 +1,6 @@
 // Paint flows only inside the active window, which follows the brush. Where the brush rests, the
-// window slides toward the paint that still flows (Simulator::place_window), so a bead running down
-// an upright canvas beside a resting brush runs as it would in a window holding the whole canvas,
+// window slides away from a wall that running paint nears (Simulator::place_window), so a bead
+// running down an upright canvas beside a resting brush runs as it would in a taller window,
 // instead of stopping on the wall the brush placed (docs/GRID.md "The window's walls").
 #include <algorithm>
 #include <cstdio>
