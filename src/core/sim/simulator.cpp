@@ -408,7 +408,7 @@ Simulator::WindowPlace Simulator::place_window(const std::array<float, 4>& befor
                                std::abs(after[2] + after[3] - before[2] - before[3]));
   w.resting = 0.5f * moved <= kRestingBox;
   if (!w.resting) slid_ = {0.f, 0.f};
-  if (w.resting && (running_ || slid_[0] != 0.f || slid_[1] != 0.f)) {
+  if (w.resting) {
     // Paint flows only inside the window. A brush at rest leaves the window free to slide off its
     // box's centre toward paint that ran at the last step's end within the rim of a wall of the
     // window centred on the box (drips down an easel, an oily pool spreading): along each axis,
