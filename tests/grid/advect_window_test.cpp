@@ -101,23 +101,41 @@ TEST_F(AdvectWindowTest, MovesCarryVelocityWithTheCanvas) {
   TileStore canvas(device_, CanvasDims{512, 512, 64});
   ActiveWindow w(canvas, Int3{32, 24, 16}, Int3{100, 100, 0});
   const GridDims d = w.grid_dims();
-  // u as a function of the canvas position of each face.
-  auto value = [](int cx, int cy, int cz) { return float(cx) + 1000.f * float(cy) + 0.25f * float(cz); };
-  std::vector<float> u0(size_t(d.nu()));
-  for (int k = 0; k < d.nz; ++k)
-    for (int j = 0; j < d.ny; ++j)
-      for (int i = 0; i <= d.nx; ++i) u0[size_t(d.uidx(i, j, k))] = value(i + 100, j + 100, k);
-  w.velocity(0).copy_from_host(u0);
-  w.move_to(Int3{108, 92, 0});
-  const auto u1 = w.velocity(0).to_host();
-  for (int k = 0; k < d.nz; ++k)
-    for (int j = 0; j < d.ny; ++j)
-      for (int i = 0; i <= d.nx; ++i) {
-        const int cx = i + 108, cy = j + 92;
-        const bool overlap = cx - 100 <= d.nx && cy - 100 >= 0;
-        const float expect = overlap ? value(cx, cy, k) : 0.f;
-        ASSERT_EQ(u1[size_t(d.uidx(i, j, k))], expect) << i << " " << j << " " << k;
-      }
+  // Each component as a function of the canvas position of each face, laid before each move;
+  // after it, a face holds the value of its canvas position where the old window had that
+  // face, and 0 elsewhere. Moves along every axis and sign, and one past the window.
+  auto value = [](int c, int cx, int cy, int cz) {
+    return 1.f + float(cx) + 1000.f * float(cy) + 0.25f * float(cz) + 1e6f * float(c);
+  };
+  const Int3 moves[] = {{8, -8, 0}, {-5, 3, 0}, {0, 7, 0}, {-9, 0, 0}, {3, -2, 1}, {1, 1, -1}, {40, 0, 0}};
+  for (const Int3& m : moves) {
+    const Int3 o = w.origin(), to{o.x + m.x, o.y + m.y, o.z + m.z};
+    for (int c = 0; c < 3; ++c) {
+      int ex, ey, ez;
+      d.face_extent(c, ex, ey, ez);
+      std::vector<float> v(size_t(d.faces(c)));
+      for (int k = 0; k < ez; ++k)
+        for (int j = 0; j < ey; ++j)
+          for (int i = 0; i < ex; ++i) v[size_t((int64_t(k) * ey + j) * ex + i)] = value(c, i + o.x, j + o.y, k + o.z);
+      w.velocity(c).copy_from_host(v);
+    }
+    w.move_to(to);
+    for (int c = 0; c < 3; ++c) {
+      int ex, ey, ez;
+      d.face_extent(c, ex, ey, ez);
+      const auto v = w.velocity(c).to_host();
+      for (int k = 0; k < ez; ++k)
+        for (int j = 0; j < ey; ++j)
+          for (int i = 0; i < ex; ++i) {
+            const int si = i + m.x, sj = j + m.y, sk = k + m.z;
+            const bool overlap = si >= 0 && sj >= 0 && sk >= 0 && si < ex && sj < ey && sk < ez;
+            const float expect = overlap ? value(c, i + to.x, j + to.y, k + to.z) : 0.f;
+            ASSERT_EQ(v[size_t((int64_t(k) * ey + j) * ex + i)], expect)
+                << "move " << m.x << "," << m.y << "," << m.z << " component " << c << " face " << i << " " << j << " "
+                << k;
+          }
+    }
+  }
 }
 
 TEST_F(AdvectWindowTest, RecentreSnapsToTheGrid) {

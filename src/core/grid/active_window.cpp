@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/exec/algorithms.h"
+#include "core/exec/memory.h"
 #include "core/exec/profile.h"
 #include "core/grid/grid.h"
 
@@ -27,11 +28,24 @@ ActiveWindow::ActiveWindow(TileStore& canvas, Int3 dims, Int3 origin)
 }
 
 void ActiveWindow::shift_faces(int c, int dx, int dy, int dz) {
+  // dst(i, j, k) = src(i + dx, j + dy, k + dz), 0 where that is outside: one offset copy of the
+  // lattice (the bandwidth of a copy, no per-element index arithmetic), zero at its two ends
+  // (the layers with no source) and at the x and y edges (grid_shift_edges).
   const GridDims d = grid_dims();
   int ex, ey, ez;
   d.face_extent(c, ex, ey, ez);
-  shift_tmp_.resize(size_t(d.faces(c)));
-  grid_shift_lattice(device(), vel_[c].data(), shift_tmp_.data(), ex, ey, ez, dx, dy, dz);
+  const int64_t n = d.faces(c), off = (int64_t(dz) * ey + dy) * ex + dx;
+  const int64_t lo = std::clamp<int64_t>(-off, 0, n), hi = std::clamp<int64_t>(n - off, lo, n);
+  shift_tmp_.resize(size_t(n));
+  float* dst = shift_tmp_.data();
+  const float* src = vel_[c].data();
+  if (lo > 0) mem::fill_zero(device(), dst, size_t(lo) * sizeof(float));
+  if (hi > lo) mem::copy_on_device(device(), dst + lo, src + lo + off, size_t(hi - lo) * sizeof(float));
+  if (hi < n) mem::fill_zero(device(), dst + hi, size_t(n - hi) * sizeof(float));
+  if (std::abs(dx) < ex && std::abs(dy) < ey && hi > lo)
+    grid_shift_edges(device(), dst, ex, ey, ez, dx, dy);
+  else if (hi > lo)
+    mem::fill_zero(device(), dst, size_t(n) * sizeof(float));  // a move past the window: nothing stays
   vel_[c].swap(shift_tmp_);
 }
 

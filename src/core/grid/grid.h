@@ -314,8 +314,7 @@ class Grid {
   X(void, grid_extrapolate, (GridView g), (g))                                                                         \
   X(void, grid_extent, (GridDims d, const float* before, const float* after, GridExtent* e), (d, before, after, e))    \
   X(void, grid_dry, (PaintWindowView pw, float amount), (pw, amount))                                                  \
-  X(void, grid_shift_lattice, (const float* src, float* dst, int ex, int ey, int ez, int dx, int dy, int dz),          \
-    (src, dst, ex, ey, ez, dx, dy, dz))                                                                                \
+  X(void, grid_shift_edges, (float* dst, int ex, int ey, int ez, int dx, int dy), (dst, ex, ey, ez, dx, dy))           \
   X(void, grid_max_abs_fluid_velocity, (GridView g, float* out), (g, out))                                             \
   X(void, grid_square, (const float* x, float* out, int64_t n), (x, out, n))                                           \
   X(void, grid_scale, (float* x, float s, int64_t n), (x, s, n))                                                       \

@@ -841,14 +841,24 @@ void grid_dry(PaintWindowView pw, float amount) {
   });
 }
 
-void grid_shift_lattice(const float* src, float* dst, int ex, int ey, int ez, int dx, int dy, int dz) {
-  // A window's lattices number fewer than 2^32 (GridDims::split): 32-bit divisions, the cheaper.
-  parallel_for(int64_t(ex) * ey * ez, [=] WB_HD(int64_t t) {
-    const uint32_t u = uint32_t(t), w = uint32_t(ex), h = uint32_t(ey);
-    const int i = int(u % w), j = int((u / w) % h), k = int(u / (w * h));
-    const int si = i + dx, sj = j + dy, sk = k + dz;
-    const bool in = si >= 0 && sj >= 0 && sk >= 0 && si < ex && sj < ey && sk < ez;
-    dst[t] = in ? src[(int64_t(sk) * ey + sj) * ex + si] : 0.f;
+void grid_shift_edges(float* dst, int ex, int ey, int ez, int dx, int dy) {
+  // A lattice shifted by (dx, dy) as one offset copy (ActiveWindow::shift_faces) takes, at the
+  // x and y edges, elements of the neighbouring row or layer: they have no source and are zeroed
+  // here. Per layer: the |dy| rows whose source row is outside, then |dx| elements of each other row.
+  const int ax = dx < 0 ? -dx : dx, ay = dy < 0 ? -dy : dy;
+  const int64_t rows = int64_t(ay) * ex, layer = rows + int64_t(ey - ay) * ax;
+  parallel_for(int64_t(ez) * layer, [=] WB_HD(int64_t t) {
+    const int64_t k = t / layer, r = t - k * layer;
+    int i, j;
+    if (r < rows) {
+      j = (dy > 0 ? ey - dy : 0) + int(r / ex);
+      i = int(r % ex);
+    } else {
+      const int64_t q = r - rows;
+      j = (dy < 0 ? -dy : 0) + int(q / ax);
+      i = (dx > 0 ? ex - dx : 0) + int(q % ax);
+    }
+    dst[(k * ey + j) * ex + i] = 0.f;
   });
 }
 

@@ -30,7 +30,8 @@ struct CellField {
 /// Fixed point of order-independent sums (DepositScratch): 2^-40 per unit (9e-13 of a cell,
 /// 7e-21 kg), exact for any float of at least 2^-40 and far from overflow (2^23 cells a cell).
 WB_HD WB_INLINE int64_t to_fixed(float v) { return llrintf(v * 1099511627776.f); }
-WB_HD WB_INLINE float from_fixed(int64_t v) { return float(double(v) * (1.0 / 1099511627776.0)); }
+WB_HD WB_INLINE double from_fixed_sum(int64_t v) { return double(v) * (1.0 / 1099511627776.0); }
+WB_HD WB_INLINE float from_fixed(int64_t v) { return float(from_fixed_sum(v)); }
 
 /// Trilinear sum over the 8 cell centres of g's lattice around canvas position p: the weight of
 /// each node in the field times value(index of the cell); nodes outside the field are left out.

@@ -95,7 +95,10 @@ Transfer::Transfer(const Device& device, const TransferParams& params)
   for (auto& b : s_u32_) b.set_device(device);
   for (auto& b : s_f32_) b.set_device(device);
   for (auto& b : c_f32_) b.set_device(device);
-  for (auto& b : c_i64_) b.set_device(device);
+  for (auto& b : deposit_sums_) b.set_device(device);
+  deposit_listed_.set_device(device);
+  deposit_cells_.set_device(device);
+  deposit_count_ = DeviceBuffer<int64_t>(device, 2);
   p_moved_.set_device(device);
   room_count_.set_device(device);
   room_offset_.set_device(device);
@@ -117,7 +120,15 @@ void Transfer::ensure_samples(int64_t n) {
 }
 void Transfer::ensure_cells(int64_t n) {
   for (auto& b : c_f32_) b.resize(size_t(n));
-  for (auto& b : c_i64_) b.resize(size_t(n));
+  if (deposit_listed_.size() == size_t(n)) return;
+  // The deposit's sums and flags are zero between passes (DepositScratch): zeroed once here.
+  for (auto& b : deposit_sums_) {
+    b.resize(size_t(n));
+    b.fill_zero();
+  }
+  deposit_listed_.resize(size_t(n));
+  deposit_listed_.fill_zero();
+  deposit_cells_.resize(size_t(n));
 }
 void Transfer::ensure_particles(int64_t n) { p_moved_.resize(size_t(n)); }
 
@@ -326,16 +337,17 @@ void Transfer::particles_to_grid(ParticleStore& particles, const TransferEnv& en
   const int64_t np = particles.size(), nc = env.paint.size();
   ensure_cells(nc);
   ensure_particles(np);
-  for (auto& b : c_i64_) b.fill_zero();
   p_moved_.fill_zero();
+  deposit_count_.fill_zero();
   DepositScratch acc{};
-  acc.rho = c_i64_[0].data();
-  for (int c = 0; c < 3; ++c) acc.c[c] = c_i64_[1 + c].data();
-  acc.b = c_i64_[4].data();
-  acc.oil = c_i64_[5].data();
-  acc.dryness = c_i64_[6].data();
-  acc.added = c_f32_[0].data();
-  c_f32_[0].fill_zero();
+  acc.rho = deposit_sums_[0].data();
+  for (int c = 0; c < 3; ++c) acc.c[c] = deposit_sums_[1 + c].data();
+  acc.b = deposit_sums_[4].data();
+  acc.oil = deposit_sums_[5].data();
+  acc.dryness = deposit_sums_[6].data();
+  acc.listed = deposit_listed_.data();
+  acc.cells = deposit_cells_.data();
+  acc.count = deposit_count_.data();
   acc.moved = p_moved_.data();
   acc.counter = sum_field(env.only_leaving ? &TransferSums::to_grid_at_moves : &TransferSums::to_grid_count);
   acc.keep = env.keep;
@@ -343,11 +355,10 @@ void Transfer::particles_to_grid(ParticleStore& particles, const TransferEnv& en
   acc.surface = env.surface;
   if (np > 0) {
     transfer_to_grid_mark(device_, particles.view(), env.paint, db, acc, params_, env.dry_threshold);
-    transfer_to_grid_apply(device_, env.paint, acc);
+    // Density units in to_grid_into_grid; collect() turns them into kg.
+    transfer_to_grid_apply(device_, env.paint, acc, sum_field(&TransferSums::to_grid_into_grid));
   }
   reduce_sum_add_into(device_, p_moved_.data(), np, sum_field(&TransferSums::to_grid_from_particles), ws_);
-  // Density units here; collect() turns them into kg.
-  reduce_sum_add_into(device_, acc.added, nc, sum_field(&TransferSums::to_grid_into_grid), ws_);
 }
 
 void Transfer::emit(const SampleView& samples, BristleLoad& load, ParticleStore& particles, const TransferEnv& env,

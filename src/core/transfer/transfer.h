@@ -126,15 +126,19 @@ struct AbsorbScratch {
 /// Per-cell accumulators of Eq. 16 (density units = cell fractions), in the fixed point of
 /// to_fixed: integer sums do not depend on the order the particles arrive in, so the same
 /// particles always give the same cells, on any thread count (a save of the same state is the
-/// same file).
+/// same file). They are zero between passes: the mark pass lists each cell it reaches once, and
+/// the apply pass visits only those and zeroes what it read, so a pass costs in proportion to
+/// the particles returned, not to the window.
 struct DepositScratch {
-  int64_t* rho;    ///< sum m_k W / cell_mass
-  int64_t* c[3];   ///< sum (m_k W / cell_mass) c_k
-  int64_t* b;      ///< sum (m_k W / cell_mass) brightness(c_k)
+  int64_t* rho;     ///< sum m_k W / cell_mass
+  int64_t* c[3];    ///< sum (m_k W / cell_mass) c_k
+  int64_t* b;       ///< sum (m_k W / cell_mass) brightness(c_k)
   int64_t* oil;
   int64_t* dryness;
-  float* added;    ///< per cell: the density added (written by the apply pass, for the books)
-  float* moved;    ///< per particle: mass sent to the grid
+  int32_t* listed;  ///< per cell: 1 while it is in `cells`
+  uint32_t* cells;  ///< the cells reached, in the order reached
+  int64_t* count;   ///< [0] their number; [1] the density they received (to_fixed of each cell's add)
+  float* moved;     ///< per particle: mass sent to the grid
   int32_t* counter;
   KeepBox keep;             ///< particles outside it are deposited regardless (TransferEnv::keep)
   bool only_leaving;        ///< TransferEnv::only_leaving
@@ -251,7 +255,11 @@ class Transfer {
   DeviceBuffer<uint32_t> room_count_, room_offset_, room_ends_;
   // Per cell.
   DeviceBuffer<float> c_f32_[7];
-  DeviceBuffer<int64_t> c_i64_[7];
+  // Eq. 16's deposit (DepositScratch): its sums, zero between passes, and the cells listed.
+  DeviceBuffer<int64_t> deposit_sums_[7];
+  DeviceBuffer<int32_t> deposit_listed_;
+  DeviceBuffer<uint32_t> deposit_cells_;
+  DeviceBuffer<int64_t> deposit_count_;
   // Distance blocks.
   DeviceBuffer<int32_t> occ_;
   DeviceBuffer<float> d2_, d2_tmp_, edt_z_;
@@ -289,7 +297,8 @@ class Transfer {
       (db, axis, src, dst, v, z))                                                                                    \
   X(void, transfer_to_grid_mark, (ParticleView p, PaintWindowView pw, DistanceBlocks db, DepositScratch acc,         \
       TransferParams prm, float dry_threshold), (p, pw, db, acc, prm, dry_threshold))                                \
-  X(void, transfer_to_grid_apply, (PaintWindowView pw, DepositScratch acc), (pw, acc))                               \
+  X(void, transfer_to_grid_apply, (PaintWindowView pw, DepositScratch acc, double* into_grid),                       \
+      (pw, acc, into_grid))                                                                                          \
   X(void, transfer_emit_count, (SampleView s, BristleLoadView load, TransferParams prm, float dt, uint32_t* count,   \
       float* mass_each, float* swept_each, uint32_t* swept_n),                                                       \
       (s, load, prm, dt, count, mass_each, swept_each, swept_n))                                                     \
