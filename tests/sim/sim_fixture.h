@@ -8,12 +8,13 @@
 namespace wb {
 /// The stages' state behind Simulator's API, for tests that poison or inspect it.
 struct SimulatorTestAccess {
-  static Brush& brush(Simulator& s) { return *s.brush_; }
-  static Grid& grid(Simulator& s) { return *s.grid_; }
-  static ParticleStore& particles(Simulator& s) { return s.particles_; }
-  static BristleLoad& load(Simulator& s) { return *s.load_; }
-  static TileStore& canvas(Simulator& s) { return s.tiles(); }
-  static PaintWindow* live_window(Simulator& s) { return s.live_window(); }
+  // Each may change the state from outside the stages: the next step counts what it receives.
+  static Brush& brush(Simulator& s) { return (s.entry_check_ = true, *s.brush_); }
+  static Grid& grid(Simulator& s) { return (s.entry_check_ = true, *s.grid_); }
+  static ParticleStore& particles(Simulator& s) { return (s.entry_check_ = true, s.particles_); }
+  static BristleLoad& load(Simulator& s) { return (s.entry_check_ = true, *s.load_); }
+  static TileStore& canvas(Simulator& s) { return (s.entry_check_ = true, s.tiles()); }
+  static PaintWindow* live_window(Simulator& s) { return (s.entry_check_ = true, s.live_window()); }
 };
 }  // namespace wb
 

@@ -171,10 +171,22 @@ PaintCensus Simulator::record_census(TransferRecord& rec) {
   return c;
 }
 
-void Simulator::load_paint(const PaintLoad& paint) { books_.external(load_->fill(paint)); }
-void Simulator::dip(const PaintLoad& paint) { books_.external(load_->dip(paint)); }
-void Simulator::wipe(float fraction) { books_.external(-load_->wipe(fraction)); }
-void Simulator::clean() { books_.external(-load_->clean()); }
+void Simulator::load_paint(const PaintLoad& paint) {
+  entry_check_ = true;
+  books_.external(load_->fill(paint));
+}
+void Simulator::dip(const PaintLoad& paint) {
+  entry_check_ = true;
+  books_.external(load_->dip(paint));
+}
+void Simulator::wipe(float fraction) {
+  entry_check_ = true;
+  books_.external(-load_->wipe(fraction));
+}
+void Simulator::clean() {
+  entry_check_ = true;
+  books_.external(-load_->clean());
+}
 
 void Simulator::apply(const StrokeEvent& e) {
   switch (e.kind) {
@@ -193,12 +205,14 @@ void Simulator::apply(const StrokeEvent& e) {
 }
 
 void Simulator::dry_canvas() {
+  entry_check_ = true;
   settle();
   canvas_->dry_all();
   grid_->window().reload();
 }
 
 void Simulator::settle() {
+  entry_check_ = true;
   if (particles_.size() > 0) {
     // Every particle, slow or not and near the bristles or not, goes back by Eq. 16: none may
     // stay anywhere.
@@ -257,6 +271,7 @@ bool tile_has_paint(const TileData& t) {
 }  // namespace
 
 void Simulator::with_settled_canvas(const std::function<void(TileStore&)>& fn) {
+  entry_check_ = true;
   ActiveWindow& win = grid_->window();
   PaintWindow& w = win.paint();
   TileStore& canvas = *canvas_;
@@ -311,6 +326,7 @@ TileStore Simulator::settled_canvas_copy(const Device& device) {
 BristleLoadHost Simulator::brush_paint() const { return load_->to_host(); }
 
 void Simulator::set_brush_paint(const BristleLoadHost& paint) {
+  entry_check_ = true;
   const double before = load_->total_mass(ws_);
   load_->from_host(paint);
   books_.external(load_->total_mass(ws_) - before);
@@ -339,6 +355,7 @@ void Simulator::lay_ground(const CanvasGround& ground, Vec3 primer_ryb) {
 }
 
 void Simulator::replace_canvas(const std::function<void(TileStore&)>& write) {
+  entry_check_ = true;
   const double before = census().total();
   flush_window();  // `write` sees the live canvas
   write(*canvas_);
@@ -592,7 +609,7 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
   ProfilerGuard guard(&profiler_);
   WB_PROFILE_SCOPE("sim.step");
   grid_->set_particle_density(nullptr);  // last step's raster is stale
-  count_nonfinite(true);
+  if (entry_check_) count_nonfinite(true);
 
   // --- 1-2. Brush (§4.1) in sub-steps, then its samples ------------------------------------
   const std::array<float, 4> box_before = box_;
@@ -676,6 +693,7 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
     // census. Where something went non-finite, it is contained and the census taken again.
     WB_PROFILE_SCOPE("books");
     count_nonfinite(false);
+    entry_check_ = false;
     queue_samples_box(step_sums_.data()->extent);
     if (resting) grid_->running_box_into(step_sums_.data()->running, kRunningPaint);
     books_.record(rec, record_census(rec));

@@ -191,6 +191,11 @@ class Simulator {
   void joint_fields_stage();
   /// Counts, on the device, the non-finite values of every checked array (into step_sums_).
   void count_nonfinite(bool on_entry);
+  /// The state the next step receives may hold values no step's check has seen: set by every
+  /// method that changes the checked arrays from outside the stages (and by the tests' access),
+  /// cleared by a step's own count at its end. Where it is clear, that count already covers what
+  /// the step receives, and the step's entry count is not made again.
+  bool entry_check_ = true;
   /// Zeroes (fields) or removes (particles) what the step record's counts show non-finite;
   /// true when there was any.
   bool contain_nonfinite(const int64_t* counts);
