@@ -186,10 +186,11 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
     b.set_device(d);
     b.resize(size_t(kFilmFields) * size_t(g.nx) * size_t(g.ny));
   }
-  for (auto* b : {&visc_idx_, &visc_list_}) {
+  for (auto* b : {&visc_flag_, &visc_idx_, &visc_list_}) {
     b->set_device(d);
     b->resize(all_faces);
   }
+  visc_flag_.fill_zero();  // then written over each step's extent: outside it no face is fluid
   cg_nb_.set_device(d);
   cg_nu_.set_device(d);
   for (auto* b : {&cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_}) b->set_device(d);
@@ -406,13 +407,14 @@ void Grid::apply_viscosity(float dt) {
   stats_.viscosity_faces = 0;
   stats_.viscosity_iterations = 0;
   stats_.viscosity_residual = 0;
+  // The flags every step (visc_flag_ is kept over the extents), the solve where it runs.
+  grid_viscous_flags(d, v, visc_flag_.data());
   if (params_.viscosity_max_iterations <= 0) return;
   // The fluid faces, compacted: the solve costs in proportion to the paint, not to the window.
   // Their count stays on the device (ListCount) and comes back with the CG's one read; a list
   // longer than the vectors' capacity runs nothing and is solved again once they are sized.
   const int64_t all = int64_t(visc_idx_.size());
-  grid_viscous_flags(d, v, visc_idx_.data());
-  exclusive_scan_into(d, visc_idx_.data(), visc_idx_.data(), all, ws_);
+  exclusive_scan_into(d, visc_flag_.data(), visc_idx_.data(), all, ws_);
   grid_viscous_list(d, v, visc_idx_.data(), visc_list_.data());
   // (1 - dt div(nu grad)) u = u_old, nu = mu / rho0 in cells^2/s.
   const double h = params_.cell_size;

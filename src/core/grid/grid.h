@@ -171,7 +171,9 @@ class Grid {
   // the conjugate-gradient vectors over the list. Sized to every face once.
   // Per entry: nu dt, the six neighbour entries, and the CG vectors; they grow with the paint
   // (never per step in a steady stroke) and keep their capacity.
-  DeviceBuffer<uint32_t> visc_idx_, visc_list_;
+  // visc_flag_: 1 at a fluid face, written over each step's extent only (faces outside it are
+  // no longer fluid since the step that last visited them, as for the fluid flags themselves).
+  DeviceBuffer<uint32_t> visc_flag_, visc_idx_, visc_list_;
   DeviceBuffer<int32_t> cg_nb_;
   DeviceBuffer<float> cg_nu_;
   /// The viscous CG's vectors and matrix diagonal, in double (viscous_apply says why).

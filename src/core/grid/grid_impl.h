@@ -591,13 +591,10 @@ void grid_effective_viscosity(GridView g, JointOil oil, HerschelBulkley stiff, H
 }
 
 void grid_viscous_flags(GridView g, uint32_t* flag) {
+  // The extent's faces: beyond them every flag is 0 already, as the fluid flags are (the faces
+  // a step's liquid held are visited once more by the next step, GridExtent::dirty_box).
   const GridDims d = g.d;
-  parallel_for(detail::all_faces(d), [=] WB_HD(int64_t t) {
-    int c;
-    int64_t f;
-    detail::split_face_below(d, d.nz, t, c, f);
-    flag[t] = g.fluid[c][f] ? 1u : 0u;
-  });
+  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f) { flag[global_face(d, c, f)] = g.fluid[c][f] ? 1u : 0u; });
 }
 
 void grid_viscous_list(GridView g, const uint32_t* idx, uint32_t* list) {
