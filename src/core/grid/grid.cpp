@@ -273,24 +273,22 @@ void Grid::advect(float dt) {
   // each face's flux the paint between it and its departure point (face_paint_carry): a pass
   // moves paint as far as the flow takes it at the cost of one, so the step's work does not grow
   // with the pen's speed. The axes alternate x y z and z y x from step to step (Strang).
-  const int64_t cells = g.cells();
   // The classes and face fractions the advection reads (solids, dried paint never moved) lie in
   // the cells of the paint and particles and a few beyond: those of the columns and layers
   // holding them first, found on the device, for the outflow rates; the rest once the plan
   // (below) has told how far the paint moves. Beyond, nothing in the step reads them
   // (docs/GRID.md).
   column_maxima(kTraceDensity, kPaintTop);
-  grid_first_extent(d, g, advect_max_.data() + kJointTop, advect_extent_.data());
-  within(advect_extent_.data(), [&] { classify(); });
-  grid_paint_outflow(d, view(), paint.density.data(), face_tmp_.data());
-  // The outflow rate along each axis (face_tmp_, one value per face, holds the three rates:
-  // there are more faces than 3 cells) make, with the layers holding paint and those holding
-  // paint or particles, the step's plan on the device: the paint's reach along each axis, the
-  // layers and columns its passes visit, and the box the velocity's advection classifies. The
-  // passes run over the device's counts, so the host reads none of it (docs/GRID.md "Work in
+  grid_first_extent(d, g, advect_max_.data() + kJointTop, advect_extent_.data(), advect_max_.data() + kRateX);
+  within(advect_extent_.data(), [&] {
+    classify();
+    grid_paint_outflow(d, view(), paint.density.data(), advect_max_.data() + kRateX);
+  });
+  // The largest outflow rate along each axis make, with the layers holding paint and those
+  // holding paint or particles, the step's plan on the device: the paint's reach along each axis,
+  // the layers and columns its passes visit, and the box the velocity's advection classifies.
+  // The passes run over the device's counts, so the host reads none of it (docs/GRID.md "Work in
   // proportion to the paint").
-  for (int a = 0; a < 3; ++a)
-    reduce_max_into(d, face_tmp_.data() + a * cells, cells, advect_max_.data() + kRateX + a, ws_);
   grid_advect_plan(d, g, advect_max_.data() + kRateX, advect_max_.data() + kPaintTop, advect_max_.data() + kJointTop,
                    dt, advect_plan_.data(), advect_extent_.data() + 1);
   within(advect_extent_.data() + 1, [&] {

@@ -242,14 +242,14 @@ class Grid {
     (g, pw, br, particle_density, canvas, flow, liquid_threshold, dry_threshold))                                      \
   X(void, grid_column_tops, (GridDims d, const float* rho, const float* particle_density, float trace, float* out),    \
     (d, rho, particle_density, trace, out))                                                                            \
-  X(void, grid_first_extent, (GridDims d, const float* maxima, GridExtent* e), (d, maxima, e))                         \
+  X(void, grid_first_extent, (GridDims d, const float* maxima, GridExtent* e, float* rates), (d, maxima, e, rates))    \
   X(void, grid_running_columns, (GridView g, PaintWindowView pw, float dry_threshold, float speed, float* out),        \
     (g, pw, dry_threshold, speed, out))                                                                                \
   X(void, grid_advect_plan,                                                                                            \
     (GridDims d, const float* rates, const float* paint_top, const float* joint, float dt, AdvectPlan* plan,           \
      GridExtent* e),                                                                                                   \
     (d, rates, paint_top, joint, dt, plan, e))                                                                         \
-  X(void, grid_paint_outflow, (GridView g, const float* rho, float* out), (g, rho, out))                               \
+  X(void, grid_paint_outflow, (GridView g, const float* rho, float* rates), (g, rho, rates))                           \
   X(void, grid_advect_paint_axis,                                                                                      \
     (GridView g, PaintWindowView paint, PaintWindowView scratch, int axis, int pass, int order, float dt,              \
      float dry_threshold, PaintTiles tiles, const int32_t* process, int32_t* painted, const int32_t* below,            \

@@ -158,8 +158,9 @@ void grid_running_columns(GridView g, PaintWindowView pw, float dry_threshold, f
   });
 }
 
-void grid_first_extent(GridDims d, const float* maxima, GridExtent* e) {
+void grid_first_extent(GridDims d, const float* maxima, GridExtent* e, float* rates) {
   parallel_for(1, [=] WB_HD(int64_t) {
+    for (int a = 0; a < 3; ++a) rates[a] = 0.f;  // grid_paint_outflow's maxima start here
     // The cells holding paint or particles and a cell around them: the faces of their cells
     // carry the outflow.
     const float top = maxf(maxima[0], 0.f);
@@ -208,21 +209,23 @@ void grid_advect_plan(GridDims d, const float* rates, const float* paint_top, co
   });
 }
 
-void grid_paint_outflow(GridView g, const float* rho, float* out) {
+void grid_paint_outflow(GridView g, const float* rho, float* rates) {
+  // The largest outflow rate along each axis of a painted cell, into rates[0..3) (atomic maxima:
+  // the same whatever the order). The painted cells lie in the step's first extent, which g's
+  // extent is (grid_first_extent).
   const GridDims d = g.d;
-  const int64_t n = d.cells();
-  parallel_for(n, [=] WB_HD(int64_t c) {
+  for_cells(d, g.extent, [=] WB_HD(int64_t c) {
     // Traces (a millionth of a cell) do not count. The donor limit leaves a part in 10^6 of what
     // a cell held, so a drained cell in the bristles' fast flow keeps 1e-6, then 1e-12, ... of a
     // cell: sized by them, the studio's stroke took 16 sub-steps a step where its paint needed 3.
     // A trace asked for more than it holds gives what it holds (the donor limit).
-    if (!(rho[c] > kTraceDensity)) {
-      for (int a = 0; a < 3; ++a) out[a * n + c] = 0.f;
-      return;
-    }
+    if (!(rho[c] > kTraceDensity)) return;
     int i, j, k;
     d.decompose_cell(c, i, j, k);
-    for (int a = 0; a < 3; ++a) out[a * n + c] = cell_axis_outflow(g, rho, a, i, j, k);
+    for (int a = 0; a < 3; ++a) {
+      const float r = cell_axis_outflow(g, rho, a, i, j, k);
+      if (r > rates[a]) atomic_max(&rates[a], r);
+    }
   });
 }
 
