@@ -224,7 +224,7 @@ void grid_paint_outflow(GridView g, const float* rho, float* rates) {
     d.decompose_cell(c, i, j, k);
     for (int a = 0; a < 3; ++a) {
       const float r = cell_axis_outflow(g, rho, a, i, j, k);
-      if (r > rates[a]) atomic_max(&rates[a], r);
+      if (r > 0.f) atomic_max(&rates[a], r);  // loads first, and writes only a larger value
     }
   });
 }
