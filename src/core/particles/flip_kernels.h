@@ -6,6 +6,7 @@
 
 #include "core/exec/atomics.h"
 #include "core/exec/hd.h"
+#include "core/exec/touch_list.h"
 #include "core/math/vec.h"
 #include "core/particles/mac_sample.h"
 
@@ -21,6 +22,9 @@ struct ParticleRasterView {
   FloatPair* face[3];  ///< all null: the cells alone
   int nx, ny, nz;
   int ox, oy, oz;  ///< canvas cell of the window's cell (0, 0, 0)
+  /// Where on: the cells and faces the raster reaches are listed (the passes after it visit
+  /// those, and the fields go back to zero through them, Simulator::clear_raster).
+  TouchList cell_list{}, face_list[3]{};
 };
 
 /// Splats pairs (a, b) trilinearly onto a node grid of ex x ey x ez nodes at offsets (ox, oy, oz):
@@ -33,19 +37,24 @@ struct SplatRun {
   int64_t base = -1;  ///< node of the run's lower corner, -1: no run open
   int64_t node[8];
   FloatPair sum[8];
-  /// Adds the open run's sums to f (nodes whose sums are both zero are skipped) and closes it.
-  WB_HD void flush(FloatPair* f) {
+  /// Adds the open run's sums to f (nodes whose sums are both zero are skipped), listing the
+  /// nodes it adds to where `list` is on, and closes it.
+  WB_HD void flush(FloatPair* f, const TouchList& list) {
     if (base < 0) return;
     for (int n = 0; n < 8; ++n)
-      if (sum[n].first != 0.f || sum[n].second != 0.f) atomic_add(&f[node[n]], sum[n].first, sum[n].second);
+      if (sum[n].first != 0.f || sum[n].second != 0.f) {
+        atomic_add(&f[node[n]], sum[n].first, sum[n].second);
+        if (list.on()) list.touch(node[n]);
+      }
     base = -1;
   }
   /// The weights of the pair (a, b) at q, into the run (flushed first if q's corner is another).
-  WB_HD void add(FloatPair* f, int ex, int ey, int ez, float ox, float oy, float oz, Vec3 q, float a, float b) {
+  WB_HD void add(FloatPair* f, const TouchList& list, int ex, int ey, int ez, float ox, float oy, float oz, Vec3 q,
+                 float a, float b) {
     const Stencil1 sx = stencil1(q.x, ox, ex), sy = stencil1(q.y, oy, ey), sz = stencil1(q.z, oz, ez);
     const int64_t corner = (int64_t(sz.i0) * ey + sy.i0) * ex + sx.i0;
     if (corner != base) {
-      flush(f);
+      flush(f, list);
       base = corner;
       const int ix[2] = {sx.i0, sx.i1}, iy[2] = {sy.i0, sy.i1}, iz[2] = {sz.i0, sz.i1};
       for (int n = 0; n < 8; ++n) {
@@ -79,12 +88,12 @@ WB_HD WB_INLINE void rasterise_particles(const ParticleRasterView& g, const Vec3
     for (int64_t k = k0; k < k1; ++k) {
       const Vec3 q = x[k] - o;
       if (!inside_window(q, g.nx, g.ny, g.nz)) continue;
-      if (c == 0) run.add(g.cell, g.nx, g.ny, g.nz, 0.5f, 0.5f, 0.5f, q, m[k], m[k] * oil[k]);
-      if (c == 1) run.add(g.face[0], g.nx + 1, g.ny, g.nz, 0.f, 0.5f, 0.5f, q, m[k], m[k] * v[k].x);
-      if (c == 2) run.add(g.face[1], g.nx, g.ny + 1, g.nz, 0.5f, 0.f, 0.5f, q, m[k], m[k] * v[k].y);
-      if (c == 3) run.add(g.face[2], g.nx, g.ny, g.nz + 1, 0.5f, 0.5f, 0.f, q, m[k], m[k] * v[k].z);
+      if (c == 0) run.add(g.cell, g.cell_list, g.nx, g.ny, g.nz, 0.5f, 0.5f, 0.5f, q, m[k], m[k] * oil[k]);
+      if (c == 1) run.add(g.face[0], g.face_list[0], g.nx + 1, g.ny, g.nz, 0.f, 0.5f, 0.5f, q, m[k], m[k] * v[k].x);
+      if (c == 2) run.add(g.face[1], g.face_list[1], g.nx, g.ny + 1, g.nz, 0.5f, 0.f, 0.5f, q, m[k], m[k] * v[k].y);
+      if (c == 3) run.add(g.face[2], g.face_list[2], g.nx, g.ny, g.nz + 1, 0.5f, 0.5f, 0.f, q, m[k], m[k] * v[k].z);
     }
-    run.flush(c == 0 ? g.cell : g.face[c - 1]);
+    run.flush(c == 0 ? g.cell : g.face[c - 1], c == 0 ? g.cell_list : g.face_list[c - 1]);
   }
 }
 

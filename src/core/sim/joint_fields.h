@@ -17,8 +17,10 @@ namespace wb {
 // (core/exec/dispatch.h).
 #define WB_JOINT_KERNELS(X)                                                                                         \
   X(void, joint_scale, (const float* in, float* out, int64_t n, float scale), (in, out, n, scale))                  \
-  X(void, joint_raster_density, (const FloatPair* cell, float* density, float* oil, int64_t n, float scale),        \
-      (cell, density, oil, n, scale))                                                                               \
+  X(void, joint_raster_density, (const FloatPair* cell, float* density, float* oil, TouchList list, int64_t n,      \
+      float scale), (cell, density, oil, list, n, scale))                                                           \
+  X(void, joint_clear_raster, (TouchList list, int64_t n, FloatPair* pairs, float* density, float* oil),            \
+      (list, n, pairs, density, oil))                                                                               \
   X(void, joint_blend_velocity, (GridView g, PaintWindowView paint, ParticleRasterView raster, float cell_mass),    \
       (g, paint, raster, cell_mass))                                                                                \
   X(void, joint_zero_nonfinite, (float* v, int64_t n), (v, n))                                                      \

@@ -12,13 +12,32 @@ void joint_scale(const float* in, float* out, int64_t n, float scale) {
 }
 
 /// The particles' raster as densities: density[i] = cell[i].first * scale and, where oil is
-/// not null, oil[i] = cell[i].second * scale (scale 1 / cell_mass: kg to cell-volume fractions).
-void joint_raster_density(const FloatPair* cell, float* density, float* oil, int64_t n, float scale) {
+/// not null, oil[i] = cell[i].second * scale (scale 1 / cell_mass: kg to cell-volume fractions),
+/// at the cells `list` holds where it is on (elsewhere both are 0: joint_clear_raster), else at
+/// all n.
+void joint_raster_density(const FloatPair* cell, float* density, float* oil, TouchList list, int64_t n, float scale) {
   WB_REQUIRE(n == 0 || (cell && density), "joint_raster_density: a field is null");
-  parallel_for(n, [=] WB_HD(int64_t i) {
+  const auto at = [=] WB_HD(int64_t i) {
     const FloatPair c = cell[i];
     density[i] = c.first * scale;
     if (oil) oil[i] = c.second * scale;
+  };
+  if (list.on())
+    parallel_for_count(list.count, n, [=] WB_HD(int64_t t) { at(list.items[t]); });
+  else
+    parallel_for(n, at);
+}
+
+/// The elements `list` holds (of n) back to zero in the raster's pairs and, where not null, its
+/// density and oil, and unlisted: the raster is then zero everywhere (the caller clears the
+/// list's count after).
+void joint_clear_raster(TouchList list, int64_t n, FloatPair* pairs, float* density, float* oil) {
+  parallel_for_count(list.count, n, [=] WB_HD(int64_t t) {
+    const int64_t i = list.items[t];
+    pairs[i] = FloatPair{0.f, 0.f};
+    if (density) density[i] = 0.f;
+    if (oil) oil[i] = 0.f;
+    list.listed[i] = 0;
   });
 }
 
@@ -64,7 +83,7 @@ void joint_blend_velocity(GridView g, PaintWindowView paint, ParticleRasterView 
     const float* rho = paint.density;
     const int ex = d.nx + (c == 0), ey = d.ny + (c == 1);
     const int64_t faces = int64_t(ex) * ey * (d.nz + (c == 2));
-    parallel_for(faces, [=] WB_HD(int64_t f) {
+    const auto blend = [=] WB_HD(int64_t f) {
       const FloatPair pf = face[f];
       const float wp = pf.first;
       if (!(wp > 0.f)) return;
@@ -77,7 +96,13 @@ void joint_blend_velocity(GridView g, PaintWindowView paint, ParticleRasterView 
       if (i < d.nx && j < d.ny && k < d.nz) rg += rho[(int64_t(k) * d.ny + j) * d.nx + i], ++n;
       const float wg = n ? cell_mass * rg / float(n) : 0.f;
       u[f] = (wg * u[f] + pf.second) / (wg + wp);
-    });
+    };
+    // The faces the raster reached, where it listed them (no other face has weight).
+    const TouchList list = raster.face_list[c];
+    if (list.on())
+      parallel_for_count(list.count, faces, [=] WB_HD(int64_t t) { blend(list.items[t]); });
+    else
+      parallel_for(faces, blend);
   }
 }
 

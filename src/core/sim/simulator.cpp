@@ -79,6 +79,9 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
   cells(psi_);
   raster_cell_.set_device(d);
   raster_cell_.resize(size_t(g.cells()));
+  raster_cell_.fill_zero();  // then kept zero beyond the listed cells (clear_raster)
+  raster_cells_.set_device(d);
+  raster_cells_.ensure(g.cells());
   cells(raster_oil_);
   cells(raster_density_);
   cells(overlay_mass_);
@@ -97,6 +100,9 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
     cells(bristle_v_[c]);
     raster_face_[c].set_device(d);
     raster_face_[c].resize(size_t(g.faces(c)));
+    raster_face_[c].fill_zero();
+    raster_faces_[c].set_device(d);
+    raster_faces_[c].ensure(g.faces(c));
   }
   books_.open(census());
 }
@@ -768,11 +774,12 @@ void Simulator::particle_stage(float dt) {
   // particles (§5.2), and its grid part alone would read as air that its particles fall through.
   ActiveWindow& win = grid_->window();
   const Int3 n = win.dims(), o = win.origin();
-  raster_cell_.fill_zero();
-  particles_rasterise(device(), particles_.view(),
-                      ParticleRasterView{raster_cell_.data(), {}, n.x, n.y, n.z, o.x, o.y, o.z});
-  joint_raster_density(device(), raster_cell_.data(), raster_density_.data(), nullptr, int64_t(raster_cell_.size()),
-                       1.f / transfer_->params().cell_mass());
+  clear_raster(true);
+  ParticleRasterView rv{raster_cell_.data(), {}, n.x, n.y, n.z, o.x, o.y, o.z};
+  rv.cell_list = raster_cells_.view();
+  particles_rasterise(device(), particles_.view(), rv);
+  joint_raster_density(device(), raster_cell_.data(), raster_density_.data(), nullptr, rv.cell_list,
+                       int64_t(raster_cell_.size()), 1.f / transfer_->params().cell_mass());
   particles_solid_height(device(), win.paint().view(), raster_density_.data(), config_.params.grid.dry_threshold,
                          config_.params.grid.liquid_threshold, prm.floor_z, solid_height_.data(), wet_top_.data());
   SolidView solid;
@@ -811,20 +818,35 @@ void Simulator::joint_fields_stage() {
   WB_PROFILE_SCOPE("particles.rasterise");
   ActiveWindow& win = grid_->window();
   const Int3 n = win.dims(), o = win.origin();
-  raster_cell_.fill_zero();
-  for (int c = 0; c < 3; ++c) raster_face_[c].fill_zero();
+  clear_raster(false);  // the particle stage's cells; its faces are clear
   ParticleRasterView rv{raster_cell_.data(),
                         {raster_face_[0].data(), raster_face_[1].data(), raster_face_[2].data()},
                         n.x, n.y, n.z, o.x, o.y, o.z};
+  rv.cell_list = raster_cells_.view();
+  for (int c = 0; c < 3; ++c) rv.face_list[c] = raster_faces_[c].view();
   particles_rasterise(device(), particles_.view(), rv);
   const float cell_mass = transfer_->params().cell_mass();
   // The particles' mass and oil in the density's units (the oil for the joint paint's
   // rheology, JointOil).
-  joint_raster_density(device(), raster_cell_.data(), raster_density_.data(), raster_oil_.data(),
+  joint_raster_density(device(), raster_cell_.data(), raster_density_.data(), raster_oil_.data(), rv.cell_list,
                        int64_t(raster_cell_.size()), 1.f / cell_mass);
   grid_->set_particle_density(raster_density_.data(), raster_oil_.data());
   raster_step_ = counters_.steps, raster_origin_ = o;
   joint_blend_velocity(device(), grid_->view(), win.paint().view(), rv, cell_mass);
+}
+
+void Simulator::clear_raster(bool faces) {
+  // The raster's passes visit the cells and faces it reached (TouchList), not the window: what
+  // they wrote goes back to zero through the same lists, after which each list is empty.
+  joint_clear_raster(device(), raster_cells_.view(), raster_cells_.capacity(), raster_cell_.data(),
+                     raster_density_.data(), raster_oil_.data());
+  raster_cells_.clear_count();
+  if (!faces) return;
+  for (int c = 0; c < 3; ++c) {
+    joint_clear_raster(device(), raster_faces_[c].view(), raster_faces_[c].capacity(), raster_face_[c].data(), nullptr,
+                       nullptr);
+    raster_faces_[c].clear_count();
+  }
 }
 
 std::array<std::pair<float*, int64_t>, Simulator::kCheckedArrays> Simulator::checked_arrays() {

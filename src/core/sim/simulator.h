@@ -14,6 +14,7 @@
 #include "core/exec/atomics.h"
 #include "core/exec/device.h"
 #include "core/exec/profile.h"
+#include "core/exec/touch_list.h"
 #include "core/exec/workspace.h"
 #include "core/grid/grid.h"
 #include "core/io/stroke.h"
@@ -189,6 +190,8 @@ class Simulator {
   /// (kept whole in last_record_).
   PaintCensus record_census(TransferRecord& rec);
   void joint_fields_stage();
+  /// The raster's listed cells (and faces, `faces`) back to zero: every raster field is then zero.
+  void clear_raster(bool faces);
   /// Counts, on the device, the non-finite values of every checked array (into step_sums_).
   void count_nonfinite(bool on_entry);
   /// The state the next step receives may hold values no step's check has seen: set by every
@@ -258,6 +261,8 @@ class Simulator {
   // for the drag, the particles' raster (mass, face momentum and weight) and their density.
   DeviceBuffer<float> psi_, bristle_v_[3];
   DeviceBuffer<FloatPair> raster_cell_, raster_face_[3];  ///< the particles' raster (flip_kernels.h)
+  /// The cells and faces the raster reached: zero elsewhere, and cleared through these.
+  TouchListBuffers raster_cells_, raster_faces_[3];
   DeviceBuffer<float> raster_density_, raster_oil_;  ///< its mass and oil per cell mass
   DeviceBuffer<float> overlay_mass_;
   /// The step's record on the device: the transfer's sums, the census's, the non-finite

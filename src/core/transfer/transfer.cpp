@@ -96,9 +96,9 @@ Transfer::Transfer(const Device& device, const TransferParams& params)
   for (auto& b : s_f32_) b.set_device(device);
   for (auto& b : c_f32_) b.set_device(device);
   for (auto& b : deposit_sums_) b.set_device(device);
-  deposit_listed_.set_device(device);
   deposit_cells_.set_device(device);
-  deposit_count_ = DeviceBuffer<int64_t>(device, 2);
+  deposit_received_ = DeviceBuffer<int64_t>(device, 1);
+  deposit_received_.fill_zero();
   p_moved_.set_device(device);
   room_count_.set_device(device);
   room_offset_.set_device(device);
@@ -120,15 +120,13 @@ void Transfer::ensure_samples(int64_t n) {
 }
 void Transfer::ensure_cells(int64_t n) {
   for (auto& b : c_f32_) b.resize(size_t(n));
-  if (deposit_listed_.size() == size_t(n)) return;
-  // The deposit's sums and flags are zero between passes (DepositScratch): zeroed once here.
+  if (deposit_cells_.capacity() == n) return;
+  // The deposit's sums and list are zero between passes (DepositScratch): zeroed once here.
   for (auto& b : deposit_sums_) {
     b.resize(size_t(n));
     b.fill_zero();
   }
-  deposit_listed_.resize(size_t(n));
-  deposit_listed_.fill_zero();
-  deposit_cells_.resize(size_t(n));
+  deposit_cells_.ensure(n);
 }
 void Transfer::ensure_particles(int64_t n) { p_moved_.resize(size_t(n)); }
 
@@ -338,16 +336,14 @@ void Transfer::particles_to_grid(ParticleStore& particles, const TransferEnv& en
   ensure_cells(nc);
   ensure_particles(np);
   p_moved_.fill_zero();
-  deposit_count_.fill_zero();
   DepositScratch acc{};
   acc.rho = deposit_sums_[0].data();
   for (int c = 0; c < 3; ++c) acc.c[c] = deposit_sums_[1 + c].data();
   acc.b = deposit_sums_[4].data();
   acc.oil = deposit_sums_[5].data();
   acc.dryness = deposit_sums_[6].data();
-  acc.listed = deposit_listed_.data();
-  acc.cells = deposit_cells_.data();
-  acc.count = deposit_count_.data();
+  acc.cells = deposit_cells_.view();
+  acc.received = deposit_received_.data();
   acc.moved = p_moved_.data();
   acc.counter = sum_field(env.only_leaving ? &TransferSums::to_grid_at_moves : &TransferSums::to_grid_count);
   acc.keep = env.keep;
@@ -357,6 +353,7 @@ void Transfer::particles_to_grid(ParticleStore& particles, const TransferEnv& en
     transfer_to_grid_mark(device_, particles.view(), env.paint, db, acc, params_, env.dry_threshold);
     // Density units in to_grid_into_grid; collect() turns them into kg.
     transfer_to_grid_apply(device_, env.paint, acc, sum_field(&TransferSums::to_grid_into_grid));
+    deposit_cells_.clear_count();
   }
   reduce_sum_add_into(device_, p_moved_.data(), np, sum_field(&TransferSums::to_grid_from_particles), ws_);
 }

@@ -15,6 +15,7 @@
 #include "core/exec/dispatch.h"
 #include "core/exec/graph.h"
 #include "core/exec/hd.h"
+#include "core/exec/touch_list.h"
 #include "core/exec/workspace.h"
 #include "core/particles/mac_sample.h"
 #include "core/particles/particle_fields.h"
@@ -135,10 +136,9 @@ struct DepositScratch {
   int64_t* b;       ///< sum (m_k W / cell_mass) brightness(c_k)
   int64_t* oil;
   int64_t* dryness;
-  int32_t* listed;  ///< per cell: 1 while it is in `cells`
-  uint32_t* cells;  ///< the cells reached, in the order reached
-  int64_t* count;   ///< [0] their number; [1] the density they received (to_fixed of each cell's add)
-  float* moved;     ///< per particle: mass sent to the grid
+  TouchList cells;    ///< the cells reached (core/exec/touch_list.h)
+  int64_t* received;  ///< the density the listed cells received (to_fixed of each cell's add)
+  float* moved;       ///< per particle: mass sent to the grid
   int32_t* counter;
   KeepBox keep;             ///< particles outside it are deposited regardless (TransferEnv::keep)
   bool only_leaving;        ///< TransferEnv::only_leaving
@@ -255,11 +255,11 @@ class Transfer {
   DeviceBuffer<uint32_t> room_count_, room_offset_, room_ends_;
   // Per cell.
   DeviceBuffer<float> c_f32_[7];
-  // Eq. 16's deposit (DepositScratch): its sums, zero between passes, and the cells listed.
+  // Eq. 16's deposit (DepositScratch): its sums, zero between passes, the cells listed and
+  // what they received.
   DeviceBuffer<int64_t> deposit_sums_[7];
-  DeviceBuffer<int32_t> deposit_listed_;
-  DeviceBuffer<uint32_t> deposit_cells_;
-  DeviceBuffer<int64_t> deposit_count_;
+  TouchListBuffers deposit_cells_;
+  DeviceBuffer<int64_t> deposit_received_;
   // Distance blocks.
   DeviceBuffer<int32_t> occ_;
   DeviceBuffer<float> d2_, d2_tmp_, edt_z_;

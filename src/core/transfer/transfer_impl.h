@@ -336,7 +336,7 @@ void transfer_to_grid_mark(ParticleView p, PaintWindowView pw, DistanceBlocks db
       atomic_add(&acc.b[id], to_fixed(add * bk));
       atomic_add(&acc.oil[id], to_fixed(add * oil));
       atomic_add(&acc.dryness[id], to_fixed(add * dry));
-      if (atomic_or(&acc.listed[id], int32_t(1)) == 0) acc.cells[atomic_add(&acc.count[0], int64_t(1))] = uint32_t(id);
+      acc.cells.touch(id);
     });
     if (cells > 0) {
       // A window move's pass leaves the particle weightless, in place, to the step's compaction
@@ -355,15 +355,15 @@ void transfer_to_grid_mark(ParticleView p, PaintWindowView pw, DistanceBlocks db
 void transfer_to_grid_apply(PaintWindowView pw, DepositScratch acc, double* into_grid) {
   // The listed cells only (fewer than the window's, which bounds the list); each is zeroed
   // once read, for the next pass.
-  parallel_for_count(acc.count, pw.size(), [=] WB_HD(int64_t t) {
-    const int64_t c = acc.cells[t];
+  parallel_for_count(acc.cells.count, pw.size(), [=] WB_HD(int64_t t) {
+    const int64_t c = acc.cells.items[t];
     const float add = from_fixed(acc.rho[c]);
     const Vec3 sum_c(from_fixed(acc.c[0][c]), from_fixed(acc.c[1][c]), from_fixed(acc.c[2][c]));
     const float sum_b = from_fixed(acc.b[c]), sum_oil = from_fixed(acc.oil[c]), sum_dry = from_fixed(acc.dryness[c]);
     acc.rho[c] = acc.c[0][c] = acc.c[1][c] = acc.c[2][c] = acc.b[c] = acc.oil[c] = acc.dryness[c] = 0;
-    acc.listed[c] = 0;
+    acc.cells.listed[c] = 0;
     if (!(add > 0.f)) return;
-    atomic_add(&acc.count[1], to_fixed(add));  // the books: what the cells received, in any order
+    atomic_add(acc.received, to_fixed(add));  // the books: what the cells received, in any order
     const float rho = maxf(pw.density[c], 0.f);
     const float tot = rho + add;
     const Vec3 cold(pw.pigment_r[c], pw.pigment_y[c], pw.pigment_b[c]);
@@ -377,7 +377,10 @@ void transfer_to_grid_apply(PaintWindowView pw, DepositScratch acc, double* into
     pw.dryness[c] = (rho * pw.dryness[c] + sum_dry) / tot;
     pw.density[c] = pw.density[c] + add;
   });
-  parallel_for(1, [=] WB_HD(int64_t) { *into_grid += from_fixed_sum(acc.count[1]); });
+  parallel_for(1, [=] WB_HD(int64_t) {
+    *into_grid += from_fixed_sum(*acc.received);
+    *acc.received = 0;
+  });
 }
 
 // --- §5.1: emission -------------------------------------------------------------------------
