@@ -18,9 +18,11 @@ struct TouchList {
   uint32_t* items = nullptr;  ///< the elements listed, in the order reached
   int64_t* count = nullptr;   ///< their number (device memory)
   WB_HD bool on() const { return listed != nullptr; }
-  /// Lists element i unless it is listed already.
+  /// Lists element i unless it is listed already (most touches find it listed: a load, no
+  /// read-modify-write).
   WB_HD void touch(int64_t i) const {
-    if (atomic_or(&listed[i], int32_t(1)) == 0) items[atomic_add(count, int64_t(1))] = uint32_t(i);
+    if (atomic_load(&listed[i]) == 0 && atomic_or(&listed[i], int32_t(1)) == 0)
+      items[atomic_add(count, int64_t(1))] = uint32_t(i);
   }
 };
 
