@@ -553,7 +553,7 @@ void Grid::flow_film(float dt) {
   FilmFlow f{stiff, oily, rho0 * -gv.z * cell, rho0 * gv.y * cell, cell, dt / float(substeps)};
   // The columns are read from the cells once, flow in their own planes, and are written back once.
   grid_film_columns(device(), g, extent_.data(), window_.paint().view(), bristles_, particle_density_, flow_,
-                    params_.dry_threshold, params_.film_max, film_[0].data());
+                    params_.dry_threshold, params_.film_max, f, film_[0].data());
   int cur = 0;
   for (int s = 0; s < substeps; ++s, cur = 1 - cur)
     grid_film_update(device(), g, film_[cur].data(), f, film_[1 - cur].data());

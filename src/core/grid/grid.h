@@ -269,8 +269,8 @@ class Grid {
     (g, u, v, w, dt))                                                                                                  \
   X(void, grid_film_columns,                                                                                           \
     (GridDims d, const GridExtent* e, PaintWindowView pw, BristleField br, const float* particle_density,              \
-     FlowColumns flow, float dry_threshold, float film_max, float* col),                                               \
-    (d, e, pw, br, particle_density, flow, dry_threshold, film_max, col))                                              \
+     FlowColumns flow, float dry_threshold, float film_max, FilmFlow f, float* col),                                   \
+    (d, e, pw, br, particle_density, flow, dry_threshold, film_max, f, col))                                           \
   X(void, grid_film_update, (GridDims d, const float* col, FilmFlow f, float* next), (d, col, f, next))                \
   X(void, grid_film_write, (GridDims d, PaintWindowView pw, const float* col), (d, pw, col))                           \
   X(void, grid_gravity, (GridView g, float* ph, float g_dt, float g_dt_y), (g, ph, g_dt, g_dt_y))                      \

@@ -117,7 +117,22 @@ struct FilmFlow {
 /// column is no film), the top of what it lies on (cells), the first layer above that, its
 /// mass-weighted oil, pigment and dryness, and the paint that crossed its faces over the step
 /// (cells; 0: its cells stay as they are): kFilmFields planes of nx * ny.
-enum FilmField : int { kFilmH, kFilmBase, kFilmAbove, kFilmOil, kFilmR, kFilmY, kFilmB, kFilmDry, kFilmMoved, kFilmFields };
+/// kFilmTau and kFilmK are the Herschel-Bulkley tau_y and K at the column's oil (rheology_at_oil),
+/// kept with the oil so that a face's flux does not form them again in every sub-step.
+enum FilmField : int {
+  kFilmH,
+  kFilmBase,
+  kFilmAbove,
+  kFilmOil,
+  kFilmR,
+  kFilmY,
+  kFilmB,
+  kFilmDry,
+  kFilmMoved,
+  kFilmTau,
+  kFilmK,
+  kFilmFields
+};
 
 /// The oil fraction of the joint paint (§4.3: grid and particles) in a cell, mass-weighted: the
 /// paint near the bristles is mostly particles, and a cell liquid by its particles alone has the

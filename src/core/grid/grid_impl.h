@@ -470,7 +470,7 @@ void grid_gravity(GridView g, float* ph, float g_dt, float g_dt_y) {
 
 void grid_film_columns(GridDims d, const GridExtent* e, PaintWindowView pw, BristleField br,
                        const float* particle_density, FlowColumns flow, float dry_threshold, float film_max,
-                       float* col) {
+                       FilmFlow f, float* col) {
   const int64_t n = int64_t(d.nx) * d.ny;
   parallel_for(n, [=] WB_HD(int64_t c) {
     const int i = int(c % d.nx), j = int(c / d.nx);
@@ -498,6 +498,8 @@ void grid_film_columns(GridDims d, const GridExtent* e, PaintWindowView pw, Bris
     col[kFilmAbove * n + c] = float(above);
     col[kFilmOil * n + c] = mean(oil), col[kFilmDry * n + c] = mean(dry);
     col[kFilmR * n + c] = mean(r), col[kFilmY * n + c] = mean(y), col[kFilmB * n + c] = mean(b);
+    const HerschelBulkley hb = rheology_at_oil(mean(oil), f.stiff, f.oily);
+    col[kFilmTau * n + c] = hb.tau_y, col[kFilmK * n + c] = hb.K;
   });
 }
 
@@ -514,11 +516,10 @@ WB_HD WB_INLINE float film_face(const float* col, int64_t n, int64_t a, int64_t 
   const float G = f.rho_g_cos * slope - pull;  // dp/ds along a -> b, Pa/m: the paint flows down it
   const int64_t u = G > 0.f ? b : a;
   const float hu = col[kFilmH * n + u];
-  const float Gm = fabsf(G), h = hu * f.cell;
-  const HerschelBulkley hb_u = rheology_at_oil(col[kFilmOil * n + u], f.stiff, f.oily);
-  if (!(Gm * h > hb_u.tau_y)) return 0.f;
-  const float Y = h - hb_u.tau_y / Gm;
-  const float q = Gm * Y * Y * (3.f * h - Y) / (6.f * hb_u.K);  // m^2/s
+  const float Gm = fabsf(G), h = hu * f.cell, tau_y = col[kFilmTau * n + u];
+  if (!(Gm * h > tau_y)) return 0.f;
+  const float Y = h - tau_y / Gm;
+  const float q = Gm * Y * Y * (3.f * h - Y) / (6.f * col[kFilmK * n + u]);  // m^2/s
   const float t = minf(q * f.dt / (f.cell * f.cell), 0.25f * hu);
   return G > 0.f ? -t : t;
 }
@@ -526,9 +527,12 @@ WB_HD WB_INLINE float film_face(const float* col, int64_t n, int64_t a, int64_t 
 void grid_film_update(GridDims d, const float* col, FilmFlow f, float* next) {
   const int64_t n = int64_t(d.nx) * d.ny;
   parallel_for(n, [=] WB_HD(int64_t c) {
-    for (int p = 0; p < kFilmFields; ++p) next[p * n + c] = col[p * n + c];
+    // A column that is no film keeps only what its neighbours and the write read of it.
     const float h = col[kFilmH * n + c];
+    next[kFilmH * n + c] = h, next[kFilmMoved * n + c] = col[kFilmMoved * n + c];
     if (h < 0.f) return;
+    for (int p = 0; p < kFilmFields; ++p)
+      if (p != kFilmH && p != kFilmMoved) next[p * n + c] = col[p * n + c];
     const int i = int(c % d.nx), j = int(c / d.nx);
     // Signed inflow through each face and the column it comes from. Both columns of a face
     // compute its transfer from the same values, bit for bit, so what one gains the other loses;
@@ -555,6 +559,8 @@ void grid_film_update(GridDims d, const float* col, FilmFlow f, float* next) {
     next[kFilmH * n + c] = m;
     next[kFilmR * n + c] = p.x, next[kFilmY * n + c] = p.y, next[kFilmB * n + c] = p.z;
     next[kFilmOil * n + c] = m > 0.f ? oil / m : 0.f, next[kFilmDry * n + c] = m > 0.f ? dry / m : 0.f;
+    const HerschelBulkley hb = rheology_at_oil(next[kFilmOil * n + c], f.stiff, f.oily);
+    next[kFilmTau * n + c] = hb.tau_y, next[kFilmK * n + c] = hb.K;
     next[kFilmMoved * n + c] = col[kFilmMoved * n + c] + out + gain;
   });
 }
