@@ -62,21 +62,63 @@ struct AllFaces {
 };
 }  // namespace detail
 
+/// fn(c) for the first *count cells of the extent e (x fastest, then y, then z). CUDA launches a
+/// thread a cell that finds its cell by division; the CPU backend, whose device memory is the
+/// host's, reads the extent and walks it a row along x at a time (one division a row).
+template <class F>
+void for_extent_cells(const GridDims& d, const GridExtent* e, const int64_t* count, F fn) {
+#if defined(__CUDACC__)
+  parallel_for_count(count, d.cells(), detail::CellsIn<F>{d, e, fn});
+#else
+  const GridExtent x = *e;
+  const int64_t bx = x.x1 - x.x0, by = x.y1 - x.y0;
+  if (bx <= 0 || by <= 0) return;
+  const int64_t rows = (*count < d.cells() ? *count : d.cells()) / bx;
+  parallel_for(
+      rows,
+      [=](int64_t r) {
+        const int64_t c0 = ((r / by) * d.ny + x.y0 + r % by) * d.nx + x.x0;
+        for (int64_t i = 0; i < bx; ++i) fn(c0 + i);
+      },
+      kMinParallelSize / bx + 1);
+#endif
+}
 /// fn(c) for every cell a stage visits: the extent's, or all.
 template <class F>
 void for_cells(const GridDims& d, const GridExtent* e, F fn) {
   if (e)
-    parallel_for_count(&e->cells, d.cells(), detail::CellsIn<F>{d, e, fn});
+    for_extent_cells(d, e, &e->cells, fn);
   else
     parallel_for(d.cells(), fn);
 }
 /// fn(c, f) (component, index) for every face a stage visits: those of the extent's cells, or all.
+/// On the CPU backend a row along x at a time, as for_extent_cells.
 template <class F>
 void for_faces(const GridDims& d, const GridExtent* e, F fn) {
-  if (e)
-    parallel_for_count(&e->faces, detail::all_faces(d), detail::FacesIn<F>{d, e, fn});
-  else
+  if (!e) {
     parallel_for(detail::all_faces(d), detail::AllFaces<F>{d, fn});
+    return;
+  }
+#if defined(__CUDACC__)
+  parallel_for_count(&e->faces, detail::all_faces(d), detail::FacesIn<F>{d, e, fn});
+#else
+  const GridExtent x = *e;
+  const int64_t bx = x.x1 - x.x0, by = x.y1 - x.y0, layers = x.layers;
+  if (bx <= 0 || by <= 0) return;
+  // Rows of u (bx + 1 faces each), of v and of w (bx each), as extent_face numbers them.
+  const int64_t ru = by * layers, rv = (by + 1) * layers;
+  const int64_t faces = x.faces < detail::all_faces(d) ? x.faces : detail::all_faces(d);
+  const int64_t rw = (faces - (bx + 1) * ru - bx * rv) / bx;
+  parallel_for(
+      ru + rv + rw,
+      [=](int64_t r) {
+        const int c = r < ru ? 0 : (r < ru + rv ? 1 : 2);
+        const int64_t s = c == 0 ? r : (c == 1 ? r - ru : r - ru - rv), ey = by + (c == 1), ex = bx + (c == 0);
+        const int64_t f0 = ((s / ey) * (d.ny + (c == 1)) + x.y0 + s % ey) * (d.nx + (c == 0)) + x.x0;
+        for (int64_t i = 0; i < ex; ++i) fn(c, f0 + i);
+      },
+      kMinParallelSize / bx + 1);
+#endif
 }
 
 void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float* particle_density, CanvasDims canvas,
@@ -95,7 +137,7 @@ void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float*
   };
   // The extent's cells and the layer above them: the faces on top read its class.
   if (g.extent)
-    parallel_for_count(&g.extent->classes, d.cells(), detail::CellsIn<decltype(cell)>{d, g.extent, cell});
+    for_extent_cells(d, g.extent, &g.extent->classes, cell);
   else
     parallel_for(d.cells(), cell);
   // Open fraction, solid velocity and fluid flag of each face in one pass: the flag reads only
