@@ -159,9 +159,7 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   brush_panel_->set_brush(cfg.brush);
   brush_panel_->set_preset_dir(options_.data_dir + "/brushes");
   connect(brush_panel_, &BrushPanel::brushChanged, this, [this](BrushSpec b) {
-    // Sample gap below one cell along the longest bristle (the brush model requires it).
-    const int needed = int(std::ceil(b.length * (1.f + 2.f * b.length_variation) * 1.05f)) + 4;
-    b.samples_per_bristle = std::max(options_.preset.samples_per_bristle, needed);
+    b.samples_per_bristle = std::max(options_.preset.samples_per_bristle, samples_needed(b));
     try {
       validate_brush(b, "brush");
     } catch (const std::exception& e) {

@@ -1,6 +1,7 @@
 #include "studio/preset.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/exec/error.h"
 
@@ -41,6 +42,23 @@ QualityPreset QualityPreset::gpu() {
   return p;
 }
 
+QualityPreset QualityPreset::fast() {
+  QualityPreset p = cpu();
+  p.name = "fast (40 bristles)";
+  p.id = "fast";
+  // What keeps up with the pen on two CPU cores (docs/STUDIO.md "Quality presets"): a round brush
+  // of 40 bristles, about half the CPU preset's in each dimension, and a window to match. The
+  // canvas and the palette are the CPU preset's, so a painting moves between the two.
+  p.bristles = 40;
+  p.brush_length = 48.f;
+  p.brush_width = 20.f;
+  p.samples_per_bristle = 64;  // samples_needed: a gap below one cell along the longest bristle
+  p.ao_rays = 8;
+  p.window_xy = 40;
+  p.window_z = 12;
+  return p;
+}
+
 QualityPreset QualityPreset::tiny() {
   QualityPreset p;
   p.name = "tiny";
@@ -64,19 +82,20 @@ QualityPreset QualityPreset::from_name(const std::string& name, const Device& d)
   if (name == "auto") return for_device(d);
   if (name == "cpu") return cpu();
   if (name == "gpu") return gpu();
+  if (name == "fast") return fast();
   if (name == "tiny") return tiny();
-  WB_THROW("unknown quality preset '" + name + "' (valid: auto, cpu, gpu, tiny)");
+  WB_THROW("unknown quality preset '" + name + "' (valid: auto, cpu, gpu, fast, tiny)");
 }
 
 Int3 QualityPreset::window() const { return Int3{window_xy, window_xy, std::min(window_z, canvas_depth)}; }
 
 double estimated_step_ms(int64_t brush_samples, Int3 window) {
-  // Two measured points (docs/perf/studio.md, CPU backend, passive waits): the CPU preset's step
-  // (80 x 128 samples, window 64 x 64 x 16) about 38 ms, the tiny preset's (40 x 24, 48 x 48 x 8)
-  // about 5.5 ms; the brush's and the window's stages grow with their sizes.
-  constexpr double ms_per_sample = 2.70e-3, ms_per_cell = 1.58e-4;
+  // Fitted to the steps of `wetbrush bench bench/strokes/studio-demo.json` with the CPU preset's
+  // brush and window (about 29 ms) and the fast preset's (about 9.4 ms), and to the same brush in
+  // two windows (docs/STUDIO.md "Falling behind"): a fixed part, the brush's samples, the window's cells.
+  constexpr double ms_fixed = 3.0, ms_per_sample = 1.69e-3, ms_per_cell = 1.36e-4;
   const double cells = double(window.x) * double(window.y) * double(window.z);
-  return ms_per_sample * double(brush_samples) + ms_per_cell * cells;
+  return ms_fixed + ms_per_sample * double(brush_samples) + ms_per_cell * cells;
 }
 
 std::optional<QualityPreset> lighter_preset_that_keeps_up(int64_t brush_samples, Int3 window, double realtime_factor) {
@@ -84,12 +103,16 @@ std::optional<QualityPreset> lighter_preset_that_keeps_up(int64_t brush_samples,
   const double now_ms = estimated_step_ms(brush_samples, window);
   std::optional<QualityPreset> best;
   double best_ms = 0.0;
-  for (const QualityPreset& p : {QualityPreset::gpu(), QualityPreset::cpu(), QualityPreset::tiny()}) {
+  for (const QualityPreset& p : {QualityPreset::gpu(), QualityPreset::cpu(), QualityPreset::fast(), QualityPreset::tiny()}) {
     const double ms = estimated_step_ms(int64_t(p.bristles) * p.samples_per_bristle, p.window());
     if (ms >= now_ms || realtime_factor * now_ms / ms < 1.0) continue;
     if (!best || ms > best_ms) best = p, best_ms = ms;
   }
   return best;
+}
+
+int samples_needed(const BrushSpec& b) {
+  return int(std::ceil(b.length * (1.f + 2.f * b.length_variation) * 1.05f)) + 4;
 }
 
 BrushSpec QualityPreset::start_brush() const {

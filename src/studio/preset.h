@@ -13,7 +13,7 @@ namespace wb::studio {
 /// A quality preset: brush resolution, canvas and render settings sized for the device.
 struct QualityPreset {
   std::string name;
-  std::string id;  ///< its --preset name: cpu, gpu, tiny
+  std::string id;  ///< its --preset name: cpu, gpu, fast, tiny
   int bristles = 80;
   int samples_per_bristle = 32;
   int canvas_width = 1200, canvas_height = 900, canvas_depth = 32;
@@ -27,19 +27,26 @@ struct QualityPreset {
   BrushSpec start_brush() const;
   static QualityPreset cpu();
   static QualityPreset gpu();
+  /// The CPU preset's canvas with a smaller brush of fewer bristles and a smaller window: keeps up
+  /// with the pen on two CPU cores.
+  static QualityPreset fast();
   /// A small, fast configuration (small canvas, window and brush) for tests and slow machines:
   /// the same studio and the same physics, at a scale where a stroke takes seconds on two cores.
   static QualityPreset tiny();
-  /// "cpu", "gpu", "tiny"; "auto" picks from the device. Throws wb::Error for other names.
+  /// "cpu", "gpu", "fast", "tiny"; "auto" picks from the device. Throws wb::Error for other names.
   static QualityPreset from_name(const std::string& name, const Device& d);
   static QualityPreset for_device(const Device& d) { return d.is_cuda() ? gpu() : cpu(); }
   /// The simulated window of this preset, cells.
   Int3 window() const;
 };
 
+/// The samples a bristle of brush `b` needs: the brush model requires a gap below one cell along
+/// the longest bristle (length x (1 + 2 length_variation)), with a margin.
+int samples_needed(const BrushSpec& b);
+
 /// A step's wall time estimated from what it simulates: `brush_samples` (bristles x samples a
 /// bristle) and the window's cells, ms on the CPU backend of the 2-core VM. Fitted to the CPU
-/// preset's and the tiny preset's measured steps (docs/STUDIO.md "Falling behind"); what it is
+/// preset's and the fast preset's measured steps (docs/STUDIO.md "Falling behind"); what it is
 /// for is the ratio of two configurations' costs.
 double estimated_step_ms(int64_t brush_samples, Int3 window);
 

@@ -454,14 +454,30 @@ class StudioTest : public QObject {
   void lighterPresetThatKeepsUp() {
     const auto samples = [](const QualityPreset& p) { return int64_t(p.bristles) * p.samples_per_bristle; };
     const QualityPreset cpu = QualityPreset::cpu(), gpu = QualityPreset::gpu(), tiny = QualityPreset::tiny();
-    // The CPU preset at a third of real time (docs/STUDIO.md): tiny costs about a seventh of it.
-    auto p = lighter_preset_that_keeps_up(samples(cpu), cpu.window(), 0.33);
+    const QualityPreset fast = QualityPreset::fast();
+    // The CPU preset at a third of real time (docs/STUDIO.md): the fast preset costs about a third
+    // of it and has more detail than tiny; at a quarter only tiny keeps up; at a twentieth none.
+    auto p = lighter_preset_that_keeps_up(samples(cpu), cpu.window(), 0.36);
+    QVERIFY(p && p->id == "fast");
+    p = lighter_preset_that_keeps_up(samples(cpu), cpu.window(), 0.26);
     QVERIFY(p && p->id == "tiny");
     QVERIFY(!lighter_preset_that_keeps_up(samples(cpu), cpu.window(), 0.05));
+    QVERIFY(!lighter_preset_that_keeps_up(samples(fast), fast.window(), 0.5));
     // The paper's preset at half real time: the CPU preset keeps up, and has more detail than tiny.
     p = lighter_preset_that_keeps_up(samples(gpu), gpu.window(), 0.5);
     QVERIFY(p && p->id == "cpu");
     QVERIFY(!lighter_preset_that_keeps_up(samples(tiny), tiny.window(), 0.5));  // none is lighter
+  }
+
+  /// Every preset is named by its --preset name, its brush has the samples the brush model needs
+  /// (the brush panel would otherwise raise them at the first change), and its window fits its canvas.
+  void presetsAreWhatTheyName() {
+    for (const QualityPreset& p : {QualityPreset::gpu(), QualityPreset::cpu(), QualityPreset::fast(), QualityPreset::tiny()}) {
+      QCOMPARE(QualityPreset::from_name(p.id, Device(DeviceType::CPU)).name, p.name);
+      QVERIFY2(p.samples_per_bristle >= samples_needed(p.start_brush()), p.id.c_str());
+      QVERIFY(p.window().x <= p.canvas_width && p.window().y <= p.canvas_height && p.window().z <= p.canvas_depth);
+    }
+    QVERIFY_THROWS_EXCEPTION(wb::Error, QualityPreset::from_name("laptop", Device(DeviceType::CPU)));
   }
 
   void brushPanelRangesAreTheBrushTable() {
