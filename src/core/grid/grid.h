@@ -222,7 +222,7 @@ class Grid {
   void find_extent();
   /// Thin films (GridParams::film_max): their lubrication flow over dt, in explicit sub-steps.
   void flow_film(float dt);
-  /// The maxima of grid_column_tops (paint and particles above `trace`) into advect_max_'s six
+  /// The maxima of grid_column_tops (wet paint and particles above `trace`) into advect_max_'s six
   /// slots from `slot`: the paint's top, the joint top, then x, -x, y, -y of the joint columns.
   void column_maxima(float trace, int slot);
   /// The paint's passes of advect(), one along each axis, by the step's plan (advect_plan_).
@@ -240,8 +240,10 @@ class Grid {
     (GridView g, PaintWindowView pw, BristleField br, const float* particle_density, CanvasDims canvas,                \
      FlowColumns flow, float liquid_threshold, float dry_threshold),                                                   \
     (g, pw, br, particle_density, canvas, flow, liquid_threshold, dry_threshold))                                      \
-  X(void, grid_column_tops, (GridDims d, const float* rho, const float* particle_density, float trace, float* out),    \
-    (d, rho, particle_density, trace, out))                                                                            \
+  X(void, grid_column_tops,                                                                                            \
+    (GridDims d, const float* rho, const float* dryness, float liquid_threshold, float dry_threshold,                  \
+     const float* particle_density, float trace, float* out),                                                          \
+    (d, rho, dryness, liquid_threshold, dry_threshold, particle_density, trace, out))                                  \
   X(void, grid_first_extent, (GridDims d, const float* maxima, GridExtent* e, float* rates), (d, maxima, e, rates))    \
   X(void, grid_running_columns, (GridView g, PaintWindowView pw, float dry_threshold, float speed, float* out),        \
     (g, pw, dry_threshold, speed, out))                                                                                \

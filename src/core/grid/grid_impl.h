@@ -153,19 +153,27 @@ void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float*
   });
 }
 
-void grid_column_tops(GridDims d, const float* rho, const float* particle_density, float trace, float* out) {
+void grid_column_tops(GridDims d, const float* rho, const float* dryness, float liquid_threshold, float dry_threshold,
+                      const float* particle_density, float trace, float* out) {
   const int64_t n = int64_t(d.nx) * d.ny;
   parallel_for(n, [=] WB_HD(int64_t col) {
     // The column's top layer (k + 1) holding paint above `trace`, and holding paint or particles;
-    // where it holds either, its x, -x, y and -y, whose maxima are the box of such columns.
+    // where it holds either, its x, -x, y and -y, whose maxima are the box of such columns. Dried
+    // paint counts only where the classification makes it liquid (classify_cell): a canvas's
+    // ground or a dried layer is solid or air, never moves, and the cells of it that wet paint
+    // can reach lie within the box's margins.
+    const auto wet = [=](int64_t c) {
+      return rho[c] > trace && (!(dryness[c] >= dry_threshold) ||
+                                (!dried_solid(rho[c], dryness[c], dry_threshold) && rho[c] >= liquid_threshold));
+    };
     float top = 0.f, joint = 0.f;
     for (int k = d.nz - 1; k >= 0 && joint == 0.f; --k) {
       const int64_t c = int64_t(k) * n + col;
-      if (rho[c] > trace) top = joint = float(k + 1);
+      if (wet(c)) top = joint = float(k + 1);
       else if (particle_density && particle_density[c] > trace) joint = float(k + 1);
     }
     for (int k = int(joint) - 1; k >= 0 && top == 0.f; --k)
-      if (rho[int64_t(k) * n + col] > trace) top = float(k + 1);
+      if (wet(int64_t(k) * n + col)) top = float(k + 1);
     const float none = -INFINITY, i = float(col % d.nx), j = float(col / d.nx);
     out[col] = top;
     out[n + col] = joint;
