@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
   cli.addHelpOption();
   cli.addVersionOption();
   QCommandLineOption device_opt("device", "Simulation device: auto, cpu, cuda or cuda:N.", "device", "auto");
-  QCommandLineOption preset_opt("preset", "Quality preset: auto (from the device), cpu, gpu, fast (fewer bristles: keeps up on two CPU cores) or tiny (small canvas and brush, for tests).", "preset", "auto");
+  QCommandLineOption preset_opt("preset", "Quality preset: auto (gpu on a GPU; cpu from 8 CPU threads, fast below), cpu, gpu, fast (fewer bristles: keeps up on two CPU cores) or tiny (small canvas and brush, for tests).", "preset", "auto");
   QCommandLineOption view_opt("view",
                               "Canvas view: auto (OpenGL when a context can be made, else raster), gl (OpenGL) or "
                               "raster (QPainter, no OpenGL).",

@@ -79,12 +79,17 @@ QualityPreset QualityPreset::tiny() {
 }
 
 QualityPreset QualityPreset::from_name(const std::string& name, const Device& d) {
-  if (name == "auto") return for_device(d);
+  if (name == "auto") return for_device(d, cpu_thread_count());
   if (name == "cpu") return cpu();
   if (name == "gpu") return gpu();
   if (name == "fast") return fast();
   if (name == "tiny") return tiny();
   WB_THROW("unknown quality preset '" + name + "' (valid: auto, cpu, gpu, fast, tiny)");
+}
+
+QualityPreset QualityPreset::for_device(const Device& d, int cpu_threads) {
+  if (d.is_cuda()) return gpu();
+  return cpu_threads >= 8 ? cpu() : fast();
 }
 
 Int3 QualityPreset::window() const { return Int3{window_xy, window_xy, std::min(window_z, canvas_depth)}; }

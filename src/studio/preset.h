@@ -33,9 +33,13 @@ struct QualityPreset {
   /// A small, fast configuration (small canvas, window and brush) for tests and slow machines:
   /// the same studio and the same physics, at a scale where a stroke takes seconds on two cores.
   static QualityPreset tiny();
-  /// "cpu", "gpu", "fast", "tiny"; "auto" picks from the device. Throws wb::Error for other names.
+  /// "cpu", "gpu", "fast", "tiny"; "auto" picks from the device and the CPU's threads
+  /// (for_device). Throws wb::Error for other names.
   static QualityPreset from_name(const std::string& name, const Device& d);
-  static QualityPreset for_device(const Device& d) { return d.is_cuda() ? gpu() : cpu(); }
+  /// The GPU preset on a GPU; on the CPU, the CPU preset with 8 threads or more and the fast
+  /// preset below (docs/STUDIO.md "Quality presets": the CPU preset's step on two cores is two to
+  /// three times the real-time budget).
+  static QualityPreset for_device(const Device& d, int cpu_threads);
   /// The simulated window of this preset, cells.
   Int3 window() const;
 };

@@ -478,6 +478,11 @@ class StudioTest : public QObject {
       QVERIFY(p.window().x <= p.canvas_width && p.window().y <= p.canvas_height && p.window().z <= p.canvas_depth);
     }
     QVERIFY_THROWS_EXCEPTION(wb::Error, QualityPreset::from_name("laptop", Device(DeviceType::CPU)));
+    // auto: the GPU preset on a GPU; on the CPU, fast below 8 threads (two cores cannot keep up
+    // with the CPU preset), the CPU preset from 8.
+    QCOMPARE(QualityPreset::for_device(Device(DeviceType::CUDA), 2).id, std::string("gpu"));
+    QCOMPARE(QualityPreset::for_device(Device(DeviceType::CPU), 2).id, std::string("fast"));
+    QCOMPARE(QualityPreset::for_device(Device(DeviceType::CPU), 8).id, std::string("cpu"));
   }
 
   void brushPanelRangesAreTheBrushTable() {
