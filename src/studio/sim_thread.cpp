@@ -274,6 +274,24 @@ void SimThread::recover(const std::exception& e) {
                                        "): the painting is as it was before it; save it now"));
 }
 
+void StepTimes::add(double ms) {
+  const double b = ms / kBinMs;
+  ++count[b < double(kBins - 1) ? size_t(b > 0.0 ? b : 0.0) : size_t(kBins - 1)];
+}
+
+double StepTimes::quantile_since(const StepTimes& before, double q) const {
+  int64_t n = 0;
+  for (int i = 0; i < kBins; ++i) n += count[size_t(i)] - before.count[size_t(i)];
+  if (n <= 0) return 0.0;
+  const int64_t rank = std::max<int64_t>(1, int64_t(std::ceil(q * double(n))));
+  int64_t seen = 0;
+  for (int i = 0; i < kBins; ++i) {
+    seen += count[size_t(i)] - before.count[size_t(i)];
+    if (seen >= rank) return double(i + 1) * kBinMs;
+  }
+  return double(kBins) * kBinMs;
+}
+
 void SimThread::step_once(const SessionStep& s) {
   Session& doc = *doc_;
   if (s.first) {
@@ -286,7 +304,7 @@ void SimThread::step_once(const SessionStep& s) {
   doc.step(session_.player(), s.step, s.events, s.pen_down_edge && session_.paint().reload_on_pen_down);
   for (const StrokeEvent& e : s.events)
     if (e.kind == StrokeEventKind::Dry) invalidate_all();
-  lap(times_.step, t);
+  step_times_.add(1e3 * (lap(times_.step, t) - t));
   // Paint changes only inside the active window (where it was and where it moved to).
   const Int3 o = doc.sim().grid().window().origin(), n = doc.sim().grid().window().dims();
   invalidate_rect(std::min(o.x, o0.x), std::min(o.y, o0.y), std::max(o.x, o0.x) + n.x, std::max(o.y, o0.y) + n.y);
@@ -339,6 +357,7 @@ void SimThread::publish_status(bool force) {
   status_.window = config_.window;
   status_.steps = steps_;
   status_.times = times_;
+  status_.step_times = step_times_;
   const BrushPicture picture = frames_.brush_picture();
   status_.brush_ryb = {picture.mean_ryb.x, picture.mean_ryb.y, picture.mean_ryb.z};
   status_.brush_amount = picture.amount;

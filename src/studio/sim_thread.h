@@ -40,6 +40,18 @@ struct WorkerTimes {
   double idle = 0.0;      ///< waiting for input
 };
 
+/// The wall times of the steps since the thread started, in bins of kBinMs (the last holds every
+/// longer step): a painting's median step and tail without a time kept for every step.
+struct StepTimes {
+  static constexpr int kBins = 1000;
+  static constexpr double kBinMs = 0.25;
+  std::array<int64_t, kBins> count{};
+  void add(double ms);
+  /// The q-quantile (nearest rank; the bin's upper edge, ms) of the steps counted since `before`
+  /// (an earlier copy of this); 0 when there are none.
+  double quantile_since(const StepTimes& before, double q) const;
+};
+
 /// What the status bar shows; updated by the worker about twice a second.
 struct SimStatus {
   double steps_per_s = 0.0;     ///< simulation steps per wall second (last ~0.5 s of activity)
@@ -60,6 +72,7 @@ struct SimStatus {
   std::string error;            ///< first error; stepping stops, the document is kept
   int64_t faults = 0;           ///< failed steps recovered from (the stroke ended, the canvas as before it)
   WorkerTimes times;
+  StepTimes step_times;
 };
 
 class SimThread : public QObject {
@@ -191,6 +204,7 @@ class SimThread : public QObject {
   double last_status_ = 0.0;
   bool failed_ = false;
   WorkerTimes times_;  ///< worker only; copied into status_ with it
+  StepTimes step_times_;  ///< worker only; copied into status_ with it
 
   std::thread thread_;
 };

@@ -485,6 +485,19 @@ class StudioTest : public QObject {
     QCOMPARE(QualityPreset::for_device(Device(DeviceType::CPU), 8).id, std::string("cpu"));
   }
 
+  /// The demo's median and 95th-percentile step come from the steps' bins, counted since a copy.
+  void stepTimesQuantiles() {
+    StepTimes t;
+    for (int ms = 1; ms <= 40; ++ms) t.add(1000.0);  // before the copy: not counted
+    const StepTimes before = t;
+    QCOMPARE(t.quantile_since(before, 0.5), 0.0);
+    for (int ms = 1; ms <= 100; ++ms) t.add(double(ms) - 0.1);
+    QCOMPARE(t.quantile_since(before, 0.5), 50.0);   // the 50th step, 49.9 ms, in the bin up to 50
+    QCOMPARE(t.quantile_since(before, 0.95), 95.0);
+    t.add(1000.0);  // past the bins: the last one
+    QCOMPARE(t.quantile_since(before, 1.0), StepTimes::kBins * StepTimes::kBinMs);
+  }
+
   void brushPanelRangesAreTheBrushTable() {
     // Every number the brush panel edits is a brush field, with the range the brush files and
     // their validation use (brush_field_ranges): a preset the reader accepts is never clamped.
