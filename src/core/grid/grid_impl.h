@@ -163,8 +163,9 @@ void grid_column_tops(GridDims d, const float* rho, const float* dryness, float 
     // ground or a dried layer is solid or air, never moves, and the cells of it that wet paint
     // can reach lie within the box's margins.
     const auto wet = [=](int64_t c) {
-      return rho[c] > trace && (!(dryness[c] >= dry_threshold) ||
-                                (!dried_solid(rho[c], dryness[c], dry_threshold) && rho[c] >= liquid_threshold));
+      return rho[c] > trace &&
+             (!(dryness[c] >= dry_threshold) ||
+              classify_cell(rho[c], dryness[c], true, liquid_threshold, dry_threshold) == kCellLiquid);
     };
     float top = 0.f, joint = 0.f;
     for (int k = d.nz - 1; k >= 0 && joint == 0.f; --k) {
@@ -518,6 +519,12 @@ void grid_gravity(GridView g, float* ph, float g_dt, float g_dt_y) {
 
 // --- thin films (docs/GRID.md "Thin films") --------------------------------------------------
 
+/// Column c's tau_y and K at its oil, kept beside it (kFilmTau, kFilmK).
+WB_HD WB_INLINE void film_rheology(float* col, int64_t n, int64_t c, const FilmFlow& f) {
+  const HerschelBulkley hb = rheology_at_oil(col[kFilmOil * n + c], f.stiff, f.oily);
+  col[kFilmTau * n + c] = hb.tau_y, col[kFilmK * n + c] = hb.K;
+}
+
 void grid_film_columns(GridDims d, const GridExtent* e, PaintWindowView pw, BristleField br,
                        const float* particle_density, FlowColumns flow, float dry_threshold, float film_max,
                        FilmFlow f, float* col) {
@@ -548,8 +555,7 @@ void grid_film_columns(GridDims d, const GridExtent* e, PaintWindowView pw, Bris
     col[kFilmAbove * n + c] = float(above);
     col[kFilmOil * n + c] = mean(oil), col[kFilmDry * n + c] = mean(dry);
     col[kFilmR * n + c] = mean(r), col[kFilmY * n + c] = mean(y), col[kFilmB * n + c] = mean(b);
-    const HerschelBulkley hb = rheology_at_oil(mean(oil), f.stiff, f.oily);
-    col[kFilmTau * n + c] = hb.tau_y, col[kFilmK * n + c] = hb.K;
+    film_rheology(col, n, c, f);
   });
 }
 
@@ -609,8 +615,7 @@ void grid_film_update(GridDims d, const float* col, FilmFlow f, float* next) {
     next[kFilmH * n + c] = m;
     next[kFilmR * n + c] = p.x, next[kFilmY * n + c] = p.y, next[kFilmB * n + c] = p.z;
     next[kFilmOil * n + c] = m > 0.f ? oil / m : 0.f, next[kFilmDry * n + c] = m > 0.f ? dry / m : 0.f;
-    const HerschelBulkley hb = rheology_at_oil(next[kFilmOil * n + c], f.stiff, f.oily);
-    next[kFilmTau * n + c] = hb.tau_y, next[kFilmK * n + c] = hb.K;
+    film_rheology(next, n, c, f);
     next[kFilmMoved * n + c] = col[kFilmMoved * n + c] + out + gain;
   });
 }

@@ -13,19 +13,15 @@ void joint_scale(const float* in, float* out, int64_t n, float scale) {
 
 /// The particles' raster as densities: density[i] = cell[i].first * scale and, where oil is
 /// not null, oil[i] = cell[i].second * scale (scale 1 / cell_mass: kg to cell-volume fractions),
-/// at the cells `list` holds where it is on (elsewhere both are 0: joint_clear_raster), else at
-/// all n.
+/// at the cells `list` holds (elsewhere both are 0: joint_clear_raster).
 void joint_raster_density(const FloatPair* cell, float* density, float* oil, TouchList list, int64_t n, float scale) {
-  WB_REQUIRE(n == 0 || (cell && density), "joint_raster_density: a field is null");
-  const auto at = [=] WB_HD(int64_t i) {
+  WB_REQUIRE(n == 0 || (cell && density && list.on()), "joint_raster_density: a field or the list is null");
+  parallel_for_count(list.count, n, [=] WB_HD(int64_t t) {
+    const int64_t i = list.items[t];
     const FloatPair c = cell[i];
     density[i] = c.first * scale;
     if (oil) oil[i] = c.second * scale;
-  };
-  if (list.on())
-    parallel_for_count(list.count, n, [=] WB_HD(int64_t t) { at(list.items[t]); });
-  else
-    parallel_for(n, at);
+  });
 }
 
 /// The elements `list` holds (of n) back to zero in the raster's pairs and, where not null, its
@@ -75,7 +71,8 @@ void joint_sample_extent(const Vec3* x, int64_t n, float z_top, float* out) {
 void joint_blend_velocity(GridView g, PaintWindowView paint, ParticleRasterView raster, float cell_mass) {
   WB_REQUIRE(raster.nx == g.d.nx && raster.ny == g.d.ny && raster.nz == g.d.nz,
              "joint_blend_velocity: particle raster and grid differ in size");
-  WB_REQUIRE(raster.face[0] && raster.face[1] && raster.face[2], "joint_blend_velocity: the raster has no faces");
+  for (int c = 0; c < 3; ++c)
+    WB_REQUIRE(raster.face[c] && raster.face_list[c].on(), "joint_blend_velocity: the raster has no listed faces");
   const GridDims d = g.d;
   for (int c = 0; c < 3; ++c) {
     float* u = g.vel[c];
@@ -83,7 +80,10 @@ void joint_blend_velocity(GridView g, PaintWindowView paint, ParticleRasterView 
     const float* rho = paint.density;
     const int ex = d.nx + (c == 0), ey = d.ny + (c == 1);
     const int64_t faces = int64_t(ex) * ey * (d.nz + (c == 2));
-    const auto blend = [=] WB_HD(int64_t f) {
+    // The faces the raster reached, which it listed (no other face has weight).
+    const TouchList list = raster.face_list[c];
+    parallel_for_count(list.count, faces, [=] WB_HD(int64_t t) {
+      const int64_t f = list.items[t];
       const FloatPair pf = face[f];
       const float wp = pf.first;
       if (!(wp > 0.f)) return;
@@ -96,13 +96,7 @@ void joint_blend_velocity(GridView g, PaintWindowView paint, ParticleRasterView 
       if (i < d.nx && j < d.ny && k < d.nz) rg += rho[(int64_t(k) * d.ny + j) * d.nx + i], ++n;
       const float wg = n ? cell_mass * rg / float(n) : 0.f;
       u[f] = (wg * u[f] + pf.second) / (wg + wp);
-    };
-    // The faces the raster reached, where it listed them (no other face has weight).
-    const TouchList list = raster.face_list[c];
-    if (list.on())
-      parallel_for_count(list.count, faces, [=] WB_HD(int64_t t) { blend(list.items[t]); });
-    else
-      parallel_for(faces, blend);
+    });
   }
 }
 
