@@ -43,7 +43,7 @@ void BM_GridAdvect(benchmark::State& state) {
   wb::Grid& g = scene().grid();
   g.classify();
   for (auto _ : state) g.advect(g.params().dt);
-  g.read_advect_plan();
+  g.read_record();
   state.counters["courant"] = g.stats().advect_courant;
 }
 BENCHMARK(BM_GridAdvect)->Unit(benchmark::kMillisecond);

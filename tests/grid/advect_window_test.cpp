@@ -192,7 +192,7 @@ TEST_F(AdvectWindowTest, TiledAdvectionEqualsAnyTilingOfTheSameCells) {
       }
       g.classify();
       g.advect(g.params().dt);
-      g.read_advect_plan();
+      g.read_record();
       courant = std::max(courant, g.stats().advect_courant);
     }
     // Back to small-window cells.

@@ -231,9 +231,9 @@ TEST_F(LayerPropertiesTest, WhiteBrushCarriesRedPastAWetRedBand) {
   PaintLoad white;
   white.ryb[0] = white.ryb[1] = white.ryb[2] = 0.f;
   white.load = 1.f;
-  sim.load_paint(white);
   Books books;
-  books.open(sim);
+  books.open(sim);  // before the load: the books enter it with the first step's record
+  sim.load_paint(white);
   drag(sim, kX0, kX1, 300.f, 0.6f);
   const double drift = books.max_drift(sim);
   std::printf("books from the layer: drift %.2e\n", drift);
@@ -355,9 +355,9 @@ TEST_F(LayerPropertiesTest, LightBrushScumblesTheTopsOfADriedRidgedLayer) {
     }
     return p;
   });
-  load_light_white(sim, env_or("WB_LAYER_LOAD", 0.3f));
   Books books;
-  books.open(sim);
+  books.open(sim);  // before the load: the books enter it with the first step's record
+  load_light_white(sim, env_or("WB_LAYER_LOAD", 0.3f));
   drag(sim, kX0, kX1, 300.f, env_or("WB_LAYER_PRESSURE", 0.1f));
   EXPECT_LT(books.max_drift(sim), 1e-4);
   EXPECT_EQ(sim.counters().nonfinite_events, 0);

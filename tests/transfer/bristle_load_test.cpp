@@ -29,7 +29,8 @@ TEST_F(BristleLoadTest, FillLoadsToTheFractionOfCapacity) {
   const int64_t n = 3000;
   BristleLoad load(device_, n, prm);
   EXPECT_EQ(load.total_mass(ws_), 0.0);
-  const double added = load.fill(paint(Vec3(0.1f, 0.15f, 0.85f), 0.3f, 0.8f));
+  load.fill(paint(Vec3(0.1f, 0.15f, 0.85f), 0.3f, 0.8f));
+  const double added = load.take_change();
   EXPECT_NEAR(load.total_mass(ws_), double(n) * 0.8 * prm.M_max, 1e-6 * n * prm.M_max);
   EXPECT_NEAR(added, load.total_mass(ws_), 1e-6 * added);
   const Vec3 c = load.mean_color(ws_);
@@ -50,7 +51,9 @@ TEST_F(BristleLoadTest, DipMixesIntoWhatIsThere) {
   BristleLoad load(device_, 100, prm);
   const Vec3 blue(0.f, 0.f, 1.f), yellow(0.f, 1.f, 0.f);
   load.fill(paint(blue, 0.2f, 0.5f));
-  const double added = load.dip(paint(yellow, 0.6f, 1.f));
+  (void)load.take_change();
+  load.dip(paint(yellow, 0.6f, 1.f));
+  const double added = load.take_change();
   EXPECT_NEAR(added, 100.0 * 0.5 * prm.M_max, 1e-6 * 100 * prm.M_max);
   EXPECT_NEAR(load.total_mass(ws_), 100.0 * prm.M_max, 1e-6 * 100 * prm.M_max);
   const Vec3 ref = color_mix(blue, yellow, 0.5f, 0.5f);
@@ -71,7 +74,8 @@ TEST_F(BristleLoadTest, DipMixesIntoWhatIsThere) {
   EXPECT_NEAR(well.oil, 0.4f, 1e-5f);
   EXPECT_NEAR(well.load, 1.f, 1e-5f);
   // A full brush takes no more paint, and its colour stays.
-  EXPECT_EQ(load.dip(paint(Vec3(1.f, 0.f, 0.f), 0.3f, 0.7f)), 0.0);
+  load.dip(paint(Vec3(1.f, 0.f, 0.f), 0.3f, 0.7f));
+  EXPECT_EQ(load.take_change(), 0.0);
   EXPECT_NEAR(load.to_host().pigment_r[0], 0.f, 1e-6f);
 }
 
@@ -86,7 +90,9 @@ TEST_F(BristleLoadTest, DipReplacesTheShareTheWellReaches) {
   h.m[1] *= 0.5f, h.m[3] *= 0.5f;  // half-empty samples
   load.from_host(h);
   load.set_dip_exchange({0.f, 0.f, 0.6f, 0.6f});
-  const double added = load.dip(paint(blue, 0.6f, 1.f));
+  (void)load.take_change();
+  load.dip(paint(blue, 0.6f, 1.f));
+  const double added = load.take_change();
   EXPECT_NEAR(added, prm.M_max, 1e-6 * prm.M_max) << "two half-empty samples topped up";
   h = load.to_host();
   const float M = prm.M_max;
@@ -109,13 +115,16 @@ TEST_F(BristleLoadTest, WipeRemovesTheFractionAndCleanEmpties) {
   BristleLoad load(device_, 500, prm);
   load.fill(paint(Vec3(0.7f, 0.2f, 0.1f), 0.3f, 0.9f));
   const double before = load.total_mass(ws_);
-  const double removed = load.wipe(0.3f);
+  (void)load.take_change();
+  load.wipe(0.3f);
+  const double removed = -load.take_change();
   EXPECT_NEAR(removed, 0.3 * before, 1e-6 * before);
   EXPECT_NEAR(load.total_mass(ws_), 0.7 * before, 1e-6 * before);
   const Vec3 c = load.mean_color(ws_);
   EXPECT_NEAR(c.x, 0.7f, 1e-4f) << "wiping keeps the colour";
   const double left = load.total_mass(ws_);
-  EXPECT_NEAR(load.clean(), left, 1e-6 * left);
+  load.clean();
+  EXPECT_NEAR(-load.take_change(), left, 1e-6 * left);
   EXPECT_EQ(load.total_mass(ws_), 0.0);
   const Vec3 w = load.mean_color(ws_);
   EXPECT_EQ(w.x + w.y + w.z, 0.f);

@@ -458,11 +458,11 @@ struct BooksScene {
     env.D0 = 12.f;
     const int64_t before = mem::host_reads();
     TransferRecord rec = t.step(s.view(), load, p, env);
-    step_reads = mem::host_reads() - before;
     t.collect(rec);
+    step_reads = mem::host_reads() - before;
     return rec;
   }
-  int64_t step_reads = 0;  ///< host reads of the last Transfer::step
+  int64_t step_reads = 0;  ///< host reads of the last Transfer::step and its collect
   PaintCensus census(Workspace& ws) { return PaintBooks::census(load, p, w.total_density(ws), prm, ws); }
 };
 
@@ -489,9 +489,10 @@ TEST_F(GridParticleTest, WholeStepsKeepTheBooks) {
   EXPECT_EQ(books.steps().size(), 6u);
 }
 
-// The compaction and both batches of new particles share one scan and one host read: the
-// survivors keep their order at the front, the emission follows, then Eq. 15's candidates; a
-// store at its limit serves the emission first and drops the rest, and the books still close.
+// The compaction and both batches of new particles share one scan, whose ends come back with the
+// step's sums in one host read (collect): the survivors keep their order at the front, the
+// emission follows, then Eq. 15's candidates; a store at its limit serves the emission first and
+// drops the rest, and the books still close.
 TEST_F(GridParticleTest, AStepRemovesAndAddsParticlesWithOneRead) {
   BooksScene with(device_, books_window(), 2000000);
   const std::vector<Vec3> at_start = with.p.to_host().x;

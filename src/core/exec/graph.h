@@ -1,5 +1,7 @@
 // LaunchGraph: a run of launches that repeats with the same arguments, recorded once as a CUDA
 // graph and replayed whole, so the run costs one launch's latency instead of one a kernel.
+// LaunchLoop: such a run repeated until a flag its last kernel writes says stop, a loop the
+// device runs (a CUDA graph's conditional while node) without the host waiting on the flag.
 #pragma once
 #include <bit>
 #include <cstdint>
@@ -71,6 +73,64 @@ class LaunchGraph {
   uint64_t key_ = 0;
   uint64_t seen_ = 0;     // the key of the last direct run
   int64_t launches_ = 0;  // the kernels recorded: counted as launches on every replay
+};
+
+/// Runs `body` (launches only, the same arguments for the same key) once and again while the flag
+/// `*go` (device memory the body's last kernel writes: nonzero, once more) says so. The loop is the
+/// device's: on CUDA the body is recorded into a conditional while node of a graph and the host
+/// only launches the graph (no wait); on the CPU backend, whose device memory is the host's, the
+/// flag is read where it lies. A key's first run on CUDA is made directly, the flag copied back
+/// after each pass (a workspace the body grows grows then, outside a recording). On CUDA a replay
+/// counts the body's launches once: its further passes run on the device.
+class LaunchLoop {
+ public:
+  LaunchLoop() = default;
+  ~LaunchLoop() { reset(); }
+  LaunchLoop(const LaunchLoop&) = delete;
+  LaunchLoop& operator=(const LaunchLoop&) = delete;
+
+  template <typename F>
+  void run(const Device& d, uint64_t key, const uint32_t* go, F&& body) {
+    if (!d.is_cuda()) {
+      do body();
+      while (*go != 0u);
+      return;
+    }
+    if (!(exec_ && key == key_) && key != seen_) {
+      seen_ = key;
+      for (uint32_t more = 1; more != 0u;) {
+        body();
+        mem::copy_to_host(d, &more, go, sizeof(more));
+      }
+      return;
+    }
+    if (!(exec_ && key == key_)) {
+      const int64_t before = mem::launches();
+      begin();
+      try {
+        body();
+      } catch (...) {
+        abandon();
+        throw;
+      }
+      end(key, go, mem::launches() - before);
+    }
+    replay();
+  }
+  void reset();
+
+ private:
+  void drop();
+  void begin();
+  void end(uint64_t key, const uint32_t* go, int64_t launches);
+  void abandon();
+  void replay();
+  void* exec_ = nullptr;   // cudaGraphExec_t
+  void* graph_ = nullptr;  // cudaGraph_t whose conditional node's body is being recorded
+  uint64_t handle_ = 0;    // cudaGraphConditionalHandle
+  uint64_t key_ = 0;
+  uint64_t seen_ = 0;
+  int64_t launches_ = 0;
 };
 
 }  // namespace wb

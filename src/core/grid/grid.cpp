@@ -3,6 +3,7 @@
 #include "core/grid/grid.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <utility>
 
@@ -196,6 +197,8 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   for (auto* b : {&cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_}) b->set_device(d);
   cg_sums_.set_device(d);
   cg_sums_.resize(6);
+  cg_go_.set_device(d);
+  cg_go_.resize(1);
   cg_count_.set_device(d);
   cg_count_.resize(1);
   cg_partial_.set_device(d);
@@ -304,12 +307,6 @@ void Grid::advect(float dt) {
          [&] { grid_advect_velocity(d, view(), vel_tmp_[0].data(), vel_tmp_[1].data(), vel_tmp_[2].data(), dt); });
 }
 
-void Grid::read_advect_plan() {
-  AdvectPlan p{};
-  advect_plan_.copy_to_host(&p, 1);
-  take_advect_plan(p);
-}
-
 void Grid::advect_paint(float dt) {
   const Device& d = device();
   const GridDims g = dims();
@@ -404,15 +401,13 @@ void Grid::apply_viscosity(float dt) {
   WB_PROFILE_SCOPE("grid.viscosity");
   const Device& d = device();
   GridView v = view();
-  stats_.viscosity_faces = 0;
-  stats_.viscosity_iterations = 0;
-  stats_.viscosity_residual = 0;
+  cg_sums_.fill_zero();  // the record's figures are this step's, zero where nothing is solved
   // The flags every step (visc_flag_ is kept over the extents), the solve where it runs.
   grid_viscous_flags(d, v, visc_flag_.data());
   if (params_.viscosity_max_iterations <= 0) return;
   // The fluid faces, compacted: the solve costs in proportion to the paint, not to the window.
-  // Their count stays on the device (ListCount) and comes back with the CG's one read; a list
-  // longer than the vectors' capacity runs nothing and is solved again once they are sized.
+  // Their count stays on the device (ListCount), and the vectors hold every face of the window,
+  // so that no count has to come back before the solve (docs/GRID.md "Viscosity").
   const int64_t all = int64_t(visc_idx_.size());
   exclusive_scan_into(d, visc_flag_.data(), visc_idx_.data(), all, ws_);
   grid_viscous_list(d, v, visc_idx_.data(), visc_list_.data());
@@ -421,81 +416,71 @@ void Grid::apply_viscosity(float dt) {
   const float nu_scale = float(double(dt) / (double(params_.rho0) * h * h));
   const uint32_t* list = visc_list_.data();
   const uint32_t* idx = visc_idx_.data();
+  if (cg_x_.size() != size_t(all)) {
+    cg_nb_.resize(6 * size_t(all));
+    cg_nu_.resize(size_t(all));
+    for (auto* b : {&cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_}) b->resize(size_t(all));
+  }
   // Jacobi-preconditioned conjugate gradients (Saad 2003, Alg. 9.1) from the current velocity.
   // alpha, beta and the test of convergence are formed on the device from sums kept there
-  // (cg_sums_: r.z of the current and the next iteration, p.Ap, b.D^-1 b, the iterations made),
-  // so an iteration makes no host read and one launched past convergence moves nothing
-  // (CgGuard; on the CPU backend its driver returns at once). The host launches twice as many
-  // as the last solve made and a few more, then reads once; a solve that needs more (as at a
-  // lift) has every iteration left launched at once and reads once more: two reads at most.
-  constexpr int kCgMargin = 8;
-  constexpr int64_t kCgFirstCapacity = 4096;  // entries of the first solve's vectors
+  // (cg_sums_: r.z of the current and the next iteration, p.Ap, b.D^-1 b, the iterations made,
+  // the fluid faces), and the device runs the iterations until the test or the iteration limit
+  // stops them (LaunchLoop): the host waits for none of it. The sums come back with the step's
+  // record (record_into).
   const double tol2 = double(params_.viscosity_tolerance) * double(params_.viscosity_tolerance);
   const int max_it = params_.viscosity_max_iterations;
   double* sums = cg_sums_.data();
   const SumScratch sum{cg_partial_.data(), cg_ticket_.data()};
-  double host[6] = {};
-  int cur = 0;
-  for (int64_t need = 0;;) {
-    if (need > int64_t(cg_x_.size()) || cg_x_.size() == 0) {
-      const size_t cap = size_t(std::min(all, std::max<int64_t>(need + need / 2, kCgFirstCapacity)));
-      cg_nb_.resize(6 * cap);
-      cg_nu_.resize(cap);
-      for (auto* b : {&cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_}) b->resize(cap);
-    }
-    const ListCount n{cg_count_.data(), int64_t(cg_x_.size())};
-    cg_sums_.fill_zero();
-    grid_viscous_count(d, v, idx, n.capacity, cg_count_.data(), sums + 5);
-    grid_viscous_setup(d, v, list, n, idx, mu_.data(), nu_scale, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(),
-                       cg_b_.data(), cg_x_.data());
-    // A x into q (its p.Ap lands in slot 2, which the first iteration writes again), then r, z,
-    // p, r.z and b.D^-1 b.
-    grid_viscous_apply(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_x_.data(), cg_q_.data(), sums + 2, {},
-                       sum);
-    grid_pcg_start(d, n, cg_b_.data(), cg_q_.data(), cg_diag_.data(), cg_r_.data(), cg_z_.data(), cg_p_.data(),
-                   sums + 0, sums + 3, sum);
-    // Three launches an iteration (each pass forms its dot product as it goes), queued two
-    // iterations at a time: the pair repeats with the same arguments (r.z's slots alternate), so
-    // on CUDA it is one graph's launch (recorded again when the vectors move).
-    const auto iterate = [&](int c) {
-      const CgGuard guard{sums + c, sums + 3, tol2};
-      grid_viscous_apply(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_p_.data(), cg_q_.data(), sums + 2,
-                         guard, sum);
-      grid_pcg_update(d, n, guard, sums + 2, cg_p_.data(), cg_q_.data(), cg_diag_.data(), cg_x_.data(), cg_r_.data(),
-                      cg_z_.data(), sums + 1 - c, sums + 4, sum);
-      grid_pcg_direction(d, n, guard, sums + 1 - c, cg_z_.data(), cg_p_.data());
-    };
-    const uint64_t key = launch_key({launch_key_of(cg_x_.data()), launch_key_of(cg_nb_.data()),
-                                     launch_key_of(cg_nu_.data()), launch_key_of(sums), uint64_t(n.capacity)});
-    int launched = 0;
-    cur = 0;
-    // Plans are even (pairs) but for an odd max_it, whose last iteration runs alone.
-    const auto even = [](int k) { return k + (k & 1); };
-    for (int planned = std::min(max_it, even(2 * cg_last_iterations_ + kCgMargin));;) {
-      for (; launched + 2 <= planned; launched += 2) cg_pair_.run(d, key, [&] {
-          iterate(0);
-          iterate(1);
-        });
-      if (launched < planned) {
-        iterate(0);
-        cur = 1;
-        ++launched;
-      }
-      cg_sums_.copy_to_host(host, 6);
-      need = int64_t(host[5]);
-      if (need > n.capacity) break;  // nothing ran: size the vectors and solve again
-      const double rz = host[cur];
-      if (!(rz > tol2 * host[3] && rz > 0.0) || launched >= max_it) break;
-      planned = max_it;
-    }
-    if (need <= int64_t(cg_x_.size())) break;
-  }
-  stats_.viscosity_faces = int(host[5]);
-  const int it = int(host[4]);
-  if (host[5] > 0.0) cg_last_iterations_ = it;  // a solve of nothing plans nothing
-  stats_.viscosity_iterations = it;
-  stats_.viscosity_residual = host[3] > 0.0 ? std::sqrt(std::max(host[cur], 0.0) / host[3]) : 0.0;
-  grid_viscous_write(d, v, list, ListCount{cg_count_.data(), int64_t(cg_x_.size())}, cg_x_.data());
+  const ListCount n{cg_count_.data(), all};
+  grid_viscous_count(d, v, idx, cg_count_.data(), sums + 5);
+  grid_viscous_setup(d, v, list, n, idx, mu_.data(), nu_scale, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(),
+                     cg_b_.data(), cg_x_.data());
+  // A x into q (its p.Ap lands in slot 2, which the first iteration writes again), then r, z,
+  // p, r.z and b.D^-1 b.
+  grid_viscous_apply(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_x_.data(), cg_q_.data(), sums + 2, {},
+                     sum);
+  grid_pcg_start(d, n, cg_b_.data(), cg_q_.data(), cg_diag_.data(), cg_r_.data(), cg_z_.data(), cg_p_.data(),
+                 sums + 0, sums + 3, sum);
+  // An iteration: p.Ap, the update (r.z into slot 1), the direction, and the test, which moves
+  // r.z to slot 0 and sets the loop's flag. Every pass also tests (CgGuard), so that a solve that
+  // starts converged moves nothing in its one pass.
+  const CgGuard guard{sums + 0, sums + 3, tol2};
+  const uint64_t key = launch_key({launch_key_of(cg_x_.data()), launch_key_of(cg_nb_.data()),
+                                   launch_key_of(cg_nu_.data()), launch_key_of(sums), uint64_t(all), uint64_t(max_it),
+                                   std::bit_cast<uint64_t>(tol2)});
+  cg_loop_.run(d, key, cg_go_.data(), [&] {
+    grid_viscous_apply(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_p_.data(), cg_q_.data(), sums + 2,
+                       guard, sum);
+    grid_pcg_update(d, n, guard, sums + 2, cg_p_.data(), cg_q_.data(), cg_diag_.data(), cg_x_.data(), cg_r_.data(),
+                    cg_z_.data(), sums + 1, sums + 4, sum);
+    grid_pcg_direction(d, n, guard, sums + 1, cg_z_.data(), cg_p_.data());
+    grid_pcg_continue(d, sums + 0, sums + 1, sums + 3, tol2, sums + 4, max_it, cg_go_.data());
+  });
+  grid_viscous_write(d, v, list, n, cg_x_.data());
+}
+
+void Grid::record_into(GridRecord* out) const {
+  mem::copy_on_device(device(), &out->advect, advect_plan_.data(), sizeof(AdvectPlan));
+  mem::copy_on_device(device(), out->viscosity, cg_sums_.data(), sizeof(out->viscosity));
+}
+
+void Grid::take_record(const GridRecord& r) {
+  stats_.advect_passes = r.advect.passes;
+  stats_.advect_courant = r.advect.courant;
+  // The sums of the last solve (apply_viscosity): r.z in slot 0, b.D^-1 b in 3, the iterations
+  // in 4, the fluid faces in 5; all zero where no solve ran.
+  stats_.viscosity_faces = int(r.viscosity[5]);
+  stats_.viscosity_iterations = int(r.viscosity[4]);
+  stats_.viscosity_residual =
+      r.viscosity[3] > 0.0 ? std::sqrt(std::max(r.viscosity[0], 0.0) / r.viscosity[3]) : 0.0;
+}
+
+void Grid::read_record() {
+  DeviceBuffer<GridRecord> rec(device(), 1);
+  record_into(rec.data());
+  GridRecord r{};
+  rec.copy_to_host(&r, 1);
+  take_record(r);
 }
 
 void Grid::compute_rhs(float dt) {

@@ -131,19 +131,17 @@ class Grid {
   const DeviceBuffer<float>& rhs() const { return rhs_; }
 
   // --- diagnostics ---
-  /// The last step's figures. advect_passes and advect_courant are the step's AdvectPlan, made on
-  /// the device: they are the host's once the plan comes back, with the simulator's step record
-  /// (take_advect_plan) or, for a grid stepped alone, read_advect_plan.
+  /// The last step's figures. Those the device makes (the advection's plan, the viscous solve's
+  /// faces, iterations and residual) are the host's once they come back, with the simulator's
+  /// step record (record_into, take_record) or, for a grid stepped alone, read_record.
   const GridStats& stats() const { return stats_; }
-  /// The last step's advection plan on the device (the simulator copies it into its record).
-  const AdvectPlan* advect_plan() const { return advect_plan_.data(); }
-  /// Takes the advection's plan that came back with a step's record into stats().
-  void take_advect_plan(const AdvectPlan& p) {
-    stats_.advect_passes = p.passes;
-    stats_.advect_courant = p.courant;
-  }
-  /// Reads the last step's advection plan into stats() (a host wait: for a grid stepped alone).
-  void read_advect_plan();
+  /// Queues copies of the last step's device figures into `out` (device memory: a slot of the
+  /// simulator's step record, read with it).
+  void record_into(GridRecord* out) const;
+  /// Takes the figures that came back with a step's record into stats().
+  void take_record(const GridRecord& r);
+  /// Reads the last step's device figures into stats() (a host wait: for a grid stepped alone).
+  void read_record();
   /// The layers the last step's stages after the joint fields visited (device; docs/GRID.md).
   const DeviceBuffer<GridExtent>& extent() const { return extent_; }
   /// ||div||_2 of the current velocity over liquid cells, against the compression source of
@@ -178,16 +176,16 @@ class Grid {
   DeviceBuffer<float> cg_nu_;
   /// The viscous CG's vectors and matrix diagonal, in double (viscous_apply says why).
   DeviceBuffer<double> cg_x_, cg_b_, cg_r_, cg_z_, cg_p_, cg_q_, cg_diag_;
-  /// The CG's scalars on the device: r.z of the two latest iterations, p.Ap, b.D^-1 b, the
-  /// iterations made, the fluid faces counted (read together, once a solve).
+  /// The CG's scalars on the device: r.z of the current and the next iteration, p.Ap, b.D^-1 b,
+  /// the iterations made, the fluid faces counted (they come back with the step's record).
   DeviceBuffer<double> cg_sums_;
+  DeviceBuffer<uint32_t> cg_go_;  ///< the CG loop's flag: 1, another iteration (LaunchLoop)
   /// The fluid faces the solve's kernels run over (ListCount::n).
   DeviceBuffer<int64_t> cg_count_;
   /// The scratch of the iterations' dot products (parallel_sum_count): a partial a block, a ticket.
   DeviceBuffer<double> cg_partial_;
   DeviceBuffer<uint32_t> cg_ticket_;
-  LaunchGraph cg_pair_;  ///< two CG iterations, recorded (CUDA)
-  int cg_last_iterations_ = 0;  ///< the last viscous solve's CG iterations: the next one plans on them
+  LaunchLoop cg_loop_;  ///< the CG's iterations, run by the device until converged
   /// The advection's maxima: the outflow rate along each axis (slots 0-2), then column_maxima's
   /// six (the top layers holding paint and paint or particles, the latter's box), which make the
   /// step's AdvectPlan on the device; then column_maxima's six again after the particles joined
@@ -281,8 +279,7 @@ class Grid {
     (g, oil, stiff, oily, m, mu))                                                                                      \
   X(void, grid_viscous_flags, (GridView g, uint32_t * flag), (g, flag))                                                \
   X(void, grid_viscous_list, (GridView g, const uint32_t* idx, uint32_t* list), (g, idx, list))                        \
-  X(void, grid_viscous_count, (GridView g, const uint32_t* idx, int64_t capacity, int64_t* run, double* total),        \
-    (g, idx, capacity, run, total))                                                                                    \
+  X(void, grid_viscous_count, (GridView g, const uint32_t* idx, int64_t* run, double* total), (g, idx, run, total))    \
   X(void, grid_viscous_setup,                                                                                          \
     (GridView g, const uint32_t* list, ListCount n, const uint32_t* idx, const float* mu, float nu_scale, float* nu,   \
      int32_t* nb, double* diag, double* b, double* x),                                                                 \
@@ -301,6 +298,10 @@ class Grid {
     (n, guard, pq, p, q, diag, x, r, z, rz, iterations, s))                                                            \
   X(void, grid_pcg_direction, (ListCount n, CgGuard guard, const double* rz_new, const double* z, double* p),          \
     (n, guard, rz_new, z, p))                                                                                          \
+  X(void, grid_pcg_continue,                                                                                           \
+    (double* rz, const double* rz_new, const double* bnorm, double tol2, const double* iterations, int max_it,         \
+     uint32_t* go),                                                                                                    \
+    (rz, rz_new, bnorm, tol2, iterations, max_it, go))                                                                 \
   X(void, grid_viscous_write, (GridView g, const uint32_t* list, ListCount n, const double* x), (g, list, n, x))       \
   X(void, grid_rhs, (GridView g, const float* rho, float inv_dt, float* b), (g, rho, inv_dt, b))                       \
   X(void, poisson_jacobi, (PoissonView s, const float* b, const float* x, float* out, float omega),                    \

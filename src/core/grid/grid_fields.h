@@ -174,7 +174,7 @@ constexpr int kPaintTile = 8;
 /// The paint advection's plan for a step, made on the device from the step's maxima
 /// (grid_advect_plan) so that the host launches the passes without reading them: how far the
 /// paint moves along each axis and the layers and tiles its passes visit. It comes back to the
-/// host with the step's record (Grid::take_advect_plan).
+/// host with the step's record (Grid::take_record).
 struct AdvectPlan {
   /// Cells a pass along each axis walks: the paint's largest outflow over the step, rounded up,
   /// and 1; 0: no flow along the axis, and its pass writes nothing.
@@ -186,6 +186,14 @@ struct AdvectPlan {
   int32_t halo_tiles;   ///< the ring of tiles beyond them the passes read
   int32_t passes;       ///< the axes along which paint flows (reach > 0)
   float courant;        ///< the largest one-axis outflow of a painted cell over the step, cells
+};
+
+/// The grid's figures that the device makes in a step and the host learns with the step's
+/// record (Grid::record_into, Grid::take_record): the advection's plan and the viscous solve's
+/// sums (r.z, r.z next, p.Ap, b.D^-1 b, the iterations, the fluid faces).
+struct GridRecord {
+  AdvectPlan advect;
+  double viscosity[6];
 };
 
 /// Whether the passes of a step before its pass n (the axes in `order`: 0 x y z, 1 z y x) left

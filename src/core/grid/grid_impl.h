@@ -682,7 +682,7 @@ WB_HD WB_INLINE int64_t list_face(const GridDims& d, const uint32_t* list, int64
 }
 }  // namespace detail
 
-void grid_viscous_count(GridView g, const uint32_t* idx, int64_t capacity, int64_t* run, double* total) {
+void grid_viscous_count(GridView g, const uint32_t* idx, int64_t* run, double* total) {
   // idx is the exclusive scan of the fluid flags of every face: the last entry plus the last
   // face's own flag is the count.
   const GridDims d = g.d;
@@ -692,7 +692,7 @@ void grid_viscous_count(GridView g, const uint32_t* idx, int64_t capacity, int64
     int64_t f;
     detail::split_face_below(d, d.nz, last, c, f);
     const int64_t n = int64_t(idx[last]) + (g.fluid[c][f] ? 1 : 0);
-    *run = n <= capacity ? n : 0;
+    *run = n;
     *total = double(n);
   });
 }
@@ -783,6 +783,16 @@ void grid_pcg_direction(ListCount n, CgGuard guard, const double* rz_new, const 
     if (!guard.active()) return;
     const double beta = *rz_new / *guard.rz;
     p[e] = z[e] + beta * p[e];
+  });
+}
+
+void grid_pcg_continue(double* rz, const double* rz_new, const double* bnorm, double tol2, const double* iterations,
+                       int max_it, uint32_t* go) {
+  // The iteration's r.z becomes the current one; another iteration while the test fails and the
+  // limit is not reached.
+  parallel_for(1, [=] WB_HD(int64_t) {
+    *rz = *rz_new;
+    *go = CgGuard{rz, bnorm, tol2}.active() && *iterations < double(max_it) ? 1u : 0u;
   });
 }
 

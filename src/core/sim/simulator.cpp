@@ -96,6 +96,7 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
   step_sums_ = DeviceBuffer<StepSums>(d, 1);
   step_sums_.fill_zero();
   transfer_->set_sums(&step_sums_.data()->transfer);
+  load_->set_change_sink(&step_sums_.data()->load_change);
   for (int c = 0; c < 3; ++c) {
     cells(bristle_v_[c]);
     raster_face_[c].set_device(d);
@@ -135,7 +136,7 @@ PaintCensus Simulator::census() {
   return PaintBooks::census(*load_, particles_, grid_->window().total_mass(ws_), transfer_->params(), ws_);
 }
 
-PaintCensus Simulator::record_census(TransferRecord& rec) {
+PaintCensus Simulator::record_census(TransferRecord& rec, bool step_end) {
   // The census's sums join the transfer's and the non-finite counts on the device; one copy
   // brings the step's record. Where the counts show non-finite values, they are contained and
   // the census taken again (a second read, on that path alone).
@@ -151,15 +152,19 @@ PaintCensus Simulator::record_census(TransferRecord& rec) {
     mem::copy_on_device(device(), d->canvas_sums, canvas_->mass_sums(), 2 * sizeof(double));
     mem::copy_on_device(device(), &d->gathered, win.gathered_sum(), sizeof(double));
     mem::copy_on_device(device(), &d->tiles_used, canvas_->tiles_used(), sizeof(int32_t));
-    mem::copy_on_device(device(), &d->advect, grid_->advect_plan(), sizeof(AdvectPlan));
+    grid_->record_into(&d->grid);
     StepSums r{};
     step_sums_.copy_to_host(&r, 1);
     step_sums_.fill_zero();
     canvas_->take_tiles_used(r.tiles_used);
-    grid_->take_advect_plan(r.advect);
+    grid_->take_record(r.grid);
     canvas_->take_mass_sums(r.canvas_sums);
     win.set_gathered_mass(r.gathered);
     if (take == 0) {
+      // The transfer's scan ends came with the record: the store is compacted and the new
+      // particles made now (none where something went non-finite: their paint stays put).
+      if (step_end) transfer_->finish(r.transfer, !nonfinite_found(r.nonfinite), rec);
+      books_.external(r.load_change);
       h = r;
       last_record_ = r;
       // Sub-steps the brush rolled back on the device (Brush::step) are non-finite events too.
@@ -177,21 +182,23 @@ PaintCensus Simulator::record_census(TransferRecord& rec) {
   return c;
 }
 
+// The brush's paint changes from outside the transfers: the kg it gains or loses come back with
+// the next step record, which enters them in the books (record_census).
 void Simulator::load_paint(const PaintLoad& paint) {
   entry_check_ = true;
-  books_.external(load_->fill(paint));
+  load_->fill(paint);
 }
 void Simulator::dip(const PaintLoad& paint) {
   entry_check_ = true;
-  books_.external(load_->dip(paint));
+  load_->dip(paint);
 }
 void Simulator::wipe(float fraction) {
   entry_check_ = true;
-  books_.external(-load_->wipe(fraction));
+  load_->wipe(fraction);
 }
 void Simulator::clean() {
   entry_check_ = true;
-  books_.external(-load_->clean());
+  load_->clean();
 }
 
 void Simulator::apply(const StrokeEvent& e) {
@@ -231,7 +238,7 @@ void Simulator::settle() {
     transfer_->update_distance(none, env);
     transfer_->particles_to_grid(particles_, env);
     particles_.compact(ws_);
-    books_.record(rec, record_census(rec));
+    books_.record(rec, record_census(rec, false));
   }
   grid_->window().flush();
 }
@@ -691,7 +698,6 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
     env.dt = dt;  // wicking along the bristles over this step
     // The device's sums include the particles deposited before the window moved.
     rec = transfer_->step(brush_->samples(), *load_, particles_, env);
-    counters_.particles_refused += rec.emission_dropped + rec.to_particles_dropped;
   }
 
   {
@@ -702,7 +708,8 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
     entry_check_ = false;
     queue_samples_box(step_sums_.data()->extent);
     if (resting) grid_->running_box_into(step_sums_.data()->running, kRunningPaint);
-    books_.record(rec, record_census(rec));
+    books_.record(rec, record_census(rec, true));
+    counters_.particles_refused += rec.emission_dropped + rec.to_particles_dropped;
     const float* m = last_record_.running;
     running_.reset();
     if (resting && m[0] >= -m[1] && m[2] >= -m[3]) running_ = std::array<float, 4>{-m[1], m[0], -m[3], m[2]};
@@ -890,11 +897,9 @@ bool Simulator::contain_nonfinite(const int64_t* counts) {
   // A non-finite value anywhere in the live state is zeroed (grid fields, velocities, the
   // brush's load: that paint is lost and the books show it) or removed (particles) before
   // anything renders or scatters it; the event is counted.
+  if (!nonfinite_found(counts)) return false;
   const auto arrays = checked_arrays();
   const size_t n = arrays.size();
-  int64_t bad = 0;
-  for (size_t i = 0; i < 2 * n; ++i) bad += counts[i];
-  if (!bad) return false;
   for (size_t i = 0; i + kNonfiniteParticleArrays < n; ++i)
     if (counts[i]) joint_zero_nonfinite(device(), arrays[i].first, arrays[i].second);
   int64_t particles_bad = 0;

@@ -2,6 +2,7 @@
 // stages called by name in the paper's order. The physics lives in the stage headers;
 // this file only sequences them, times them and keeps the books.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <functional>
 #include <memory>
@@ -120,7 +121,7 @@ class Simulator {
   /// brush waits at rest at `pose`, where the pause ends.
   void rest(double seconds, const BrushPose& pose);
 
-  // --- paint on the brush (books record what enters and leaves) ---
+  // --- paint on the brush (the books enter what it gains or loses with the next step record) ---
   void load_paint(const PaintLoad& paint);  ///< a freshly loaded brush
   void dip(const PaintLoad& paint);         ///< dip a dirty brush into a well
   void wipe(float fraction);
@@ -186,9 +187,11 @@ class Simulator {
   void brush_stage(const BrushPose* poses, int substeps, float dt);
   void particle_stage(float dt);
   void deposit_leaving_particles(Int3 next_origin);
-  /// The step's transfer sums added to rec and the census after it, from one read of step_sums_
-  /// (kept whole in last_record_).
-  PaintCensus record_census(TransferRecord& rec);
+  /// The step's transfer sums added to rec and the census, from one read of step_sums_ (kept
+  /// whole in last_record_). At a step's end (`step_end`) the read also ends the step's transfer
+  /// (Transfer::finish: the store compacted and the new particles made, after the census's sums
+  /// were queued: the paint they move is counted where it was).
+  PaintCensus record_census(TransferRecord& rec, bool step_end);
   void joint_fields_stage();
   /// The raster's listed cells (and faces, `faces`) back to zero: every raster field is then zero.
   void clear_raster(bool faces);
@@ -202,6 +205,10 @@ class Simulator {
   /// Zeroes (fields) or removes (particles) what the step record's counts show non-finite;
   /// true when there was any.
   bool contain_nonfinite(const int64_t* counts);
+  /// Whether the step record's counts show any non-finite value.
+  static bool nonfinite_found(const int64_t* counts) {
+    return std::any_of(counts, counts + 2 * kCheckedArrays, [](int64_t c) { return c != 0; });
+  }
   /// Every array of the live state the containment checks (device pointer, floats): the paint
   /// fields, 3 velocities, 5 load fields, then kNonfiniteParticleArrays particle fields.
   static constexpr size_t kNonfiniteParticleArrays = 8;
@@ -278,7 +285,8 @@ class Simulator {
     float extent[kExtentValues];  ///< the samples' box and the ground at the step's end (queue_samples_box)
     float running[4];             ///< the box of running paint, on a resting step (Grid::running_box_into)
     int32_t tiles_used;           ///< the canvas's slots in use (TileStore::tiles_used)
-    AdvectPlan advect;            ///< the grid's advection plan (Grid::take_advect_plan)
+    GridRecord grid;              ///< the grid's plan and solve figures (Grid::take_record)
+    double load_change;           ///< kg the brush's paint gained from outside (BristleLoad's sink)
   };
   DeviceBuffer<StepSums> step_sums_;
   StepSums last_record_{};            ///< the last read of step_sums_

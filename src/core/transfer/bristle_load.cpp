@@ -33,6 +33,9 @@ BristleLoad::BristleLoad(const Device& device, int64_t samples, const TransferPa
   WB_BRISTLE_LOAD_FIELDS(WB_X)
 #undef WB_X
   scratch_.set_device(device);
+  change_.set_device(device);
+  change_.resize(1);
+  change_.fill_zero();
   ws_ = Workspace(device);
   scratch_.resize(size_t(samples));
   BristleLoadHost h;
@@ -55,17 +58,17 @@ BristleLoadView BristleLoad::view() {
   return v;
 }
 
-double BristleLoad::fill(const PaintLoad& paint) { return load(paint, true, "BristleLoad::fill"); }
+void BristleLoad::fill(const PaintLoad& paint) { load(paint, true, "BristleLoad::fill"); }
 
-double BristleLoad::dip(const PaintLoad& paint) { return load(paint, false, "BristleLoad::dip"); }
+void BristleLoad::dip(const PaintLoad& paint) { load(paint, false, "BristleLoad::dip"); }
 
-double BristleLoad::load(const PaintLoad& paint, bool replace, const char* what) {
+void BristleLoad::load(const PaintLoad& paint, bool replace, const char* what) {
   validate(paint, what);
-  if (count_ == 0) return 0.0;
+  if (count_ == 0) return;
   transfer_load_dip(device_, view(), exchange_.empty() ? nullptr : exchange_.data(),
                     Vec3(paint.ryb[0], paint.ryb[1], paint.ryb[2]), paint.oil, paint.load, replace ? 1 : 0,
                     scratch_.data());
-  return reduce_sum(device_, scratch_.data(), count_, ws_);
+  reduce_sum_add_into(device_, scratch_.data(), count_, sink(), ws_);
 }
 
 void BristleLoad::set_dip_exchange(const std::vector<float>& x) {
@@ -76,19 +79,26 @@ void BristleLoad::set_dip_exchange(const std::vector<float>& x) {
   exchange_.copy_from_host(x.data(), x.size());
 }
 
-double BristleLoad::wipe(float fraction) {
+void BristleLoad::wipe(float fraction) {
   WB_REQUIRE(std::isfinite(fraction) && fraction >= 0.f && fraction <= 1.f,
              "BristleLoad::wipe: the fraction must lie in [0, 1], got " + std::to_string(fraction));
-  if (count_ == 0) return 0.0;
+  if (count_ == 0) return;
   transfer_load_scale(device_, view(), 1.f - fraction, scratch_.data());
-  return reduce_sum(device_, scratch_.data(), count_, ws_);
+  reduce_sum_add_into(device_, scratch_.data(), count_, sink(), ws_);
 }
 
-double BristleLoad::clean() {
-  if (count_ == 0) return 0.0;
+void BristleLoad::clean() {
+  if (count_ == 0) return;
   // A fill with nothing: no load, no pigment (white), no oil.
   transfer_load_dip(device_, view(), nullptr, Vec3(0.f, 0.f, 0.f), 0.f, 0.f, 1, scratch_.data());
-  return -reduce_sum(device_, scratch_.data(), count_, ws_);
+  reduce_sum_add_into(device_, scratch_.data(), count_, sink(), ws_);
+}
+
+double BristleLoad::take_change() {
+  double kg = 0.0;
+  change_.copy_to_host(&kg, 1);
+  change_.fill_zero();
+  return kg;
 }
 
 double BristleLoad::total_mass(Workspace& ws) const { return reduce_sum(device_, m.data(), count_, ws); }

@@ -54,22 +54,31 @@ class BristleLoad {
   int64_t size() const { return count_; }
   BristleLoadView view();
 
+  // Loading, dipping, wiping and cleaning add the net kg the brush gains (negative where it
+  // loses) to a double in device memory, with no host read: the load's own, read by
+  // take_change(), or the caller's (set_change_sink: the simulator's step record, read with it).
+
   /// A fresh brush loaded with `paint`: m_j = paint.load * M'_j (the potential capacity of
   /// Eq. 12 from the last transfer step, M_max before it), colour paint.ryb, oil paint.oil.
-  /// Returns the net change of the brush's paint, kg (what entered minus what it replaced).
-  double fill(const PaintLoad& paint);
+  /// The change is what entered minus what it replaced.
+  void fill(const PaintLoad& paint);
   /// Dips the brush into a well of `paint` (dirty brush): the well's paint replaces the share
   /// x_j (set_dip_exchange) of each sample's paint, then tops the sample up to paint.load * M'_j;
   /// the old and the new paint mix (Algorithm 2 by mass, oil by mass). The replaced paint stays
-  /// in the well. Returns the net kg the brush gained.
-  double dip(const PaintLoad& paint);
+  /// in the well.
+  void dip(const PaintLoad& paint);
   /// The share x_j in [0, 1] of each sample's paint a dip replaces (dip_exposure times
   /// TransferParams::dip_exchange); size() values. Until set, a dip only tops up.
   void set_dip_exchange(const std::vector<float>& x);
-  /// Wipes the brush on a rag: removes `fraction` (in [0, 1]) of every sample's load. Returns the kg removed.
-  double wipe(float fraction);
-  /// Cleans the brush in solvent: no load, no pigment, no oil. Returns the kg removed.
-  double clean();
+  /// Wipes the brush on a rag: removes `fraction` (in [0, 1]) of every sample's load.
+  void wipe(float fraction);
+  /// Cleans the brush in solvent: no load, no pigment, no oil.
+  void clean();
+  /// Where the changes go: a double on this device that the caller reads (and zeroes) with its
+  /// own record; nullptr: the load's own.
+  void set_change_sink(double* device_kg) { sink_ = device_kg; }
+  /// Reads and zeroes the load's own sum of changes since the last take, kg (a host read).
+  double take_change();
 
   /// Sum of the loads, kg (double).
   double total_mass(Workspace& ws) const;
@@ -96,13 +105,16 @@ class BristleLoad {
   /// mean_color and mean_oil of a load of w kg (total_mass).
   Vec3 mean_color(double w, Workspace& ws);
   float mean_oil(double w, Workspace& ws);
-  /// fill (replace) and dip (top up and mix) in one pass: the kg added.
-  double load(const PaintLoad& paint, bool replace, const char* what);
+  /// fill (replace) and dip (top up and mix) in one pass.
+  void load(const PaintLoad& paint, bool replace, const char* what);
+  double* sink() { return sink_ ? sink_ : change_.data(); }
   Device device_;
   int64_t count_ = 0;
   DeviceBuffer<float> scratch_;
   DeviceBuffer<float> exchange_;  ///< x_j of dip(); empty: a dip only tops up
   Workspace ws_;  ///< reduction scratch of fill / dip / wipe / clean, kept between calls
+  DeviceBuffer<double> change_;  ///< the load's own sum of changes (take_change)
+  double* sink_ = nullptr;       ///< the caller's, where set
 };
 
 }  // namespace wb

@@ -47,7 +47,9 @@ class PaintBooks {
 
   /// Opens the books on a census: its total is the initial total; clears the history.
   void open(const PaintCensus& start);
-  /// Paint entering (+) or leaving (-) from outside the transfers (fill, dip, wipe, clean), kg.
+  /// Paint entering (+) or leaving (-) from outside the transfers (fill, dip, wipe, clean), kg;
+  /// counted in the next record (the simulator enters the brush's with the step record that
+  /// brings it back from the device).
   void external(double kg);
   /// Records one step's transfers and the census after the step; returns its drift.
   double record(const TransferRecord& rec, const PaintCensus& after);

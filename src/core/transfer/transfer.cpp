@@ -102,7 +102,6 @@ Transfer::Transfer(const Device& device, const TransferParams& params)
   p_moved_.set_device(device);
   room_count_.set_device(device);
   room_offset_.set_device(device);
-  room_ends_ = DeviceBuffer<uint32_t>(device, 3);
   passes_.set_device(device);
   occ_.set_device(device);
   d2_.set_device(device);
@@ -159,7 +158,7 @@ TransferRecord Transfer::step(const SampleView& samples, BristleLoad& load, Part
     WB_PROFILE_SCOPE("transfer.to_grid");
     particles_to_grid(particles, env);
   }
-  make_particles(&samples, &load, particles, env, /*compact=*/true, /*candidates=*/true, rec);
+  plan_particles(&samples, &load, particles, env, /*compact=*/true, /*candidates=*/true);
   ++step_index_;
   return rec;
 }
@@ -169,6 +168,7 @@ void Transfer::collect(TransferRecord& rec) {
   TransferSums s{};
   sums_.copy_to_host(&s, 1);
   sums_.fill_zero();
+  finish(s, true, rec);
   add_sums(s, double(params_.cell_mass()), rec);
 }
 
@@ -369,6 +369,16 @@ void Transfer::grid_to_particles(ParticleStore& particles, const TransferEnv& en
 
 void Transfer::make_particles(const SampleView* samples, BristleLoad* load, ParticleStore& particles,
                               const TransferEnv& env, bool compact, bool candidates, TransferRecord& rec) {
+  plan_particles(samples, load, particles, env, compact, candidates);
+  if (!planned_) return;
+  uint32_t ends[3];
+  mem::copy_to_host(device_, ends, sums_ptr_->room_ends, sizeof(ends));  // a stage called alone: its own read
+  finish_particles(ends, true, rec);
+}
+
+void Transfer::plan_particles(const SampleView* samples, BristleLoad* load, ParticleStore& particles,
+                              const TransferEnv& env, bool compact, bool candidates) {
+  planned_.reset();  // one left by an exception before its finish moved nothing
   const int64_t nk = compact ? particles.size() : 0;
   const int64_t ns = samples ? samples->count() : 0;
   if (samples)
@@ -383,60 +393,76 @@ void Transfer::make_particles(const SampleView* samples, BristleLoad* load, Part
   const int64_t nc = candidates ? env.paint.size() : 0;
   const int64_t n = nk + ns + nc;
   if (n == 0) return;
+  WB_PROFILE_SCOPE("transfer.room");
+  room_count_.resize(size_t(n));
+  room_offset_.resize(size_t(n));
+  uint32_t* count = room_count_.data();
+  uint32_t* offset = room_offset_.data();
+  if (nk > 0) particles_keep_flags(device_, particles.dead.data(), particles.m.data(), count, nk);
+  if (ns > 0) {
+    ensure_samples(ns);
+    const EmitScratch e = emit_scratch();
+    transfer_emit_count(device_, *samples, load->view(), params_, env.dt, count + nk, e.mass_each, e.swept_each,
+                        e.swept_n);
+  }
+  if (nc > 0) {
+    ensure_cells(nc);
+    transfer_grid_count(device_, env.paint, db, env.keep, params_, env.dry_threshold, count + nk + ns);
+  }
+  exclusive_scan_into(device_, count, offset, n, ws_);
+  // The three ends go into the record's sums: they come back with them (the simulator's step
+  // record, or collect), and finish_particles sizes the store by them.
+  transfer_room_ends(device_, count, offset, n, nk, nk + ns, sums_ptr_->room_ends);
+  planned_ = Planned{samples ? *samples : SampleView{}, load, &particles, env, nk, ns, step_index_, compact, candidates};
+}
+
+void Transfer::finish(const TransferSums& s, bool create, TransferRecord& rec) {
+  if (planned_) finish_particles(s.room_ends, create, rec);
+}
+
+void Transfer::finish_particles(const uint32_t ends[3], bool create, TransferRecord& rec) {
+  const Planned pl = *planned_;
+  planned_.reset();
+  ParticleStore& particles = *pl.particles;
+  const int64_t nk = pl.nk, ns = pl.ns;
+  uint32_t* count = room_count_.data();
+  uint32_t* offset = room_offset_.data();
   NewBatch emission{}, cells{};
   {
     WB_PROFILE_SCOPE("transfer.room");
-    room_count_.resize(size_t(n));
-    room_offset_.resize(size_t(n));
-    uint32_t* count = room_count_.data();
-    uint32_t* offset = room_offset_.data();
-    if (nk > 0) particles_keep_flags(device_, particles.dead.data(), particles.m.data(), count, nk);
-    if (ns > 0) {
-      ensure_samples(ns);
-      const EmitScratch e = emit_scratch();
-      transfer_emit_count(device_, *samples, load->view(), params_, env.dt, count + nk, e.mass_each, e.swept_each,
-                          e.swept_n);
-    }
-    if (nc > 0) {
-      ensure_cells(nc);
-      transfer_grid_count(device_, env.paint, db, env.keep, params_, env.dry_threshold, count + nk + ns);
-    }
-    exclusive_scan_into(device_, count, offset, n, ws_);
-    transfer_room_ends(device_, count, offset, n, nk, nk + ns, room_ends_.data());
-    uint32_t ends[3];
-    room_ends_.copy_to_host(ends, 3);  // the step's one wait of the transfer
-    const int64_t kept = compact ? int64_t(ends[0]) : particles.size();
+    const int64_t kept = pl.compact ? int64_t(ends[0]) : particles.size();
     if (kept < nk) particles.remove_dead(offset, kept);
+    if (!create) return;  // the counts stay where they were: the next step makes them
     const int64_t want_emitted = int64_t(ends[1]) - int64_t(ends[0]), want_cells = int64_t(ends[2]) - int64_t(ends[1]);
     int64_t room = std::max<int64_t>(particles.limit() - kept, 0);
     const int64_t n_emitted = std::min(want_emitted, room);
     room -= n_emitted;
     const int64_t n_cells = std::min(want_cells, room);
-    if (samples) rec.emission_dropped = want_emitted - n_emitted;
-    if (candidates) rec.to_particles_dropped = want_cells - n_cells;
+    if (ns > 0) rec.emission_dropped = want_emitted - n_emitted;
+    if (pl.candidates) rec.to_particles_dropped = want_cells - n_cells;
     const int64_t first = n_emitted + n_cells > 0 ? particles.append_uninitialised(n_emitted + n_cells) : kept;
     emission = NewBatch{count + nk, offset + nk, int64_t(ends[0]), first, n_emitted};
     cells = NewBatch{count + nk + ns, offset + nk + ns, int64_t(ends[1]), first + n_emitted, n_cells};
   }
   if (emission.n > 0) {
     WB_PROFILE_SCOPE("transfer.emit");
-    fill_emission(*samples, *load, particles, env, emission);
+    fill_emission(pl.samples, *pl.load, particles, pl.env, emission, pl.step);
     rec.emitted_count = emission.n;
   }
   if (cells.n > 0) {
     WB_PROFILE_SCOPE("transfer.to_particles");
-    fill_candidates(particles, env, cells);
+    fill_candidates(particles, pl.env, cells);
     rec.to_particles_count = cells.n;
   }
 }
 
 void Transfer::fill_emission(const SampleView& samples, BristleLoad& load, ParticleStore& particles,
-                             const TransferEnv& env, const NewBatch& batch) {
+                             const TransferEnv& env, const NewBatch& batch, int64_t step) {
   const int64_t ns = samples.count();
   const ParticleView pv = particles.view();
   const EmitScratch e = emit_scratch();
   float* emitted = e.emitted;
-  transfer_emit_fill(device_, samples, load.view(), pv, batch, e.mass_each, e.swept_each, e.swept_n, step_index_,
+  transfer_emit_fill(device_, samples, load.view(), pv, batch, e.mass_each, e.swept_each, e.swept_n, step,
                      params_, env.floor_z, env.dt, env.paint, env.dry_threshold, emitted);
   reduce_sum_add_into(device_, emitted, ns, sum_field(&TransferSums::emitted_from_bristles), ws_);
   reduce_sum_add_into(device_, pv.m + batch.first, batch.n, sum_field(&TransferSums::emitted_into_particles), ws_);

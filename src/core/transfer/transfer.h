@@ -1,11 +1,13 @@
 // Liquid transfer stage (paper §5, Eq. 12-16; DESIGN step 8). Transfer::step runs, in order:
 //   update_capacity (Eq. 12-13) -> absorb (Eq. 14, colour bleeding) -> update_distance ->
 //   particles_to_grid (Eq. 16) -> compact -> emit (§5.1) -> grid_to_particles (Eq. 15)
-// (the last three sized by one scan and one host read, make_particles)
+// (the last three sized by one scan whose three ends come back with the record's sums, and made
+// by finish once they have)
 // and returns what each transfer moved (TransferRecord; PaintBooks keeps the budget).
 // The stage functions validate their input and dispatch to wb::cpu or wb::cuda (transfer_impl.h).
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "core/brush/bristle_fields.h"
@@ -96,6 +98,9 @@ struct TransferSums {
   int32_t absorb_counts[2];  ///< absorbed, bleeding (AbsorbScratch::counters)
   int32_t to_grid_count;     ///< DepositScratch::counter of the step's passes ...
   int32_t to_grid_at_moves;  ///< ... and of a window move's (only_leaving)
+  /// The new particles' scan's three ends (survivors; and the emission; and Eq. 15's candidates):
+  /// the counts the store is sized by (Transfer::finish).
+  uint32_t room_ends[3];
 };
 
 /// Scratch of the absorption pass, per sample (accumulators) and per particle (moved mass).
@@ -167,14 +172,22 @@ class Transfer {
   const TransferParams& params() const { return params_; }
   int64_t steps() const { return step_index_; }
 
-  /// One transfer step (§5): every stage below in order; the compaction of the particle store
-  /// and the room of the emission and of Eq. 15 come from one scan and one host read. The particles' `nearest` must come from SampleGrid::query_nearest on these
-  /// samples this step (the absorption candidate; the distance is re-measured here). The
-  /// record holds what the host knows (new particles, drops); the device's sums and counts
-  /// join it in collect().
+  /// One transfer step (§5): every stage below in order, queued without a host read. The
+  /// compaction of the particle store and the room of the emission and of Eq. 15 come from one
+  /// scan, whose ends go into the sums (TransferSums::room_ends); the store is compacted and the
+  /// new particles made by finish() once the sums are read (the caller's record, or collect()).
+  /// The particles' `nearest` must come from SampleGrid::query_nearest on these samples this
+  /// step (the absorption candidate; the distance is re-measured here).
   TransferRecord step(const SampleView& samples, BristleLoad& load, ParticleStore& particles, const TransferEnv& env);
-  /// Adds the sums and counts the device accumulated since the last collect (every stage call's)
-  /// into rec, in one host read, and starts the next accumulation.
+  /// Ends the last step() with the sums that came back: removes the dead particles and, where
+  /// `create`, makes the new ones (as many as the store's limit allows, emission first; the rest
+  /// counted as dropped in rec). Without `create` the paint they would take stays where it is
+  /// (the next step makes them): the simulator's step that found non-finite values. The new
+  /// particles' sums go into the device's accumulation after the read: they come back with the
+  /// next record. Nothing to do where no step is waiting.
+  void finish(const TransferSums& s, bool create, TransferRecord& rec);
+  /// Reads the sums and counts the device accumulated since the last collect (every stage call's)
+  /// in one host read, ends the last step() with them (finish) and adds them into rec.
   void collect(TransferRecord& rec);
   /// Where the stages accumulate their sums: a TransferSums on this device that the caller
   /// reads with more of its own in one copy (the simulator's step record), then passes to
@@ -224,8 +237,23 @@ class Transfer {
   /// in index order); the rest are counted as dropped in rec.
   void make_particles(const SampleView* samples, BristleLoad* load, ParticleStore& particles, const TransferEnv& env,
                       bool compact, bool candidates, TransferRecord& rec);
+  /// make_particles up to the scan's ends (queued into the sums); finish_particles the rest.
+  void plan_particles(const SampleView* samples, BristleLoad* load, ParticleStore& particles, const TransferEnv& env,
+                      bool compact, bool candidates);
+  void finish_particles(const uint32_t ends[3], bool create, TransferRecord& rec);
+  /// What plan_particles queued, for finish_particles.
+  struct Planned {
+    SampleView samples;
+    BristleLoad* load;
+    ParticleStore* particles;
+    TransferEnv env;
+    int64_t nk, ns;  ///< the survivors' and the emission's sources
+    int64_t step;    ///< the step index the emission's random draws use
+    bool compact, candidates;
+  };
+  std::optional<Planned> planned_;
   void fill_emission(const SampleView& samples, BristleLoad& load, ParticleStore& particles, const TransferEnv& env,
-                     const NewBatch& batch);
+                     const NewBatch& batch, int64_t step);
   /// The emission's per-sample scratch, written by its count and read by its fill.
   struct EmitScratch {
     float* mass_each;
@@ -251,8 +279,8 @@ class Transfer {
   LaunchGraph wick_graph_;  ///< the wick's passes, recorded (CUDA)
   // Per particle.
   DeviceBuffer<float> p_moved_;
-  // make_particles: the counts, their scan, and its three prefix ends.
-  DeviceBuffer<uint32_t> room_count_, room_offset_, room_ends_;
+  // make_particles: the counts and their scan (its ends go into the sums).
+  DeviceBuffer<uint32_t> room_count_, room_offset_;
   // Per cell.
   DeviceBuffer<float> c_f32_[7];
   // Eq. 16's deposit (DepositScratch): its sums, zero between passes, the cells listed and
@@ -320,7 +348,7 @@ class Transfer {
   X(void, transfer_load_brightness, (BristleLoadView load, float* out), (load, out))                                 \
   X(void, transfer_load_dip, (BristleLoadView load, const float* exchange, Vec3 ryb, float oil, float level,         \
       int replace, float* added), (load, exchange, ryb, oil, level, replace, added))                                 \
-  X(void, transfer_load_scale, (BristleLoadView load, float keep, float* removed), (load, keep, removed))
+  X(void, transfer_load_scale, (BristleLoadView load, float keep, float* change), (load, keep, change))
 WB_DECLARE_KERNELS(WB_TRANSFER_KERNELS)
 
 }  // namespace wb

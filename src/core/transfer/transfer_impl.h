@@ -213,7 +213,10 @@ void transfer_absorb(ParticleView p, SampleView s, BristleLoadView load, AbsorbS
           return;
         const float before = atomic_add(&a.claimed[j], mk);
         if (mj + before < Mj) {
+          // Dead and weightless: the census, taken before the step's compaction, counts its
+          // paint in the bristles only.
           p.dead[k] = 1u;
+          p.m[k] = 0.f;
           a.moved[k] = mk;
           atomic_add(&a.acc_m[j], mk);
           atomic_add(&a.acc_c[0][j], mk * ck.x);
@@ -339,13 +342,11 @@ void transfer_to_grid_mark(ParticleView p, PaintWindowView pw, DistanceBlocks db
       acc.cells.touch(id);
     });
     if (cells > 0) {
-      // A window move's pass leaves the particle weightless, in place, to the step's compaction
-      // (no count read back at the move; the sort after it moves the state, not the dead flags);
-      // the step's own pass marks it dead.
-      if (acc.only_leaving)
-        p.m[k] = 0.f;
-      else
-        p.dead[k] = 1u;
+      // The particle is left weightless, in place, to the step's compaction (the census, taken
+      // before it, counts its paint in the grid only); a window move's pass marks nothing more
+      // (the sort after it moves the state, not the dead flags), the step's own pass marks it dead.
+      p.m[k] = 0.f;
+      if (!acc.only_leaving) p.dead[k] = 1u;
       acc.moved[k] = mk;
       atomic_add(acc.counter, int32_t(1));
     }
@@ -611,12 +612,12 @@ void transfer_load_dip(BristleLoadView load, const float* exchange, Vec3 ryb, fl
   });
 }
 
-void transfer_load_scale(BristleLoadView load, float keep, float* removed) {
+void transfer_load_scale(BristleLoadView load, float keep, float* change) {
   parallel_for(load.count, [=] WB_HD(int64_t j) {
     const float m = load.m[j];
     const float m_new = m * keep;
     load.m[j] = m_new;
-    removed[j] = m - m_new;
+    change[j] = m_new - m;
   });
 }
 
