@@ -254,6 +254,33 @@ TEST_F(AlgorithmsTest, LaunchGraphReplaysItsLaunchesAndRecordsAgainForANewKey) {
   EXPECT_EQ(sums[1], sums[0]);
 }
 
+TEST_F(AlgorithmsTest, LaunchLoopRunsItsBodyUntilTheFlagStopsItWithoutAHostRead) {
+  // A body that visits every element and counts down: it runs as many times as the count says,
+  // whichever backend, and once recorded (CUDA: a conditional while node) the host reads nothing.
+  const int64_t n = 50000;
+  DeviceBuffer<int32_t> hits(device_, n);
+  hits.fill_zero();
+  DeviceBuffer<int64_t> left(device_, 1);
+  DeviceBuffer<uint32_t> go(device_, 1);
+  LaunchLoop loop;
+  const uint64_t key = launch_key({launch_key_of(hits.data()), launch_key_of(left.data())});
+  int64_t expect = 0;
+  for (const int64_t passes : {int64_t(3), int64_t(7), int64_t(1), int64_t(12)}) {
+    left.copy_from_host(&passes, 1);
+    const int64_t reads = mem::host_reads();
+    loop.run(device_, key, go.data(), [&] {
+      selftest_count_visits(device_, hits.data(), n);
+      selftest_count_down(device_, left.data(), go.data());
+    });
+    const int64_t made = mem::host_reads() - reads;
+    expect += passes;
+    if (device_.is_cpu() || expect > 3) EXPECT_EQ(made, 0) << passes << " passes";  // CUDA's first run reads
+    const std::vector<int32_t> h = hits.to_host();
+    for (int64_t i = 0; i < n; i += 997) ASSERT_EQ(h[size_t(i)], expect) << i << " after " << passes << " passes";
+    EXPECT_EQ(left.to_host()[0], 0);
+  }
+}
+
 TEST(DeviceTest, ParseAndPrint) {
   EXPECT_EQ(Device::parse("cpu").to_string(), "cpu");
   EXPECT_TRUE(Device::parse("cpu") == Device(DeviceType::CPU));

@@ -18,6 +18,7 @@ std::string selftest_run(const Device& d);
   X(void, selftest_atomic_contention, (float* acc4, int32_t* iacc2, int64_t n), (acc4, iacc2, n))               \
   X(void, selftest_count_visits, (int32_t* hits, int64_t n), (hits, n))                                         \
   X(void, selftest_sum_squares, (const int64_t* count, int64_t capacity, double* x, double* out, SumScratch s), \
-      (count, capacity, x, out, s))
+      (count, capacity, x, out, s))                                                                             \
+  X(void, selftest_count_down, (int64_t * left, uint32_t* go), (left, go))
 WB_DECLARE_KERNELS(WB_SELFTEST_KERNELS)
 }  // namespace wb

@@ -31,4 +31,12 @@ void selftest_sum_squares(const int64_t* count, int64_t capacity, double* x, dou
       out, s);
 }
 
+/// One thread: *left -= 1, and *go = 1 while some are left (a LaunchLoop's flag).
+void selftest_count_down(int64_t* left, uint32_t* go) {
+  parallel_for(1, [=] WB_HD(int64_t) {
+    *left -= 1;
+    *go = *left > 0 ? 1u : 0u;
+  });
+}
+
 }  // namespace wb::WB_BACKEND_NS

@@ -194,7 +194,7 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   visc_flag_.fill_zero();  // then written over each step's extent: outside it no face is fluid
   cg_nb_.set_device(d);
   cg_nu_.set_device(d);
-  for (auto* b : {&cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_}) b->set_device(d);
+  for (auto* b : {&cg_x_, &cg_r_, &cg_p_, &cg_q_, &cg_diag_}) b->set_device(d);
   cg_sums_.set_device(d);
   cg_sums_.resize(6);
   cg_go_.set_device(d);
@@ -419,7 +419,7 @@ void Grid::apply_viscosity(float dt) {
   if (cg_x_.size() != size_t(all)) {
     cg_nb_.resize(6 * size_t(all));
     cg_nu_.resize(size_t(all));
-    for (auto* b : {&cg_x_, &cg_b_, &cg_r_, &cg_z_, &cg_p_, &cg_q_, &cg_diag_}) b->resize(size_t(all));
+    for (auto* b : {&cg_x_, &cg_r_, &cg_p_, &cg_q_, &cg_diag_}) b->resize(size_t(all));
   }
   // Jacobi-preconditioned conjugate gradients (Saad 2003, Alg. 9.1) from the current velocity.
   // alpha, beta and the test of convergence are formed on the device from sums kept there
@@ -434,13 +434,12 @@ void Grid::apply_viscosity(float dt) {
   const ListCount n{cg_count_.data(), all};
   grid_viscous_count(d, v, idx, cg_count_.data(), sums + 5);
   grid_viscous_setup(d, v, list, n, idx, mu_.data(), nu_scale, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(),
-                     cg_b_.data(), cg_x_.data());
-  // A x into q (its p.Ap lands in slot 2, which the first iteration writes again), then r, z,
-  // p, r.z and b.D^-1 b.
+                     cg_r_.data(), cg_x_.data());
+  // The right-hand side b goes into r; A x into q (its p.Ap lands in slot 2, which the first
+  // iteration writes again), then b.D^-1 b, r = b - A x, p = D^-1 r and r.z.
   grid_viscous_apply(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_x_.data(), cg_q_.data(), sums + 2, {},
                      sum);
-  grid_pcg_start(d, n, cg_b_.data(), cg_q_.data(), cg_diag_.data(), cg_r_.data(), cg_z_.data(), cg_p_.data(),
-                 sums + 0, sums + 3, sum);
+  grid_pcg_start(d, n, cg_r_.data(), cg_q_.data(), cg_diag_.data(), cg_p_.data(), sums + 0, sums + 3, sum);
   // An iteration: p.Ap, the update (r.z into slot 1), the direction, and the test, which moves
   // r.z to slot 0 and sets the loop's flag. Every pass also tests (CgGuard), so that a solve that
   // starts converged moves nothing in its one pass.
@@ -452,8 +451,8 @@ void Grid::apply_viscosity(float dt) {
     grid_viscous_apply(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_p_.data(), cg_q_.data(), sums + 2,
                        guard, sum);
     grid_pcg_update(d, n, guard, sums + 2, cg_p_.data(), cg_q_.data(), cg_diag_.data(), cg_x_.data(), cg_r_.data(),
-                    cg_z_.data(), sums + 1, sums + 4, sum);
-    grid_pcg_direction(d, n, guard, sums + 1, cg_z_.data(), cg_p_.data());
+                    sums + 1, sums + 4, sum);
+    grid_pcg_direction(d, n, guard, sums + 1, cg_r_.data(), cg_diag_.data(), cg_p_.data());
     grid_pcg_continue(d, sums + 0, sums + 1, sums + 3, tol2, sums + 4, max_it, cg_go_.data());
   });
   grid_viscous_write(d, v, list, n, cg_x_.data());

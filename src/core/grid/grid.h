@@ -166,16 +166,17 @@ class Grid {
   DeviceBuffer<uint8_t> cls_, fluid_[3];
   DeviceBuffer<float> pressure_, rhs_, cell_tmp_, face_tmp_, mu_;
   // Viscous solve: fluid faces as a compact list (idx maps a global face to its entry), and
-  // the conjugate-gradient vectors over the list. Sized to every face once.
-  // Per entry: nu dt, the six neighbour entries, and the CG vectors; they grow with the paint
-  // (never per step in a steady stroke) and keep their capacity.
+  // the conjugate-gradient vectors over the list. Sized to every face of the window once.
+  // Per entry: nu dt, the six neighbour entries, and the CG vectors (68 bytes: the solve's
+  // vectors hold every face, so that no count comes back before it; z = D^-1 r is not kept, and
+  // b is formed in r).
   // visc_flag_: 1 at a fluid face, written over each step's extent only (faces outside it are
   // no longer fluid since the step that last visited them, as for the fluid flags themselves).
   DeviceBuffer<uint32_t> visc_flag_, visc_idx_, visc_list_;
   DeviceBuffer<int32_t> cg_nb_;
   DeviceBuffer<float> cg_nu_;
-  /// The viscous CG's vectors and matrix diagonal, in double (viscous_apply says why).
-  DeviceBuffer<double> cg_x_, cg_b_, cg_r_, cg_z_, cg_p_, cg_q_, cg_diag_;
+  /// The viscous CG's x, r, p, q = A p and the matrix's diagonal, in double (viscous_apply says why).
+  DeviceBuffer<double> cg_x_, cg_r_, cg_p_, cg_q_, cg_diag_;
   /// The CG's scalars on the device: r.z of the current and the next iteration, p.Ap, b.D^-1 b,
   /// the iterations made, the fluid faces counted (they come back with the step's record).
   DeviceBuffer<double> cg_sums_;
@@ -289,15 +290,15 @@ class Grid {
      CgGuard guard, SumScratch s),                                                                                     \
     (n, nu, nb, diag, p, q, pq, guard, s))                                                                             \
   X(void, grid_pcg_start,                                                                                              \
-    (ListCount n, const double* b, const double* ax, const double* diag, double* r, double* z, double* p, double* rz,  \
-     double* bz, SumScratch s),                                                                                        \
-    (n, b, ax, diag, r, z, p, rz, bz, s))                                                                              \
+    (ListCount n, double* r, const double* ax, const double* diag, double* p, double* rz, double* bz, SumScratch s),   \
+    (n, r, ax, diag, p, rz, bz, s))                                                                                    \
   X(void, grid_pcg_update,                                                                                             \
     (ListCount n, CgGuard guard, const double* pq, const double* p, const double* q, const double* diag, double* x,    \
-     double* r, double* z, double* rz, double* iterations, SumScratch s),                                              \
-    (n, guard, pq, p, q, diag, x, r, z, rz, iterations, s))                                                            \
-  X(void, grid_pcg_direction, (ListCount n, CgGuard guard, const double* rz_new, const double* z, double* p),          \
-    (n, guard, rz_new, z, p))                                                                                          \
+     double* r, double* rz, double* iterations, SumScratch s),                                                         \
+    (n, guard, pq, p, q, diag, x, r, rz, iterations, s))                                                               \
+  X(void, grid_pcg_direction,                                                                                          \
+    (ListCount n, CgGuard guard, const double* rz_new, const double* r, const double* diag, double* p),                \
+    (n, guard, rz_new, r, diag, p))                                                                                    \
   X(void, grid_pcg_continue,                                                                                           \
     (double* rz, const double* rz_new, const double* bnorm, double tol2, const double* iterations, int max_it,         \
      uint32_t* go),                                                                                                    \

@@ -739,23 +739,23 @@ void grid_viscous_apply(ListCount n, const float* nu, const int32_t* nb, const d
       pq, s);
 }
 
-void grid_pcg_start(ListCount n, const double* b, const double* ax, const double* diag, double* r, double* z,
-                    double* p, double* rz, double* bz, SumScratch s) {
+void grid_pcg_start(ListCount n, double* r, const double* ax, const double* diag, double* p, double* rz, double* bz,
+                    SumScratch s) {
+  // r holds b (grid_viscous_setup): b.D^-1 b first, then r = b - A x, z = D^-1 r (not kept: the
+  // passes that need it divide again) and p = z.
+  parallel_sum_count(n.n, n.capacity, [=] WB_HD(int64_t e) { return r[e] * r[e] / diag[e]; }, bz, s);
   parallel_sum_count(
       n.n, n.capacity,
       [=] WB_HD(int64_t e) {
-        r[e] = b[e] - ax[e];
-        z[e] = r[e] / diag[e];
-        p[e] = z[e];
-        return r[e] * z[e];
+        r[e] -= ax[e];
+        p[e] = r[e] / diag[e];
+        return r[e] * p[e];
       },
       rz, s);
-  parallel_sum_count(n.n, n.capacity, [=] WB_HD(int64_t e) { return b[e] * b[e] / diag[e]; }, bz, s);
 }
 
 void grid_pcg_update(ListCount n, CgGuard guard, const double* pq, const double* p, const double* q,
-                     const double* diag, double* x, double* r, double* z, double* rz, double* iterations,
-                     SumScratch s) {
+                     const double* diag, double* x, double* r, double* rz, double* iterations, SumScratch s) {
   if (detail::cpu_past_convergence(guard)) {
     *rz = *guard.rz;  // as the pass would sum it (to rounding)
     return;
@@ -764,25 +764,25 @@ void grid_pcg_update(ListCount n, CgGuard guard, const double* pq, const double*
       n.n, n.capacity,
       [=] WB_HD(int64_t e) {
         // Past convergence nothing moves, and the sum is the last r.z again (to rounding).
-        if (!guard.active()) return r[e] * z[e];
+        if (!guard.active()) return r[e] * r[e] / diag[e];
         if (e == 0) *iterations += 1.0;
         // alpha = (r.z) / (p.Ap) from the device sums; 0 (no step) where p.Ap is not positive,
         // which an SPD system reaches only by round-off at convergence.
         const double alpha = *pq > 0.0 ? *guard.rz / *pq : 0.0;
         x[e] += alpha * p[e];
         r[e] -= alpha * q[e];
-        z[e] = r[e] / diag[e];
-        return r[e] * z[e];
+        return r[e] * r[e] / diag[e];  // r.z with z = D^-1 r
       },
       rz, s);
 }
 
-void grid_pcg_direction(ListCount n, CgGuard guard, const double* rz_new, const double* z, double* p) {
+void grid_pcg_direction(ListCount n, CgGuard guard, const double* rz_new, const double* r, const double* diag,
+                        double* p) {
   if (detail::cpu_past_convergence(guard)) return;
   parallel_for_count(n.n, n.capacity, [=] WB_HD(int64_t e) {
     if (!guard.active()) return;
     const double beta = *rz_new / *guard.rz;
-    p[e] = z[e] + beta * p[e];
+    p[e] = r[e] / diag[e] + beta * p[e];
   });
 }
 

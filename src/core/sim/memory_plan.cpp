@@ -14,8 +14,8 @@ namespace {
 // Measured with the CPU backend's ledger (tests/sim/memory_budget_test.cpp checks the estimate
 // against what a run holds): every buffer the grid, the paint window, the rasters and the
 // per-step scratch size by the window's cells, after the first steps allocated the lazy ones
-// (the viscous solve's vectors, sized to every face of the window, about 250 of them).
-constexpr int64_t kWindowBytesPerCell = 640;
+// (the viscous solve's vectors, sized to every face of the window, about 200 of them).
+constexpr int64_t kWindowBytesPerCell = 592;
 // Bristle vertices and samples, their loads and the brush's scratch, per sample.
 constexpr int64_t kBrushBytesPerSample = 300;
 // The profiler, the workspaces and the small device buffers.
