@@ -20,10 +20,6 @@ void LaunchGraph::reset() {
   seen_ = 0;
 }
 
-void LaunchLoop::reset() {
-  drop();
-  seen_ = 0;
-}
 
 #if defined(WB_WITH_CUDA)
 void LaunchGraph::drop() {
@@ -109,7 +105,7 @@ void LaunchLoop::abandon() {
   cudaGraph_t graph = nullptr;
   (void)cudaStreamEndCapture(cuda_stream(), &graph);  // the body belongs to graph_
   (void)cudaGetLastError();  // the launch's own error is the one reported
-  reset();
+  drop();
 }
 
 void LaunchLoop::replay() {

@@ -77,11 +77,11 @@ class LaunchGraph {
 
 /// Runs `body` (launches only, the same arguments for the same key) once and again while the flag
 /// `*go` (device memory the body's last kernel writes: nonzero, once more) says so. The loop is the
-/// device's: on CUDA the body is recorded into a conditional while node of a graph and the host
-/// only launches the graph (no wait); on the CPU backend, whose device memory is the host's, the
-/// flag is read where it lies. A key's first run on CUDA is made directly, the flag copied back
-/// after each pass (a workspace the body grows grows then, outside a recording). On CUDA a replay
-/// counts the body's launches once: its further passes run on the device.
+/// device's: on CUDA the body is recorded into a conditional while node of a graph at a key's first
+/// run and the host only launches the graph (no wait); on the CPU backend, whose device memory is
+/// the host's, the flag is read where it lies. The body must not allocate (it is recorded as it
+/// first runs: an allocation there fails the capture, loudly). On CUDA a run counts the body's
+/// launches once: its further passes run on the device.
 class LaunchLoop {
  public:
   LaunchLoop() = default;
@@ -94,14 +94,6 @@ class LaunchLoop {
     if (!d.is_cuda()) {
       do body();
       while (*go != 0u);
-      return;
-    }
-    if (!(exec_ && key == key_) && key != seen_) {
-      seen_ = key;
-      for (uint32_t more = 1; more != 0u;) {
-        body();
-        mem::copy_to_host(d, &more, go, sizeof(more));
-      }
       return;
     }
     if (!(exec_ && key == key_)) {
@@ -117,7 +109,7 @@ class LaunchLoop {
     }
     replay();
   }
-  void reset();
+  void reset() { drop(); }
 
  private:
   void drop();
@@ -129,7 +121,6 @@ class LaunchLoop {
   void* graph_ = nullptr;  // cudaGraph_t whose conditional node's body is being recorded
   uint64_t handle_ = 0;    // cudaGraphConditionalHandle
   uint64_t key_ = 0;
-  uint64_t seen_ = 0;
   int64_t launches_ = 0;
 };
 
