@@ -97,8 +97,10 @@ void parallel_for(int64_t n, F fn, int64_t serial_below = kMinParallelSize) {
 }
 
 /// parallel_for over the first *count of `capacity` elements, where *count is device memory a
-/// kernel wrote: the host never waits for it. CUDA launches over the capacity and the threads
-/// past *count return; the CPU backend, whose device memory is the host's, loops to *count.
+/// kernel wrote: the host never waits for it. CUDA launches at most kSumBlocks blocks (a full
+/// GPU's resident threads) that stride to *count, so a large capacity (the viscous solve's: every
+/// face of the window) costs no launch of blocks that only return; the CPU backend, whose device
+/// memory is the host's, loops to *count.
 template <typename F>
 void parallel_for_count(const int64_t* count, int64_t capacity, F fn, int64_t serial_below = kMinParallelSize) {
   if (capacity <= 0) return;
@@ -106,8 +108,9 @@ void parallel_for_count(const int64_t* count, int64_t capacity, F fn, int64_t se
   mem::count_launch();
   static_assert(__nv_is_extended_host_device_lambda_closure_type(F) || !__nv_is_extended_device_lambda_closure_type(F),
                 "parallel_for_count takes __host__ __device__ (WB_HD) lambdas or functors");
-  detail::parallel_for_count_kernel<<<detail::blocks_for(capacity), detail::kBlock, 0, ::wb::cuda_stream()>>>(
-      count, capacity, fn);
+  const unsigned blocks = detail::blocks_for(capacity) < unsigned(kSumBlocks) ? detail::blocks_for(capacity)
+                                                                               : unsigned(kSumBlocks);
+  detail::parallel_for_count_kernel<<<blocks, detail::kBlock, 0, ::wb::cuda_stream()>>>(count, capacity, fn);
   WB_CUDA_CHECK_LAUNCH();
 #else
   parallel_for(*count < capacity ? *count : capacity, fn, serial_below);
