@@ -59,6 +59,8 @@ bool FrameCache::render(Session& session, bool force) {
   for (int y = r.top(); y <= r.bottom(); ++y)
     std::memcpy(front_.scanLine(y) + r.left() * 4, img.at(r.left(), y), size_t(r.width()) * 4);
   front_dirty_ |= r;
+  const double published = wall_now();
+  for (InputTiming& t : inputs_) t.published = published;
   front_inputs_.insert(front_inputs_.end(), inputs_.begin(), inputs_.end());
   inputs_.clear();
   return true;

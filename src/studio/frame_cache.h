@@ -11,6 +11,8 @@
 #include <mutex>
 #include <vector>
 
+#include "studio/latency.h"
+
 #include "core/session/session.h"
 
 namespace wb::studio {
@@ -18,7 +20,7 @@ namespace wb::studio {
 /// What the view takes from the simulation for its next frame.
 struct FrameUpdate {
   QRect dirty;                      ///< pixels changed since the last take (empty: none)
-  std::vector<double> input_times;  ///< pen events (wall_now) first consumed by these pixels' steps
+  std::vector<InputTiming> input_times;  ///< pen events first consumed by these pixels' steps
 };
 
 class FrameCache {
@@ -32,9 +34,9 @@ class FrameCache {
   void invalidate_all();
   /// Cells [x0, x1) x [y0, y1) changed.
   void invalidate_rect(int x0, int y0, int x1, int y1);
-  /// A step consumed the pen event that happened at `wall_t` (wall_now): it goes to the view with
-  /// the next front image.
-  void input_consumed(double wall_t) { inputs_.push_back(wall_t); }
+  /// The step that ended at `at` consumed the pen event that happened at `wall_t` (wall_now): it
+  /// goes to the view with the next front image, which stamps when it was published.
+  void input_consumed(double wall_t, double at) { inputs_.push_back(InputTiming{wall_t, at, 0.0}); }
   /// Re-renders what changed and copies it to the front image, at most 30 times a second unless
   /// `force`; the brush picture and the consumed pen events are taken with it. True when the
   /// front image changed.
@@ -53,11 +55,11 @@ class FrameCache {
   CanvasDims dims_{};
   double last_render_ = 0.0;
   int dirty_x0_ = 1 << 30, dirty_y0_ = 1 << 30, dirty_x1_ = -1, dirty_y1_ = -1;
-  std::vector<double> inputs_;  ///< pen events consumed since the last front image
+  std::vector<InputTiming> inputs_;  ///< pen events consumed since the last front image
   mutable std::mutex mu_;  ///< guards what the UI takes: front_, front_dirty_, front_inputs_, picture_
   QImage front_;
   QRect front_dirty_;
-  std::vector<double> front_inputs_;
+  std::vector<InputTiming> front_inputs_;
   BrushPicture picture_;
 };
 

@@ -14,6 +14,14 @@ struct PenEventTime {
   double wall_t = 0.0;
 };
 
+/// A pen event on its way to the screen, wall_now times: when it happened, when the step that
+/// reached its sample ended, and when the front image holding that step's paint was published.
+struct InputTiming {
+  double event = 0.0;
+  double consumed = 0.0;
+  double published = 0.0;
+};
+
 struct LatencySummary {
   int64_t count = 0;
   double median_ms = 0.0;
@@ -43,6 +51,18 @@ class LatencyLog {
   std::deque<Entry> entries_;
   int64_t first_ = 0;  ///< index of entries_.front()
   double last_current_ = -1.0;
+};
+
+/// The latency's three parts, logged as each event is presented: to the step that consumed it
+/// (the wait for the next sample and the simulation's lag), to the front image (the render's
+/// turn), and to the screen (the view's frame).
+struct LatencyParts {
+  LatencyLog to_step, to_frame, to_screen;
+  void add(const InputTiming& t, double presented) {
+    to_step.add(t.consumed - t.event, presented);
+    to_frame.add(t.published - t.consumed, presented);
+    to_screen.add(presented - t.published, presented);
+  }
 };
 
 }  // namespace wb::studio

@@ -153,6 +153,14 @@ int main(int argc, char** argv) {
       // Pen-to-paint latency of each surface's pen events (docs/STUDIO.md "Pen-to-paint latency").
       const LatencySummary lat = w.view()->latency().summary(latency0),
                            pal_lat = w.palette()->view()->latency().summary(pal_latency0);
+      // Its parts, over the same events (each presented event adds to all four logs).
+      const LatencyParts& parts = w.view()->latency_parts();
+      const auto part = [&](const LatencyLog& log) {
+        const LatencySummary p = log.summary(latency0);
+        return nlohmann::json{{"median_ms", p.median_ms}, {"p95_ms", p.p95_ms}};
+      };
+      const nlohmann::json lat_parts = {
+          {"to_step", part(parts.to_step)}, {"to_frame", part(parts.to_frame)}, {"to_screen", part(parts.to_screen)}};
       const char* view_name = view_kind_name(w.view()->kind());
       std::printf("demo: %.1f s wall (pen on the canvas or palette %.1f s), %lld view frames (%.1f fps over the "
                   "canvas's strokes, %s view), device %s, preset %s\n",
@@ -161,6 +169,7 @@ int main(int argc, char** argv) {
                   "%.1f ms, p95 %.1f ms (%lld)\n",
                   lat.median_ms, lat.p95_ms, (long long)lat.count, pal_lat.median_ms, pal_lat.p95_ms,
                   (long long)pal_lat.count);
+      std::printf("demo: canvas latency's parts (median, p95 ms): %s\n", lat_parts.dump().c_str());
       std::printf("demo: canvas: %lld simulation steps in %.1f s of its strokes (real-time factor %.3f, %.1f ms "
                   "a step on average, %.1f the median of the last half second), %lld particles at the end\n",
                   (long long)steps, t.canvas_s, rtf, mean_ms, st.step_ms, (long long)st.particles);
@@ -185,7 +194,7 @@ int main(int argc, char** argv) {
                                     {"wall_s", secs},         {"pen_s", t.pen_s},
                                     {"view_frames", frames},  {"view_fps", fps},
                                     {"latency_median_ms", lat.median_ms}, {"latency_p95_ms", lat.p95_ms},
-                                    {"latency_events", lat.count},
+                                    {"latency_events", lat.count}, {"latency_parts", lat_parts},
                                     {"canvas_s", t.canvas_s}, {"steps", steps},
                                     {"simulated_s", sim_s},   {"real_time_factor", rtf},
                                     {"mean_step_ms", mean_ms}, {"last_median_step_ms", st.step_ms},

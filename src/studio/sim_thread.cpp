@@ -310,8 +310,9 @@ void SimThread::step_once(const SessionStep& s) {
   invalidate_rect(std::min(o.x, o0.x), std::min(o.y, o0.y), std::max(o.x, o0.x) + n.x, std::max(o.y, o0.y) + n.y);
   session_.step_done(s);
   // The pen events up to the step's end are in the paint now: they go with its next frame.
+  const double consumed = wall_now();
   while (!pending_inputs_.empty() && pending_inputs_.front().session_t <= s.step.t) {
-    frames_.input_consumed(pending_inputs_.front().wall_t);
+    frames_.input_consumed(pending_inputs_.front().wall_t, consumed);
     pending_inputs_.pop_front();
   }
   ++steps_;

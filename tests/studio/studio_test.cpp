@@ -439,6 +439,14 @@ class StudioTest : public QObject {
     }
     QVERIFY(j.at("latency_p95_ms").get<double>() >= j.at("latency_median_ms").get<double>());
     QVERIFY(j.at("latency_events").get<int64_t>() > 0);
+    // Its parts, event by event: to the step, to the front image, to the screen. Each is a time
+    // after the one before (none negative), and no part's median is over the whole's p95.
+    for (const char* part : {"to_step", "to_frame", "to_screen"}) {
+      const nlohmann::json& p = j.at("latency_parts").at(part);
+      const double med = p.at("median_ms").get<double>(), p95 = p.at("p95_ms").get<double>();
+      QVERIFY2(std::isfinite(med) && med >= 0.0 && p95 >= med, part);
+      QVERIFY2(med <= j.at("latency_p95_ms").get<double>(), part);
+    }
 
     QProcess gl;
     gl.setProcessEnvironment(env);
