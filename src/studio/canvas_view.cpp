@@ -90,10 +90,7 @@ void CanvasView::presented(int64_t pixels) {
 void CanvasView::time_inputs() {
   if (awaiting_.empty()) return;
   const double now = wall_now();
-  for (const InputTiming& t : awaiting_) {
-    latency_.add(now - t.event, now);
-    parts_.add(t, now);
-  }
+  for (const InputTiming& t : awaiting_) latency_.add(t, now);
   awaiting_.clear();
 }
 

@@ -85,8 +85,6 @@ class CanvasView : public QWidget {
   /// Pen-to-paint latencies measured by this view.
   LatencyLog& latency() { return latency_; }
   const LatencyLog& latency() const { return latency_; }
-  /// The same latencies in their three parts (LatencyParts).
-  const LatencyParts& latency_parts() const { return parts_; }
 
  Q_SIGNALS:
   /// Pen input at time t, when it happened on the wall clock (event_time).
@@ -138,7 +136,6 @@ class CanvasView : public QWidget {
   QImage image_;
   std::vector<InputTiming> awaiting_;  ///< pen events taken with pixels not presented yet
   LatencyLog latency_;
-  LatencyParts parts_;  ///< latency_ in its three parts, event by event
   int canvas_w_ = 1, canvas_h_ = 1;
   bool place_paint_ = false;
 

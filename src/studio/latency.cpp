@@ -16,19 +16,21 @@ double nearest_rank(std::vector<float>& v, double q) {
 
 }  // namespace
 
-void LatencyLog::add(double seconds, double at) {
-  entries_.push_back({at, float(seconds * 1e3)});
+void LatencyLog::add(const InputTiming& t, double at) {
+  entries_.push_back({at,
+                      {float((at - t.event) * 1e3), float((t.consumed - t.event) * 1e3),
+                       float((t.published - t.consumed) * 1e3), float((at - t.published) * 1e3)}});
   if (entries_.size() > kKeep) {
     entries_.pop_front();
     ++first_;
   }
 }
 
-LatencySummary LatencyLog::summary(int64_t from) const {
+LatencySummary LatencyLog::summary(int64_t from, LatencyPart part) const {
   const size_t skip = size_t(std::clamp<int64_t>(from - first_, 0, int64_t(entries_.size())));
   std::vector<float> ms;
   ms.reserve(entries_.size() - skip);
-  for (size_t i = skip; i < entries_.size(); ++i) ms.push_back(entries_[i].ms);
+  for (size_t i = skip; i < entries_.size(); ++i) ms.push_back(entries_[i].ms[int(part)]);
   LatencySummary s;
   s.count = int64_t(ms.size());
   if (ms.empty()) return s;
@@ -39,7 +41,7 @@ LatencySummary LatencyLog::summary(int64_t from) const {
 
 double LatencyLog::current_ms(double now) {
   std::vector<float> ms;
-  for (auto it = entries_.rbegin(); it != entries_.rend() && it->at >= now - 1.0; ++it) ms.push_back(it->ms);
+  for (auto it = entries_.rbegin(); it != entries_.rend() && it->at >= now - 1.0; ++it) ms.push_back(it->ms[0]);
   if (!ms.empty()) last_current_ = nearest_rank(ms, 0.5);
   return last_current_;
 }

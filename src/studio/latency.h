@@ -28,15 +28,21 @@ struct LatencySummary {
   double p95_ms = 0.0;  ///< nearest rank
 };
 
-/// The latencies one view measured, in the order they were presented.
+/// The span of an event's way to the screen a summary is of: the whole, or its part to the step
+/// that consumed it (the wait for the next sample and the simulation's lag), to the front image
+/// (the render's turn) or to the screen (the view's frame).
+enum class LatencyPart { whole = 0, to_step, to_frame, to_screen };
+
+/// The latencies one view measured, in the order they were presented, each with its parts.
 class LatencyLog {
  public:
-  /// A latency of `seconds`, presented at wall time `at`.
-  void add(double seconds, double at);
+  /// The event `t`, presented at wall time `at`.
+  void add(const InputTiming& t, double at);
   /// Latencies measured so far (an index for summary's `from`).
   int64_t count() const { return first_ + int64_t(entries_.size()); }
-  /// Median and 95th percentile of the latencies from the `from`-th on (of those still kept).
-  LatencySummary summary(int64_t from = 0) const;
+  /// Median and 95th percentile of `part` of the latencies from the `from`-th on (of those still
+  /// kept).
+  LatencySummary summary(int64_t from = 0, LatencyPart part = LatencyPart::whole) const;
   /// Median of the latencies presented in the second before `now`, ms; when none were, the last
   /// such median (-1 before any).
   double current_ms(double now);
@@ -44,25 +50,13 @@ class LatencyLog {
  private:
   struct Entry {
     double at;
-    float ms;
+    float ms[4];  ///< by LatencyPart
   };
   /// A long session keeps its last kKeep latencies.
   static constexpr size_t kKeep = size_t(1) << 20;
   std::deque<Entry> entries_;
   int64_t first_ = 0;  ///< index of entries_.front()
   double last_current_ = -1.0;
-};
-
-/// The latency's three parts, logged as each event is presented: to the step that consumed it
-/// (the wait for the next sample and the simulation's lag), to the front image (the render's
-/// turn), and to the screen (the view's frame).
-struct LatencyParts {
-  LatencyLog to_step, to_frame, to_screen;
-  void add(const InputTiming& t, double presented) {
-    to_step.add(t.consumed - t.event, presented);
-    to_frame.add(t.published - t.consumed, presented);
-    to_screen.add(presented - t.published, presented);
-  }
 };
 
 }  // namespace wb::studio

@@ -153,14 +153,14 @@ int main(int argc, char** argv) {
       // Pen-to-paint latency of each surface's pen events (docs/STUDIO.md "Pen-to-paint latency").
       const LatencySummary lat = w.view()->latency().summary(latency0),
                            pal_lat = w.palette()->view()->latency().summary(pal_latency0);
-      // Its parts, over the same events (each presented event adds to all four logs).
-      const LatencyParts& parts = w.view()->latency_parts();
-      const auto part = [&](const LatencyLog& log) {
-        const LatencySummary p = log.summary(latency0);
-        return nlohmann::json{{"median_ms", p.median_ms}, {"p95_ms", p.p95_ms}};
+      // Its parts, over the same events.
+      const auto part = [&](LatencyPart p) {
+        const LatencySummary s = w.view()->latency().summary(latency0, p);
+        return nlohmann::json{{"median_ms", s.median_ms}, {"p95_ms", s.p95_ms}};
       };
-      const nlohmann::json lat_parts = {
-          {"to_step", part(parts.to_step)}, {"to_frame", part(parts.to_frame)}, {"to_screen", part(parts.to_screen)}};
+      const nlohmann::json lat_parts = {{"to_step", part(LatencyPart::to_step)},
+                                        {"to_frame", part(LatencyPart::to_frame)},
+                                        {"to_screen", part(LatencyPart::to_screen)}};
       const char* view_name = view_kind_name(w.view()->kind());
       std::printf("demo: %.1f s wall (pen on the canvas or palette %.1f s), %lld view frames (%.1f fps over the "
                   "canvas's strokes, %s view), device %s, preset %s\n",

@@ -199,6 +199,8 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   cg_sums_.resize(6);
   cg_go_.set_device(d);
   cg_go_.resize(1);
+  record_.set_device(d);
+  record_.resize(1);
   cg_count_.set_device(d);
   cg_count_.resize(1);
   cg_partial_.set_device(d);
@@ -475,10 +477,9 @@ void Grid::take_record(const GridRecord& r) {
 }
 
 void Grid::read_record() {
-  DeviceBuffer<GridRecord> rec(device(), 1);
-  record_into(rec.data());
+  record_into(record_.data());
   GridRecord r{};
-  rec.copy_to_host(&r, 1);
+  record_.copy_to_host(&r, 1);
   take_record(r);
 }
 

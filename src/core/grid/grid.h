@@ -187,6 +187,7 @@ class Grid {
   DeviceBuffer<double> cg_partial_;
   DeviceBuffer<uint32_t> cg_ticket_;
   LaunchLoop cg_loop_;  ///< the CG's iterations, run by the device until converged
+  DeviceBuffer<GridRecord> record_;  ///< read_record's copy of the step's device figures
   /// The advection's maxima: the outflow rate along each axis (slots 0-2), then column_maxima's
   /// six (the top layers holding paint and paint or particles, the latter's box), which make the
   /// step's AdvectPlan on the device; then column_maxima's six again after the particles joined
