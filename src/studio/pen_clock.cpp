@@ -44,9 +44,10 @@ void PenClock::push(ClockOutput& out, const PenSample& s) {
 ClockOutput PenClock::press(const PenInput& p, double t, double arrival) {
   ClockOutput out;
   if (down_) return move(p, t, arrival);
-  // The brush hovers above the new spot kLiftGap before touching; a whole kStrokeGap after
-  // the previous stroke's last (lifted, step-aligned) sample.
-  const double s = any_ ? last_t_ + kStrokeGap : kLeadIn;
+  // The brush hovers above the new spot kLiftGap before touching, kPressLead after the previous
+  // stroke's last (lifted, step-aligned) sample: the rest of the gap came with the release. The
+  // first sample of a recording is the hover, kLeadIn into it.
+  const double s = (any_ ? last_t_ + kTravel : kLeadIn) + kLiftGap;
   push(out, sample(p, s - kLiftGap, false));
   push(out, sample(p, s, true));
   out.input = PenEventTime{s, t};
@@ -85,11 +86,12 @@ ClockOutput PenClock::release(const PenInput& p, double t) {
   if (!down_) return out;
   push(out, sample(p, stamp(t), true));
   out.input = PenEventTime{last_t_, t};
-  // Lifted kLiftGap later, then held still up to a step boundary: the simulation may run
-  // every step up to that sample without knowing what comes next.
+  // Lifted kLiftGap later, then held still there for the gap but the next press's lead, up to a
+  // step boundary: the simulation may run every step up to that sample without knowing what
+  // comes next.
   const double up = last_t_ + kLiftGap;
   push(out, sample(p, up, false));
-  push(out, sample(p, ceil_to(up + kStepDt, kStepDt), false));
+  push(out, sample(p, ceil_to(up + kStepDt + (kStrokeGap - kPressLead), kStepDt), false));
   down_ = false;
   return out;
 }
@@ -107,7 +109,7 @@ ClockOutput PenClock::event(StrokeEvent e) {
   // Before the first stroke: an anchor sample at the start of the line (the lead-in
   // then ends there); afterwards the event sits inside the next step, closed by a
   // lifted sample on that step's end.
-  const double t0 = any_ ? last_t_ : kLeadIn - kLiftGap;
+  const double t0 = any_ ? last_t_ : kLeadIn;
   if (!any_) push(out, sample(at, t0, false));
   e.t = t0 + 0.5 * kStepDt;
   out.events.push_back(e);

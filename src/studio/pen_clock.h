@@ -16,7 +16,14 @@ inline constexpr double kStepDt = 1.0 / 64.0;        ///< simulation step, secon
 inline constexpr double kTimeQuantum = 1.0 / 1024.0; ///< sample time resolution, seconds
 inline constexpr double kLiftGap = 0.125;             ///< hover before a press / lift after a release
 inline constexpr double kStrokeGap = 0.25;            ///< session time between two strokes
-inline constexpr double kLeadIn = 0.25;               ///< recording lead-in (the player's lead_in)
+/// Of the gap, what a press adds: the lifted brush's travel to the new spot (two steps) and its
+/// descent (kLiftGap). The rest is added at the release, where the pen is known to stay, so that
+/// it is simulated while the painter moves the pen, not after the press (docs/STUDIO.md).
+inline constexpr double kTravel = 2.0 * kStepDt;
+inline constexpr double kPressLead = kTravel + kLiftGap;
+/// A recording's lead-in (the player's lead_in): two steps with the brush at its first sample,
+/// above the canvas, before it moves.
+inline constexpr double kLeadIn = 2.0 * kStepDt;
 /// Silence of the pen after which it counts as held still and its last sample is repeated.
 /// Longer than the gaps between the samples of a moving pen as the UI thread receives them (a
 /// device's interval plus the UI's stalls): a repeat inside such a gap puts the pen's next move

@@ -257,6 +257,35 @@ TEST(StrokePlayer, SubstepsBoundMovement) {
   EXPECT_TRUE(capped);
 }
 
+TEST(StrokePlayer, ALiftedTravelTakesABrushLengthASubstep) {
+  // Two strokes 400 cells apart, the pen carried between them lifted in 0.05 s (8 cells a
+  // millisecond, 133 a step): the lifted steps take a sub-step per brush length of the travel,
+  // the steps in contact or coming down the stroke's bound.
+  Stroke s = make_stroke({pen(0.0, 100, 500, 0.4), pen(0.2, 150, 500, 0.4), pen(0.3, 150, 500, 0, false),
+                          pen(0.35, 550, 500, 0, false), pen(0.5, 550, 500, 0.4), pen(0.7, 600, 500, 0.4)});
+  s.max_move_per_substep = 2.f;
+  StrokePlayer player(s);
+  PlayerStep st;
+  int lifted_steps = 0, max_lifted = 0;
+  while (player.next(st)) {
+    bool lifted = player.elevation_at(st.t_begin) <= -1.f && st.elevation <= -1.f;
+    for (int k = 1; k < 8; ++k) lifted = lifted && player.elevation_at(st.t_begin + st.dt * k / 8) <= -1.f;
+    if (lifted) {
+      ++lifted_steps;
+      max_lifted = std::max(max_lifted, st.substeps);
+      EXPECT_LE(st.max_move, s.brush.length + 1e-3f) << "step " << st.index;
+      if (st.substeps > 1) {  // fewer would break the bound
+        EXPECT_GT(st.max_move * st.substeps, s.brush.length * (st.substeps - 1)) << "step " << st.index;
+      }
+    } else if (st.substeps < s.max_substeps) {
+      EXPECT_LE(st.max_move, s.max_move_per_substep + 1e-4f) << "step " << st.index;
+    }
+  }
+  EXPECT_GE(lifted_steps, 3);
+  EXPECT_GE(max_lifted, 2);                                                // 133 cells a step
+  EXPECT_LE(max_lifted, int(std::ceil(140.f / s.brush.length)) + 1);  // not 133 / 2
+}
+
 TEST(StrokePlayer, PenDownEdgesFire) {
   // down, up (lifted gap), down again.
   Stroke s = make_stroke({pen(0.0, 100, 100, 0.4), pen(0.3, 200, 100, 0.4), pen(0.4, 220, 100, 0, false),

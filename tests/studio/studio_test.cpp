@@ -579,12 +579,25 @@ class StudioTest : public QObject {
     QVERIFY(line[first_move + 60].t - line[first_move + 59].t >= kHoldAfter - 0.01);
     for (size_t k = first_move + 61; k < line.size(); ++k)
       QVERIFY(line[k].t - line[k - 1].t >= kStepDt - kTimeQuantum);
+    const double last_down = line.back().t;
     add(clock.release(PenInput{290.f, 50.f, 0.5f}, now + 0.5));
+    // The release holds the lifted pen where it was for the gap but the next press's lead: a
+    // step-aligned sample the simulation runs to while the painter moves the pen.
+    QVERIFY(!line.back().down && line.back().x == 290.f);
+    const double held_to = line.back().t;
+    QVERIFY2(held_to >= last_down + kLiftGap + kStrokeGap - kPressLead, std::to_string(held_to - last_down).c_str());
+    QCOMPARE(std::fmod(held_to, kStepDt), 0.0);
     // A stroke whose samples, 16 ms apart, the UI takes in bursts of four 50 ms late.
     const double t0 = now + 1.0;
     const size_t second = line.size();
     add(clock.press(PenInput{50.f, 80.f, 0.5f}, t0, t0));
     const size_t touch = line.size() - 1;
+    // The press adds its lead only, far from the last stroke: two steps of travel, lifted, to
+    // a hover over the new spot, then the descent. The whole pause is the fixed gap.
+    QVERIFY(!line[touch - 1].down && line[touch - 1].x == 50.f && line[touch].down);
+    QCOMPARE(line[touch - 1].t, held_to + kTravel);
+    QCOMPARE(line[touch].t, held_to + kPressLead);
+    QVERIFY(line[touch].t - last_down >= kLiftGap + kStrokeGap);
     for (int i = 1; i <= 16; ++i) {
       const double t = t0 + 0.016 * i, arrival = t0 + 0.064 * ((i + 3) / 4) + 0.05;
       add(clock.move(PenInput{50.f + 4.f * float(i), 80.f, 0.5f}, t, arrival));

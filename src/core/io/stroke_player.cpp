@@ -184,8 +184,7 @@ BrushPose StrokePlayer::pose_at(double t) const {
   return pose_from_pen(p, k.e, stroke_.brush);
 }
 
-int StrokePlayer::substeps_for(double ta, double tb, float* max_move) const {
-  const float limit = stroke_.max_move_per_substep;
+int StrokePlayer::substeps_for(double ta, double tb, float limit, float* max_move) const {
   const int cap = stroke_.max_substeps;
   Vec3 a[kRefPoints], b[kRefPoints];
   // First guess: the longest reference-point path through this step, segment by segment
@@ -258,7 +257,6 @@ bool StrokePlayer::next(PlayerStep& out) {
   out.t_begin = t_begin() + double(k) * dt;
   out.t = t_begin() + double(k + 1) * dt;
   out.dt = dt;
-  out.substeps = substeps_for(out.t_begin, out.t, &out.max_move);
   out.pen = pen_at(out.t);
   out.elevation = elevation_at(out.t);
   out.pose = pose_from_pen(out.pen, out.elevation, stroke_.brush);
@@ -267,6 +265,12 @@ bool StrokePlayer::next(PlayerStep& out) {
   float e_max = std::max(elevation_at(out.t_begin), out.elevation);
   for (auto [it, end] = keys_inside(out.t_begin, out.t); it != end; ++it) e_max = std::max(e_max, it->e);
   out.pen_down = e_max >= 0.f;
+  // The sub-step bound resolves contact. A pen up all the step holds the tips half a brush length
+  // above the canvas (kPenUpLift): the bristles, simulated in the brush's frame (Eq. 2), only
+  // swing with its acceleration, which a brush length a sub-step resolves (docs/FORMATS.md).
+  const bool lifted = e_max <= -1.f;
+  out.substeps = substeps_for(out.t_begin, out.t, lifted ? lifted_move_limit() : stroke_.max_move_per_substep,
+                              &out.max_move);
   out.pen_down_edge = out.pen_down && !prev_contact_;
   out.pen_up_edge = !out.pen_down && prev_contact_;
   prev_contact_ = out.pen_down;

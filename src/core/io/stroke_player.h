@@ -3,6 +3,7 @@
 // stable, the pen state and the paint events that fire in it. The one replay path used by
 // the tests, `wetbrush replay`, `wetbrush bench` and the studio's recorded strokes.
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <utility>
@@ -85,7 +86,9 @@ class StrokePlayer {
   Key interpolate(double t) const;
   /// Keys with ta < key.t < tb.
   std::pair<std::vector<Key>::const_iterator, std::vector<Key>::const_iterator> keys_inside(double ta, double tb) const;
-  int substeps_for(double ta, double tb, float* max_move) const;
+  int substeps_for(double ta, double tb, float limit, float* max_move) const;
+  /// Sub-step bound of a step with the pen up all through: a brush length, at least the stroke's.
+  float lifted_move_limit() const { return std::max(stroke_.max_move_per_substep, stroke_.brush.length); }
 
   Stroke stroke_;
   std::vector<Key> keys_;
