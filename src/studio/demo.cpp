@@ -93,6 +93,9 @@ DemoTimes run_demo_painting(MainWindow& w, bool short_demo) {
   // stroke of the mix, one of a well's paint across it while it is wet, and a light pass of a
   // lightly loaded brush that catches the weave.
   const int W = 400, H = 300;
+  // The script loads the brush itself (the palette's mix, then Clean and Dip): with *Reload each
+  // stroke* on, every press would clean it and load the selected well instead.
+  w.paint_panel()->set_reload_each_stroke(false);
   w.new_canvas(W, H, QColor(236, 229, 212), CanvasGround::of(Weave::Linen));
   w.settle();
   CanvasView* v = w.view();

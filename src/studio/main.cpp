@@ -61,6 +61,10 @@ int main(int argc, char** argv) {
                                "With --demo-screenshot: write the view frame rate, the simulation rate and the "
                                "pen-to-paint latency of the scripted painting to FILE (JSON).",
                                "file");
+  QCommandLineOption rec_opt("demo-recording",
+                             "With --demo-screenshot: save the canvas's recording of the scripted painting to FILE "
+                             "(a stroke file `wetbrush bench` and `wetbrush replay` take).",
+                             "file");
   QCommandLineOption short_opt("demo-short",
                                "With --demo-screenshot: a short scripted painting, one stroke on the canvas and "
                                "none on the palette (a test that the demo runs).");
@@ -74,8 +78,8 @@ int main(int argc, char** argv) {
                                 "Most memory the paintings may hold, host and GPU each (e.g. 4G, 512M); without it, "
                                 "what the machine has available (also WB_MEMORY_LIMIT).",
                                 "size");
-  cli.addOptions({device_opt, preset_opt, view_opt, data_opt, norecover_opt, autosave_opt, demo_opt, stats_opt, short_opt,
-                  loop_opt, memory_opt});
+  cli.addOptions({device_opt, preset_opt, view_opt, data_opt, norecover_opt, autosave_opt, demo_opt, stats_opt,
+                  rec_opt, short_opt, loop_opt, memory_opt});
   cli.addPositionalArgument("painting", "OpenRaster painting to open (.ora).", "[painting]");
   if (asks_for_help_or_version(argc, argv)) {
     // The help and the version need no display: a core application parses, prints and exits.
@@ -123,9 +127,9 @@ int main(int argc, char** argv) {
   MainWindow w(opt);
   w.show();
   if (cli.isSet(demo_opt)) {
-    const QString out = cli.value(demo_opt), stats = cli.value(stats_opt);
+    const QString out = cli.value(demo_opt), stats = cli.value(stats_opt), recording = cli.value(rec_opt);
     const bool short_demo = cli.isSet(short_opt);
-    QTimer::singleShot(500, &w, [&w, out, stats, short_demo, &opt] {
+    QTimer::singleShot(500, &w, [&w, out, stats, recording, short_demo, &opt] {
       // Also the frame-rate and simulation-rate measurement of docs/perf/studio.md.
       w.settle();
       QElapsedTimer timer;
@@ -213,6 +217,8 @@ int main(int argc, char** argv) {
                                                  {"worker_s", pal_worker}}}};
           wb::write_file_atomic(stats.toStdString(), j.dump(2) + "\n");
         }
+        if (!recording.isEmpty() && !w.save_recording(recording))
+          throw std::runtime_error("cannot save the recording to " + recording.toStdString());
         // The picture: the painting under a raking light, with the oblique view beside it.
         const int renders = w.oblique_renders();
         w.view_panel()->rake();
