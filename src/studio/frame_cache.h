@@ -40,7 +40,7 @@ class FrameCache {
   /// Re-renders what changed and copies it to the front image, at most 30 times a second unless
   /// `force`; the brush picture and the consumed pen events are taken with it. True when the
   /// front image changed.
-  bool render(Session& session, bool force);
+  bool render(Session& session, bool force, double min_interval = 1.0 / 30.0);
   /// The whole canvas rendered now (one pixel per cell).
   Image canvas_image(Session& session);
 

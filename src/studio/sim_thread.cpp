@@ -13,6 +13,10 @@
 namespace wb::studio {
 namespace {
 
+/// Seconds between the frames rendered while the simulation has steps waiting (caught up, it
+/// renders at once, at most 30 a second).
+constexpr double kBehindFrameInterval = 0.2;
+
 /// Adds the time since `since` to `bucket`; returns now.
 double lap(double& bucket, double since) {
   const double now = wall_now();
@@ -324,10 +328,10 @@ void SimThread::finish_stroke() {
   if (doc_ && doc_->end_stroke()) Q_EMIT strokeFinished();
 }
 
-void SimThread::render(bool force) {
+void SimThread::render(bool force, double min_interval) {
   if (!doc_) return;
   try {
-    if (frames_.render(*doc_, force)) Q_EMIT frameReady();
+    if (frames_.render(*doc_, force, min_interval)) Q_EMIT frameReady();
   } catch (const std::exception& e) {
     recover(e);  // the device failed between steps: the same as in one
   }
@@ -433,7 +437,10 @@ void SimThread::run() {
       t = lap(times_.undo, t);
       render(true);
     } else {
-      render(false);
+      // Behind the pen: a frame a fifth of a second shows the painting going on, and the rest of
+      // the thread's time goes to catching up (a frame costs about 3.6 ms; at 30 a second they
+      // held the simulation below real time: docs/STUDIO.md "Pen-to-paint latency").
+      render(false, kBehindFrameInterval);
     }
     lap(times_.render, t);
     {
