@@ -223,6 +223,15 @@ SimConfig replay_config(const ReplayArgs& a, const Stroke& stroke, const Device&
   return cfg;
 }
 
+/// The stroke with the window, tilt and paper its configuration resolved: Session::begin_replay
+/// applies a stroke's own, which would undo --window, --set and --params.
+void configure_stroke(Stroke& stroke, const SimConfig& cfg) {
+  stroke.window = std::array<int, 3>{cfg.window.x, cfg.window.y, cfg.window.z};
+  stroke.tilt = cfg.params.grid.tilt;
+  const Vec3 paper = cfg.params.render.paper_rgb;
+  stroke.paper_rgb = std::array<float, 3>{paper.x, paper.y, paper.z};
+}
+
 int run_replay(const ReplayArgs& a) {
   const Device device = resolve_device(a.device);
   Stroke stroke = load_stroke(a.strokes);
@@ -233,6 +242,7 @@ int run_replay(const ReplayArgs& a) {
     std::filesystem::create_directories(a.frames_dir);
   }
   const SimConfig cfg = replay_config(a, stroke, device);
+  configure_stroke(stroke, cfg);
 
   Session session(cfg, start_pose(stroke));
   session.begin_replay(stroke);
@@ -342,7 +352,9 @@ int run_replay(const ReplayArgs& a) {
     j["sim_time_s"] = replay.sim_time();
     j["stroke"] = a.strokes;
     j["mode"] = cfg.particles ? "hybrid" : "grid-only";
-    j["window"] = {cfg.window.x, cfg.window.y, cfg.window.z};
+    const Int3 w = sim.config().window;  // the window and tilt the session ran
+    j["window"] = {w.x, w.y, w.z};
+    j["tilt_deg"] = sim.config().params.grid.tilt;
     j["region"] = {{"x0", r.x0}, {"y0", r.y0}, {"width", r.width}, {"height", r.height}};
     j["brush"] = {{"shape", to_string(stroke.brush.shape)},
                   {"bristles", stroke.brush.bristles},
@@ -455,7 +467,9 @@ int run_soak(const SoakArgs& s) {
       a.device = s.device;
       Run r{cycle, i, 0, 0, 0, 0, 0, 0, 0, 0};
       {
-        Session session(replay_config(a, strokes[i], device), start_pose(strokes[i]));
+        const SimConfig cfg = replay_config(a, strokes[i], device);
+        configure_stroke(strokes[i], cfg);
+        Session session(cfg, start_pose(strokes[i]));
         session.begin_replay(strokes[i]);
         const Replay& replay = *session.replay();
         std::vector<double> ms;

@@ -37,9 +37,9 @@ class FrameCache {
   /// The step that ended at `at` consumed the pen event that happened at `wall_t` (wall_now): it
   /// goes to the view with the next front image, which stamps when it was published.
   void input_consumed(double wall_t, double at) { inputs_.push_back(InputTiming{wall_t, at, 0.0}); }
-  /// Re-renders what changed and copies it to the front image, at most 30 times a second unless
-  /// `force`; the brush picture and the consumed pen events are taken with it. True when the
-  /// front image changed.
+  /// Re-renders what changed and copies it to the front image, at most once in `min_interval`
+  /// seconds unless `force`; the brush picture and the consumed pen events are taken with it.
+  /// True when the front image changed.
   bool render(Session& session, bool force, double min_interval = 1.0 / 30.0);
   /// The whole canvas rendered now (one pixel per cell).
   Image canvas_image(Session& session);

@@ -174,6 +174,32 @@ TEST(Cli, ReplayWritesImageAndStats) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(Cli, ReplayOptionsOverrideTheStrokeFilesWindowAndTilt) {
+  // A recording carries its window and tilt (the studio's do); --window and --set are what the
+  // replay runs, not undone when the session takes the stroke.
+  const auto dir = temp_dir("override");
+  std::ifstream in(data("strokes/good/minimal.json"));
+  nlohmann::json stroke = nlohmann::json::parse(in);
+  stroke["simulation"]["window"] = {32, 32, 8};
+  stroke["canvas"]["tilt"] = 10;
+  const std::string file = (dir / "windowed.json").string(), stats = (dir / "stats.json").string();
+  std::ofstream(file) << stroke.dump();
+  const RunResult r = run_cli("replay --device cpu -q " + file + " --window 48,40,8 --set grid.tilt=30 --stats " + stats);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream f(stats);
+  const nlohmann::json j = nlohmann::json::parse(f);
+  EXPECT_EQ(j["window"], nlohmann::json({48, 40, 8}));
+  EXPECT_NEAR(j["tilt_deg"].get<double>(), 30.0, 1e-6);
+  // Without the options the file's own.
+  const RunResult own = run_cli("replay --device cpu -q " + file + " --stats " + stats);
+  ASSERT_EQ(own.exit_code, 0) << own.output;
+  std::ifstream g(stats);
+  const nlohmann::json k = nlohmann::json::parse(g);
+  EXPECT_EQ(k["window"], nlohmann::json({32, 32, 8}));
+  EXPECT_NEAR(k["tilt_deg"].get<double>(), 10.0, 1e-6);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Cli, BenchReportsEveryStageTheStepRateAndMemory) {
   const auto dir = temp_dir("bench");
   const std::string out = (dir / "bench.json").string();

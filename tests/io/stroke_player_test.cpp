@@ -282,7 +282,7 @@ TEST(StrokePlayer, ALiftedTravelTakesABrushLengthASubstep) {
     }
   }
   EXPECT_GE(lifted_steps, 3);
-  EXPECT_GE(max_lifted, 2);                                                // 133 cells a step
+  EXPECT_GE(max_lifted, 2);                                            // 133 cells a step
   EXPECT_LE(max_lifted, int(std::ceil(140.f / s.brush.length)) + 1);  // not 133 / 2
 }
 
