@@ -19,10 +19,7 @@ QualityPreset QualityPreset::cpu() {
   p.palette_width = 320;
   p.palette_height = 200;
   p.ao_rays = 12;
-  // Its brush, 100 cells long and 40 wide, tilted and splayed, reaches about 80 cells across: a
-  // window of 64 cut it, and the cut paint hung in streaks below a loaded brush's landing
-  // (docs/STUDIO.md "Quality presets").
-  p.window_xy = 96;
+  p.window_xy = 64;
   p.window_z = 16;
   // 8 candidates a cell instead of 27: a dab of paint on the palette, scrubbed, turned into
   // 700 000 particles at 27 (docs/perf/studio.md "The palette").
@@ -99,7 +96,7 @@ Int3 QualityPreset::window() const { return Int3{window_xy, window_xy, std::min(
 
 double estimated_step_ms(int64_t brush_samples, Int3 window) {
   // Fitted to the steps of `wetbrush bench bench/strokes/studio-demo.json` with the CPU preset's
-  // brush in a 64-cell window (about 29 ms) and the fast preset's (about 9.4 ms), and to the same brush in
+  // brush and window (about 29 ms) and the fast preset's (about 9.4 ms), and to the same brush in
   // two windows (docs/STUDIO.md "Falling behind"): a fixed part, the brush's samples, the window's cells.
   constexpr double ms_fixed = 3.0, ms_per_sample = 1.69e-3, ms_per_cell = 1.36e-4;
   const double cells = double(window.x) * double(window.y) * double(window.z);
