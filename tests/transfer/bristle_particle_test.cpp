@@ -474,6 +474,37 @@ TEST_F(BristleParticleTest, TouchingSampleTakesTheFilmItSweepsWholeParticlesOnly
   }
 }
 
+TEST_F(BristleParticleTest, ASampleBeyondTheWindowLaysNoTrailAtItsWall) {
+  // A loaded sample sliding on the canvas leaves a swept deposit inside the window; beyond the
+  // window's columns (a brush wider than its window) none, which would land in the wall's column.
+  TransferParams prm;
+  const float dt = 1.f / 60.f;
+  PaintWindow w = make_window({16, 16, 8}, {0, 0, 0}, [](int, int, int) { return 0.f; }, Vec3());
+  PaintLoad blue;
+  blue.ryb[0] = 0.1f, blue.ryb[1] = 0.15f, blue.ryb[2] = 0.85f;
+  blue.load = 1.f;
+  const auto sweep = [&](Vec3 at) {
+    HostSamples h;
+    h.resize(1, 1);
+    h.x[0] = at;
+    h.v[0] = Vec3(60.f, 0.f, 0.f);  // a cell a step
+    DeviceSamples s(device_);
+    s.upload(h);
+    BristleLoad load(device_, 1, prm);
+    load.fill(blue);
+    Transfer t(device_, prm);
+    TransferEnv env = env_for(w);
+    env.dt = dt;
+    t.update_capacity(s.view(), load, env);
+    const BristleLoadHost lh = load.to_host();
+    EXPECT_LT(lh.gap[0], lh.radius[0]) << "the sample touches the canvas at " << at.x << ", " << at.y;
+    return lh.sweep[0];
+  };
+  EXPECT_GT(sweep(Vec3(8.f, 8.f, 0.4f)), 0.f) << "inside: a trail";
+  EXPECT_EQ(sweep(Vec3(20.f, 8.f, 0.4f)), 0.f) << "beyond the +x wall";
+  EXPECT_EQ(sweep(Vec3(8.f, -3.f, 0.4f)), 0.f) << "beyond the -y wall";
+}
+
 TEST_F(BristleParticleTest, SaturatedSampleAbsorbsNoMassButBleedsColour) {
   HostSamples h = vertical_brush(1, 4, 0.8f, 8.f, 8.f, 6.f, 1.f);
   DeviceSamples s(device_);

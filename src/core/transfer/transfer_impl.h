@@ -30,11 +30,16 @@ void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellFi
     const float gap = surface_distance(x, R, floor_z, density, thr, step, dryness, dry_threshold);
     load.gap[j] = gap;
     // Swept contact: the share of its load the sample would leave sliding this step (sigma_j of
-    // the wick's sink).
+    // the wick's sink). A sample beyond the window's columns (a brush wider than its window) lays
+    // none: its trail would be put in the wall's column (swept_position keeps particles in the
+    // window), a line along the wall as the window follows the stroke. Its paint stays on the
+    // bristle until it is inside.
+    const bool inside = x.x >= float(density.ox) && x.x < float(density.ox + density.nx) &&
+                        x.y >= float(density.oy) && x.y < float(density.oy + density.ny);
     const Vec3 v = s.v[j];
     const float m = load.m[j];
     const float travel = slid_distance(v, dt);
-    load.sweep[j] = m > 0.f ? swept_deposit(m, gap, travel, prm.split, cm) / m : 0.f;
+    load.sweep[j] = m > 0.f && inside ? swept_deposit(m, gap, travel, prm.split, cm) / m : 0.f;
   });
 }
 
