@@ -35,10 +35,10 @@ void FrameCache::invalidate_rect(int x0, int y0, int x1, int y1) {
   dirty_y1_ = std::max(dirty_y1_, y1);
 }
 
-bool FrameCache::render(Session& session, bool force, double min_interval) {
+bool FrameCache::render(Session& session, double min_interval) {
   if (!cache_) return false;
   const double now = wall_now();
-  if (!force && now - last_render_ < min_interval) return false;
+  if (now - last_render_ < min_interval) return false;
   last_render_ = now;
   // The brush as it is now (preview, swatch), with every frame and after palette actions.
   BrushPicture picture = session.sim().brush_picture();
@@ -68,7 +68,7 @@ bool FrameCache::render(Session& session, bool force, double min_interval) {
 
 Image FrameCache::canvas_image(Session& session) {
   if (!cache_) return {};
-  if (dirty_x1_ >= 0) render(session, true);
+  if (dirty_x1_ >= 0) render(session, 0.0);
   return session.update_image(*cache_);
 }
 

@@ -1,6 +1,6 @@
 // The studio's pictures of the simulation, made on the simulation thread and taken by the UI:
-// the canvas image, re-rendered incrementally where the paint changed (CanvasImageCache) at most
-// 30 times a second, the changed rectangle handed over to the view, and the brush as it is now
+// the canvas image, re-rendered incrementally where the paint changed (CanvasImageCache) as often
+// as SimThread asks, the changed rectangle handed over to the view, and the brush as it is now
 // (Simulator::brush_picture) for the preview and the paint swatch. One job: SimThread runs the
 // simulation and asks this for frames.
 #pragma once
@@ -37,10 +37,10 @@ class FrameCache {
   /// The step that ended at `at` consumed the pen event that happened at `wall_t` (wall_now): it
   /// goes to the view with the next front image, which stamps when it was published.
   void input_consumed(double wall_t, double at) { inputs_.push_back(InputTiming{wall_t, at, 0.0}); }
-  /// Re-renders what changed and copies it to the front image, at most once in `min_interval`
-  /// seconds unless `force`; the brush picture and the consumed pen events are taken with it.
-  /// True when the front image changed.
-  bool render(Session& session, bool force, double min_interval = 1.0 / 30.0);
+  /// Re-renders what changed and copies it to the front image, unless the last render was less
+  /// than `min_interval` seconds ago (0: now); the brush picture and the consumed pen events are
+  /// taken with it. True when the front image changed.
+  bool render(Session& session, double min_interval);
   /// The whole canvas rendered now (one pixel per cell).
   Image canvas_image(Session& session);
 

@@ -14,7 +14,7 @@ namespace wb::studio {
 namespace {
 
 /// Seconds between the frames rendered while the simulation has steps waiting (caught up, it
-/// renders at once, at most 30 a second).
+/// renders at once).
 constexpr double kBehindFrameInterval = 0.2;
 
 /// Adds the time since `since` to `bucket`; returns now.
@@ -123,7 +123,7 @@ void SimThread::rebuild(const SimConfig& config, bool keep_canvas) {
     status_.device = config.device.to_string();
   }
   invalidate_all();
-  render(true);
+  render(0.0);
 }
 
 bool SimThread::open(const std::string& path, bool palette) {
@@ -147,7 +147,7 @@ bool SimThread::open(const std::string& path, bool palette) {
   restart_recording(false);
   frames_.reset(*doc_);
   invalidate_all();
-  render(true);
+  render(0.0);
   return true;
 }
 
@@ -328,10 +328,10 @@ void SimThread::finish_stroke() {
   if (doc_ && doc_->end_stroke()) Q_EMIT strokeFinished();
 }
 
-void SimThread::render(bool force, double min_interval) {
+void SimThread::render(double min_interval) {
   if (!doc_) return;
   try {
-    if (frames_.render(*doc_, force, min_interval)) Q_EMIT frameReady();
+    if (frames_.render(*doc_, min_interval)) Q_EMIT frameReady();
   } catch (const std::exception& e) {
     recover(e);  // the device failed between steps: the same as in one
   }
@@ -435,12 +435,12 @@ void SimThread::run() {
         }
       }
       t = lap(times_.undo, t);
-      render(true);
+      render(0.0);
     } else {
       // Behind the pen: a frame a fifth of a second shows the painting going on, and the rest of
-      // the thread's time goes to catching up (a frame costs about 3.6 ms; at 30 a second they
+      // the thread's time goes to catching up (a frame costs about 3.6 ms; at 30 a second frames
       // held the simulation below real time: docs/STUDIO.md "Pen-to-paint latency").
-      render(false, kBehindFrameInterval);
+      render(kBehindFrameInterval);
     }
     lap(times_.render, t);
     {

@@ -165,7 +165,8 @@ class SimThread : public QObject {
   /// A new time line for the recording, the old one not simulated further.
   void begin_recording(bool from_blank);
   void finish_stroke();
-  void render(bool force, double min_interval = 1.0 / 30.0);
+  /// FrameCache::render, and the view told of a new front image.
+  void render(double min_interval);
   void publish_status(bool force);
 
   SimConfig config_;

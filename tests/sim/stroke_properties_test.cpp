@@ -3,10 +3,10 @@
 // and covers its track. Small brush, short strokes (CI on two CPU cores).
 #include <algorithm>
 #include <cmath>
-#include <random>
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
+#include <random>
 #include <string>
 #include <vector>
 
