@@ -119,23 +119,30 @@ void tiles_dry_all(TileStoreView t, int64_t cells) {
 }
 
 /// Lays the woven ground into every cell of the canvas (all tiles allocated, slot = tile id):
-/// dried primer up to weave_height, nothing above it.
-void tiles_lay_weave(TileStoreView t, WeaveField w, int64_t cells) {
-  parallel_for(cells, [=] WB_HD(int64_t i) {
-    const int64_t tc = t.tile_cells();
-    const int32_t slot = int32_t(i / tc);
-    const int64_t in = i - int64_t(slot) * tc;
-    const int lx = int(in % kTileSize), ly = int((in / kTileSize) % kTileSize), z = int(in / (kTileSize * kTileSize));
+/// dried primer up to weave_height, nothing above it. One thread a column: the weave's height
+/// (its threads' cosines) once, then the column's cells.
+void tiles_lay_weave(TileStoreView t, WeaveField w, int64_t columns) {
+  constexpr int64_t kTileColumns = int64_t(kTileSize) * kTileSize;
+  parallel_for(columns, [=] WB_HD(int64_t i) {
+    const int32_t slot = int32_t(i / kTileColumns);
+    const int64_t in = i - int64_t(slot) * kTileColumns;
+    const int lx = int(in % kTileSize), ly = int(in / kTileSize);
     const int x = (slot % t.tiles_x) * kTileSize + lx, y = (slot / t.tiles_x) * kTileSize + ly;
     const bool on = x < t.width && y < t.height;
-    const float d = on ? ground_density(weave_height(w, float(x) + 0.5f, float(y) + 0.5f), z) : 0.f;
-    t.density[i] = d;
-    const bool paint = d > 0.f;
-    t.pigment_r[i] = paint ? encode_unorm16(w.ryb.x) : 0;
-    t.pigment_y[i] = paint ? encode_unorm16(w.ryb.y) : 0;
-    t.pigment_b[i] = paint ? encode_unorm16(w.ryb.z) : 0;
-    t.oil[i] = paint ? encode_unorm16(w.oil) : 0;
-    t.dryness[i] = paint ? 65535 : 0;
+    const float h = on ? weave_height(w, float(x) + 0.5f, float(y) + 0.5f) : 0.f;
+    const uint16_t r = encode_unorm16(w.ryb.x), yl = encode_unorm16(w.ryb.y), b = encode_unorm16(w.ryb.z);
+    const uint16_t oil = encode_unorm16(w.oil);
+    for (int z = 0; z < t.depth; ++z) {
+      const int64_t c = int64_t(slot) * t.tile_cells() + t.cell_offset(lx, ly, z);
+      const float d = on ? ground_density(h, z) : 0.f;
+      const bool paint = d > 0.f;
+      t.density[c] = d;
+      t.pigment_r[c] = paint ? r : 0;
+      t.pigment_y[c] = paint ? yl : 0;
+      t.pigment_b[c] = paint ? b : 0;
+      t.oil[c] = paint ? oil : 0;
+      t.dryness[c] = paint ? 65535 : 0;
+    }
   });
 }
 

@@ -197,7 +197,7 @@ void TileStore::lay_weave(const WeaveField& w) {
   tile_of_slot_dev_.copy_range_from_host(tile_of_slot_.data(), 0, size_t(n));
   slots_used_dev_.copy_from_host(&slots_used_, 1);
   dried_to_.copy_range_from_host(host_dried_to_.data(), 0, size_t(n));
-  tiles_lay_weave(device_, view(), w, int64_t(n) * tile_cells());
+  tiles_lay_weave(device_, view(), w, int64_t(n) * kTileSize * kTileSize);
   mass_ = recount_density(ws_);
 }
 

@@ -193,7 +193,7 @@ class TileStore {
   X(void, tiles_scatter_window, (TileStoreView t, PaintWindowView w, float* before, float* after),             \
     (t, w, before, after))                                                                                     \
   X(void, tiles_dry_all, (TileStoreView t, int64_t cells), (t, cells))                                         \
-  X(void, tiles_lay_weave, (TileStoreView t, WeaveField w, int64_t cells), (t, w, cells))
+  X(void, tiles_lay_weave, (TileStoreView t, WeaveField w, int64_t columns), (t, w, columns))
 WB_DECLARE_KERNELS(WB_TILE_STORE_KERNELS)
 
 }  // namespace wb
