@@ -50,7 +50,6 @@ void check_params(const GridParams& p) {
   WB_REQUIRE(p.gravity >= 0.f && p.gravity <= 1e6f, "grid: gravity must be in [0, 1e6] cells/s^2");
   WB_REQUIRE(p.tilt >= 0.f && p.tilt <= 90.f, "grid: the canvas tilt must be in [0, 90] degrees");
   WB_REQUIRE(p.film_max >= 0.f && p.film_max <= 4.f, "grid: film_max must be in [0, 4] cells");
-  WB_REQUIRE(p.surface_tension >= 0.f && p.surface_tension <= 0.1f, "grid: surface_tension must be in [0, 0.1] N/m");
   WB_REQUIRE(p.liquid_threshold > 0.f && p.liquid_threshold <= 1.f, "grid: liquid_threshold must be in (0, 1]");
   WB_REQUIRE(p.dry_rate >= 0.f && p.dry_rate <= 1000.f, "grid: dry_rate must be in [0, 1000] /s");
   WB_REQUIRE(p.dry_threshold > 0.f && p.dry_threshold <= 1.f, "grid: dry_threshold must be in (0, 1]");
@@ -188,27 +187,6 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
     b.set_device(d);
     b.resize(size_t(kFilmFields) * size_t(g.nx) * size_t(g.ny));
   }
-  const size_t film_faces = 2 * size_t(g.nx) * size_t(g.ny);
-  for (auto* b : {&film_w_, &film_e_, &film_dir_}) {
-    b->set_device(d);
-    b->resize(film_faces);
-  }
-  for (auto* b : {&film_col_[0], &film_col_[1]}) {
-    b->set_device(d);
-    b->resize(size_t(g.nx) * size_t(g.ny));
-  }
-  for (auto* b : {&film_x_, &film_r_, &film_p_, &film_q_, &film_diag_}) {
-    b->set_device(d);
-    b->resize(film_faces);
-  }
-  film_sums_.set_device(d);
-  film_sums_.resize(6);
-  film_go_.set_device(d);
-  film_go_.resize(1);
-  film_count_.set_device(d);
-  const int64_t faces = int64_t(film_faces);
-  film_count_.copy_from_host(&faces, 1);
-  film_loop_.reset();
   for (auto* b : {&visc_flag_, &visc_idx_, &visc_list_}) {
     b->set_device(d);
     b->resize(all_faces);
@@ -485,7 +463,6 @@ void Grid::apply_viscosity(float dt) {
 void Grid::record_into(GridRecord* out) const {
   mem::copy_on_device(device(), &out->advect, advect_plan_.data(), sizeof(AdvectPlan));
   mem::copy_on_device(device(), out->viscosity, cg_sums_.data(), sizeof(out->viscosity));
-  mem::copy_on_device(device(), out->film, film_sums_.data(), sizeof(out->film));
 }
 
 void Grid::take_record(const GridRecord& r) {
@@ -495,7 +472,6 @@ void Grid::take_record(const GridRecord& r) {
   // in 4, the fluid faces in 5; all zero where no solve ran.
   stats_.viscosity_faces = int(r.viscosity[5]);
   stats_.viscosity_iterations = int(r.viscosity[4]);
-  stats_.film_iterations = int(r.film[4]);
   stats_.viscosity_residual =
       r.viscosity[3] > 0.0 ? std::sqrt(std::max(r.viscosity[0], 0.0) / r.viscosity[3]) : 0.0;
 }
@@ -550,57 +526,25 @@ void Grid::dry(float dt) {
 
 void Grid::flow_film(float dt) {
   WB_PROFILE_SCOPE("grid.film");
-  film_sums_.fill_zero();  // the record's figures are this step's
-  if (params_.film_max <= 0.f || (params_.gravity <= 0.f && params_.surface_tension <= 0.f)) return;
-  const Device& d = device();
+  if (params_.film_max <= 0.f || params_.gravity <= 0.f) return;
   const GridDims g = dims();
+  // Explicit sub-steps: the film's diffusivity rho0 g h^3 / (3 K) is largest for the thickest film
+  // of the runniest paint; dt <= cell^2 / (4 D) keeps the explicit step stable. Known here, no wait.
   const float cell = params_.cell_size, rho0 = params_.rho0;
-  const auto [stiff, oily] = paint_end_members(params_);
-  const Vec3 gv = params_.gravity_vector();
-  FilmFlow f{stiff, oily, rho0 * -gv.z * cell, rho0 * gv.y * cell, params_.surface_tension / cell, cell, dt};
-  // The columns are read from the cells once, flow in their own planes, and are written back once.
-  grid_film_columns(d, g, extent_.data(), window_.paint().view(), bristles_, particle_density_, flow_,
-                    params_.dry_threshold, params_.film_max, f, film_[0].data());
-  // The step's transfers across the faces, the pressure at the step's end (gravity's head and
-  // surface tension's, whose fourth-order flow no explicit step could follow: capillary levelling
-  // of a groove a few cells wide takes 10^-4 s), each face's mobility and yield from its start.
-  FilmSolve fs{film_w_.data(), film_e_.data(), film_dir_.data(), film_col_[0].data(), film_col_[1].data()};
-  grid_film_surface(d, g, film_[0].data(), fs);
-  grid_film_faces(d, g, film_[0].data(), f, fs);
-  grid_film_rhs(d, g, fs);
-  grid_film_pressure(d, g, film_[0].data(), f, fs, {});
-  double* sums = film_sums_.data();
-  const SumScratch sum{cg_partial_.data(), cg_ticket_.data()};
-  const int64_t faces = 2 * int64_t(g.nx) * g.ny;
-  const ListCount n{film_count_.data(), faces};
-  grid_film_start(d, g, film_[0].data(), f, fs, film_diag_.data(), film_r_.data(), film_x_.data(), film_q_.data());
-  grid_pcg_start(d, n, film_r_.data(), film_q_.data(), film_diag_.data(), film_p_.data(), sums + 0, sums + 3, sum);
-  const double tol2 = double(kFilmTolerance) * double(kFilmTolerance);
-  const CgGuard guard{sums + 0, sums + 3, tol2};
-  const uint64_t key = launch_key({launch_key_of(film_x_.data()), launch_key_of(film_w_.data()),
-                                   launch_key_of(film_[0].data()), launch_key_of(sums), uint64_t(g.nx),
-                                   uint64_t(g.ny), std::bit_cast<uint32_t>(f.rho_g_cos),
-                                   std::bit_cast<uint32_t>(f.sigma_cell), std::bit_cast<uint32_t>(f.cell)});
-  film_loop_.run(d, key, film_go_.data(), [&] {
-    grid_film_outflow(d, g, fs, film_p_.data(), guard);
-    grid_film_pressure(d, g, film_[0].data(), f, fs, guard);
-    grid_film_apply(d, g, fs, n, film_p_.data(), film_q_.data(), sums + 2, guard, sum);
-    grid_pcg_update(d, n, guard, sums + 2, film_p_.data(), film_q_.data(), film_diag_.data(), film_x_.data(),
-                    film_r_.data(), sums + 1, sums + 4, sum);
-    grid_pcg_direction(d, n, guard, sums + 1, film_r_.data(), film_diag_.data(), film_p_.data());
-    grid_pcg_continue(d, sums + 0, sums + 1, sums + 3, tol2, sums + 4, kFilmMaxIterations, film_go_.data());
-  });
-  grid_film_transfers(d, g, fs, film_x_.data());
-  // The paint goes over in sub-steps, each face a share of its transfer and at most a quarter of
-  // the film upwind: the pigment, oil and dryness mix upwind as they cross (as many as the
-  // runniest, thickest film's flow under gravity needs to move a quarter of a column each).
+  const float g_si = params_.gravity * cell;  // cells/s^2 -> m/s^2
   const float h = params_.film_max * cell;
-  const float D = rho0 * params_.gravity * cell * h * h * h / (3.f * std::min(oily.K, stiff.K));
+  const auto [stiff, oily] = paint_end_members(params_);
+  const float D = rho0 * g_si * h * h * h / (3.f * std::min(oily.K, stiff.K));
   const int substeps = std::max(1, int(std::ceil(dt * 4.f * D / (cell * cell))));
+  const Vec3 gv = params_.gravity_vector();
+  FilmFlow f{stiff, oily, rho0 * -gv.z * cell, rho0 * gv.y * cell, cell, dt / float(substeps)};
+  // The columns are read from the cells once, flow in their own planes, and are written back once.
+  grid_film_columns(device(), g, extent_.data(), window_.paint().view(), bristles_, particle_density_, flow_,
+                    params_.dry_threshold, params_.film_max, f, film_[0].data());
   int cur = 0;
   for (int s = 0; s < substeps; ++s, cur = 1 - cur)
-    grid_film_update(d, g, film_[cur].data(), film_e_.data(), 1.f / float(substeps), f, film_[1 - cur].data());
-  grid_film_write(d, g, window_.paint().view(), film_[cur].data());
+    grid_film_update(device(), g, film_[cur].data(), f, film_[1 - cur].data());
+  grid_film_write(device(), g, window_.paint().view(), film_[cur].data());
 }
 
 void Grid::step(float dt, const std::function<void()>& after_advection) {

@@ -27,7 +27,6 @@ struct GridStats {
   int viscosity_faces = 0;      ///< fluid faces of the last viscous solve
   int viscosity_iterations = 0; ///< CG iterations it took
   double viscosity_residual = 0;///< relative residual it reached (sqrt(r D^-1 r / b D^-1 b))
-  int film_iterations = 0;      ///< CG iterations of the thin films' solve (docs/GRID.md "Thin films")
   bool window_moved = false;
 };
 
@@ -221,7 +220,7 @@ class Grid {
   }
   /// The layers holding paint or particles now, or liquid before the advection: extent_.
   void find_extent();
-  /// Thin films (GridParams::film_max): their lubrication flow over dt, the pressure implicit.
+  /// Thin films (GridParams::film_max): their lubrication flow over dt, in explicit sub-steps.
   void flow_film(float dt);
   /// The maxima of grid_column_tops (wet paint and particles above `trace`) into advect_max_'s six
   /// slots from `slot`: the paint's top, the joint top, then x, -x, y, -y of the joint columns.
@@ -230,15 +229,6 @@ class Grid {
   void advect_paint(float dt);
   PaintWindow paint_tmp_;
   DeviceBuffer<float> film_[2];  ///< flow_film's columns (FilmField planes), this sub-step's and the next
-  /// flow_film's solve: the faces' w, e (then the transfers) and direction (FilmSolve), two
-  /// column vectors, and its CG's x, r, p, q = A p and diagonal over the faces (two a column).
-  DeviceBuffer<float> film_w_, film_e_, film_dir_;
-  DeviceBuffer<double> film_col_[2];
-  DeviceBuffer<double> film_x_, film_r_, film_p_, film_q_, film_diag_;
-  DeviceBuffer<double> film_sums_;  ///< as cg_sums_, for the film's solve
-  DeviceBuffer<uint32_t> film_go_;
-  DeviceBuffer<int64_t> film_count_;  ///< the faces (ListCount::n): two a column of the window
-  LaunchLoop film_loop_;
   SolverScratch scratch_;
   Workspace ws_;
   GridStats stats_;
@@ -283,21 +273,7 @@ class Grid {
     (GridDims d, const GridExtent* e, PaintWindowView pw, BristleField br, const float* particle_density,              \
      FlowColumns flow, float dry_threshold, float film_max, FilmFlow f, float* col),                                   \
     (d, e, pw, br, particle_density, flow, dry_threshold, film_max, f, col))                                           \
-  X(void, grid_film_surface, (GridDims d, const float* col, FilmSolve fs), (d, col, fs))                              \
-  X(void, grid_film_faces, (GridDims d, const float* col, FilmFlow f, FilmSolve fs), (d, col, f, fs))                  \
-  X(void, grid_film_rhs, (GridDims d, FilmSolve fs), (d, fs))                                                          \
-  X(void, grid_film_pressure, (GridDims d, const float* col, FilmFlow f, FilmSolve fs, CgGuard guard),               \
-    (d, col, f, fs, guard))                                                                                            \
-  X(void, grid_film_start,                                                                                             \
-    (GridDims d, const float* col, FilmFlow f, FilmSolve fs, double* diag, double* b, double* x, double* ax),         \
-    (d, col, f, fs, diag, b, x, ax))                                                                                   \
-  X(void, grid_film_outflow, (GridDims d, FilmSolve fs, const double* p, CgGuard guard), (d, fs, p, guard))            \
-  X(void, grid_film_apply,                                                                                             \
-    (GridDims d, FilmSolve fs, ListCount n, const double* p, double* q, double* pq, CgGuard guard, SumScratch s),      \
-    (d, fs, n, p, q, pq, guard, s))                                                                                    \
-  X(void, grid_film_transfers, (GridDims d, FilmSolve fs, const double* x), (d, fs, x))                                \
-  X(void, grid_film_update, (GridDims d, const float* col, const float* transfer, float share, FilmFlow f, float* next), \
-    (d, col, transfer, share, f, next))                                                                                \
+  X(void, grid_film_update, (GridDims d, const float* col, FilmFlow f, float* next), (d, col, f, next))                \
   X(void, grid_film_write, (GridDims d, PaintWindowView pw, const float* col), (d, pw, col))                           \
   X(void, grid_gravity, (GridView g, float* ph, float g_dt, float g_dt_y), (g, ph, g_dt, g_dt_y))                      \
   X(void, grid_effective_viscosity,                                                                                    \

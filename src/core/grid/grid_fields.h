@@ -109,30 +109,8 @@ struct FilmFlow {
   HerschelBulkley stiff, oily;  ///< the paint's end members (Grid::paint_end_members)
   float rho_g_cos;  ///< rho0 g cos(tilt): the pressure gradient per unit slope of the surface, Pa/m
   float rho_g_sin;  ///< rho0 g sin(tilt): the pull down the canvas (+y), Pa/m
-  float sigma_cell; ///< surface tension over the cell, Pa: the capillary pressure of a cell of curvature
   float cell;       ///< m
-  float dt;         ///< s: the step's (the solve) or a transport sub-step's
-};
-
-/// Film columns thinner than this (cells) hold no paint a surface tension pulls on: bare ground.
-constexpr float kFilmWet = 1e-3f;
-/// The film's solve stops at this relative residual (its Jacobi-preconditioned norm), or after
-/// kFilmMaxIterations: what it leaves is the levelling's rate, never the paint's mass (the
-/// transfers move what one column gives to the other).
-constexpr float kFilmTolerance = 1e-3f;
-constexpr int kFilmMaxIterations = 200;
-
-/// Grid::flow_film's solve: per column, the faces to its +x and +y neighbours at 2c and 2c + 1.
-/// w: the face's linearised mobility over the step (cells of film moved per Pa of pressure
-/// difference, 0 where the face is shut); e: what it moves whatever the pressure (the pull down
-/// the easel less the yield stress, cells); dir: the direction the paint flowed at the step's
-/// start (+1 from c, -1 into c, 0 shut). Column planes: s (the surface), and two work vectors.
-struct FilmSolve {
-  float* w;
-  float* e;
-  float* dir;
-  double* col_a;  ///< a column vector: D^T p, then the surface less what e moves
-  double* col_b;  ///< K of col_a
+  float dt;         ///< s
 };
 
 /// Per film column in Grid::flow_film's scratch: the film's thickness (cells; negative where the
@@ -216,7 +194,6 @@ struct AdvectPlan {
 struct GridRecord {
   AdvectPlan advect;
   double viscosity[6];
-  double film[6];  ///< the film's solve: as viscosity (r.z, next r.z, p.Ap, b.D^-1 b, iterations)
 };
 
 /// Whether the passes of a step before its pass n (the axes in `order`: 0 x y z, 1 z y x) left

@@ -559,187 +559,28 @@ void grid_film_columns(GridDims d, const GridExtent* e, PaintWindowView pw, Bris
   });
 }
 
-namespace detail {
-/// On the CPU backend the device's sums are the host's memory: an iteration launched past
-/// convergence returns before its pass (on CUDA its threads return at once).
-inline bool cpu_past_convergence(const CgGuard& guard) {
-#if defined(__CUDACC__)
-  (void)guard;
-  return false;
-#else
-  return !guard.active();
-#endif
-}
-}  // namespace detail
-
-// The step's flow of the films is solved implicitly for the pressure (docs/GRID.md "Thin
-// films"): the transfer t_f across each open face f = (a, b) is w_f (P'_a - P'_b) + e_f, with P' =
-// K s' the film's pressure at the step's end (hydrostatic head plus capillary pressure of the
-// surface s' = base + h') and s' = s - D^T t (D^T: each column's net outflow). With x = t - e this
-// is (W^-1 + D K D^T) x = D K (s - D^T e): symmetric positive definite, solved by the grid's
-// Jacobi-preconditioned CG (grid_pcg_*) on the faces, two per column (2c: +x, 2c + 1: +y).
-
-namespace detail {
-/// A film column that holds paint, which its surface tension pulls on.
-WB_HD WB_INLINE bool film_wet(const float* col, int64_t n, int64_t c) { return col[kFilmH * n + c] > kFilmWet; }
-
-/// The column a face of column c leads to (k 0: +x, 1: +y), -1 at the window's edge.
-WB_HD WB_INLINE int64_t film_across(const GridDims& d, int64_t c, int k) {
-  if (k == 0) return int(c % d.nx) + 1 < d.nx ? c + 1 : -1;
-  return int(c / d.nx) + 1 < d.ny ? c + d.nx : -1;
+/// Thickness (cells) a film face carries in a sub-step from column a to b (negative: b to a).
+/// A gravity-driven Bingham film (Liu & Mei, J. Fluid Mech. 207, 505, 1989): with the driving
+/// gradient G (Pa/m) the base's shear stress is G h; below the yield stress nothing flows; above it
+/// the paint shears below the plug's height Y = h - tau_y / G and the flux is G Y^2 (3h - Y) / (6 K),
+/// the upwind column's h, tau_y and K (n taken as 1: the oily paint that flows is nearly Newtonian).
+/// At most a quarter of the upwind film leaves through one face a sub-step (it has four).
+WB_HD WB_INLINE float film_face(const float* col, int64_t n, int64_t a, int64_t b, float pull, const FilmFlow& f) {
+  const float ha = col[kFilmH * n + a], hb = col[kFilmH * n + b];
+  if (ha < 0.f || hb < 0.f) return 0.f;
+  const float slope = (col[kFilmBase * n + b] + hb) - (col[kFilmBase * n + a] + ha);  // cells per cell
+  const float G = f.rho_g_cos * slope - pull;  // dp/ds along a -> b, Pa/m: the paint flows down it
+  const int64_t u = G > 0.f ? b : a;
+  const float hu = col[kFilmH * n + u];
+  const float Gm = fabsf(G), h = hu * f.cell, tau_y = col[kFilmTau * n + u];
+  if (!(Gm * h > tau_y)) return 0.f;
+  const float Y = h - tau_y / Gm;
+  const float q = Gm * Y * Y * (3.f * h - Y) / (6.f * col[kFilmK * n + u]);  // m^2/s
+  const float t = minf(q * f.dt / (f.cell * f.cell), 0.25f * hu);
+  return G > 0.f ? -t : t;
 }
 
-/// Wet neighbours of a wet column (0 for one that holds no paint): the capillary stencil's degree.
-WB_HD WB_INLINE int film_degree(const GridDims& d, const float* col, int64_t n, int64_t c) {
-  if (!film_wet(col, n, c)) return 0;
-  const int i = int(c % d.nx), j = int(c / d.nx);
-  return (i > 0 && film_wet(col, n, c - 1)) + (i + 1 < d.nx && film_wet(col, n, c + 1)) +
-         (j > 0 && film_wet(col, n, c - d.nx)) + (j + 1 < d.ny && film_wet(col, n, c + d.nx));
-}
-
-/// (K u)_c, Pa: the hydrostatic head rho0 g cos(tilt) u_c of a surface u (cells) plus its capillary
-/// pressure -sigma lap(u), the five-point Laplacian over the wet neighbours of a wet column. A
-/// paint's edge on bare ground is pinned: surface tension does not pull it out over the ground.
-WB_HD WB_INLINE double film_pressure(const GridDims& d, const float* col, int64_t n, int64_t c, const double* u,
-                                     const FilmFlow& f) {
-  double p = double(f.rho_g_cos) * double(f.cell) * u[c];
-  if (!(f.sigma_cell > 0.f) || !film_wet(col, n, c)) return p;
-  const int i = int(c % d.nx), j = int(c / d.nx);
-  const int64_t nb[4] = {i > 0 ? c - 1 : -1, i + 1 < d.nx ? c + 1 : -1, j > 0 ? c - d.nx : -1,
-                         j + 1 < d.ny ? c + d.nx : -1};
-  for (int64_t b : nb)
-    if (b >= 0 && film_wet(col, n, b)) p += double(f.sigma_cell) * (u[c] - u[b]);
-  return p;
-}
-
-/// Net outflow of column c through its four faces, of a face vector v (2c: +x, 2c + 1: +y).
-template <typename T>
-WB_HD WB_INLINE double film_outflow(const GridDims& d, int64_t c, const T* v) {
-  const int i = int(c % d.nx), j = int(c / d.nx);
-  double out = double(v[2 * c]) + double(v[2 * c + 1]);
-  if (i > 0) out -= double(v[2 * (c - 1)]);
-  if (j > 0) out -= double(v[2 * (c - d.nx) + 1]);
-  return out;
-}
-}  // namespace detail
-
-void grid_film_surface(GridDims d, const float* col, FilmSolve fs) {
-  const int64_t n = int64_t(d.nx) * d.ny;
-  parallel_for(n, [=] WB_HD(int64_t c) {
-    const float h = col[kFilmH * n + c];
-    fs.col_a[c] = h >= 0.f ? double(col[kFilmBase * n + c]) + double(h) : 0.0;
-  });
-}
-
-void grid_film_faces(GridDims d, const float* col, FilmFlow f, FilmSolve fs) {
-  const int64_t n = int64_t(d.nx) * d.ny;
-  parallel_for(n, [=] WB_HD(int64_t c) {
-    for (int k = 0; k < 2; ++k) {
-      const int64_t a = c, b = detail::film_across(d, c, k);
-      fs.w[2 * c + k] = 0.f, fs.e[2 * c + k] = 0.f, fs.dir[2 * c + k] = 0.f;
-      if (b < 0 || col[kFilmH * n + a] < 0.f || col[kFilmH * n + b] < 0.f) continue;  // no film: shut
-      // The force driving the paint from a to b at the step's start, Pa/m: the pressure's fall
-      // over the cell, and the pull down the easel across the +y faces.
-      const float pull = k == 1 ? f.rho_g_sin : 0.f;
-      const float F = float((detail::film_pressure(d, col, n, a, fs.col_a, f) -
-                             detail::film_pressure(d, col, n, b, fs.col_a, f)) /
-                            double(f.cell)) +
-                      pull;
-      const int64_t u = F > 0.f ? a : b;
-      const float Fm = fabsf(F), h = col[kFilmH * n + u] * f.cell, tau_y = col[kFilmTau * n + u];
-      // A Bingham film (Liu & Mei, J. Fluid Mech. 207, 505, 1989): below the yield stress at its
-      // base nothing flows; above it the paint shears below the plug's height Y = h - tau_y / F
-      // and carries q = F Y^2 (3h - Y) / (6K) (m^2/s), the upwind column's h, tau_y and K.
-      if (!(Fm * h > tau_y)) continue;
-      const float Y = h - tau_y / Fm;
-      const float q = Fm * Y * Y * (3.f * h - Y) / (6.f * col[kFilmK * n + u]);
-      // Linearised over the step through the yield point: q = M (F - tau_y / h) in the flow's
-      // direction, exact at the step's start and where the flow stops.
-      const float M = q / (Fm - tau_y / h);
-      const float s = F > 0.f ? 1.f : -1.f;
-      const float w = f.dt * M / (f.cell * f.cell * f.cell);  // cells of film per Pa
-      fs.w[2 * c + k] = w;
-      fs.e[2 * c + k] = w * f.cell * (pull - s * tau_y / h);
-      fs.dir[2 * c + k] = s;
-    }
-  });
-}
-
-void grid_film_rhs(GridDims d, FilmSolve fs) {
-  // The surface less what the faces move whatever the pressure: s - D^T e.
-  parallel_for(int64_t(d.nx) * d.ny, [=] WB_HD(int64_t c) { fs.col_a[c] -= detail::film_outflow(d, c, fs.e); });
-}
-
-void grid_film_pressure(GridDims d, const float* col, FilmFlow f, FilmSolve fs, CgGuard guard) {
-  if (detail::cpu_past_convergence(guard)) return;
-  const int64_t n = int64_t(d.nx) * d.ny;
-  parallel_for(n, [=] WB_HD(int64_t c) {
-    if (!guard.active()) return;
-    fs.col_b[c] = detail::film_pressure(d, col, n, c, fs.col_a, f);
-  });
-}
-
-void grid_film_start(GridDims d, const float* col, FilmFlow f, FilmSolve fs, double* diag, double* b, double* x,
-                     double* ax) {
-  // b = D K (s - D^T e) on the open faces; the diagonal of W^-1 + D K D^T; x = 0, so A x = 0.
-  const int64_t n = int64_t(d.nx) * d.ny;
-  parallel_for(2 * n, [=] WB_HD(int64_t e) {
-    const int64_t a = e / 2, c = detail::film_across(d, a, int(e % 2));
-    const float w = fs.w[e];
-    x[e] = 0.0, ax[e] = 0.0;
-    if (!(w > 0.f)) {
-      diag[e] = 1.0, b[e] = 0.0;
-      return;
-    }
-    const bool both = detail::film_wet(col, n, a) && detail::film_wet(col, n, c);
-    const double cap = double(f.sigma_cell) * double(detail::film_degree(d, col, n, a) +
-                                                     detail::film_degree(d, col, n, c) + (both ? 2 : 0));
-    diag[e] = 1.0 / double(w) + 2.0 * double(f.rho_g_cos) * double(f.cell) + cap;
-    b[e] = fs.col_b[a] - fs.col_b[c];
-  });
-}
-
-void grid_film_outflow(GridDims d, FilmSolve fs, const double* p, CgGuard guard) {
-  if (detail::cpu_past_convergence(guard)) return;
-  parallel_for(int64_t(d.nx) * d.ny, [=] WB_HD(int64_t c) {
-    if (!guard.active()) return;
-    fs.col_a[c] = detail::film_outflow(d, c, p);
-  });
-}
-
-void grid_film_apply(GridDims d, FilmSolve fs, ListCount n, const double* p, double* q, double* pq, CgGuard guard,
-                     SumScratch s) {
-  if (detail::cpu_past_convergence(guard)) return;
-  parallel_sum_count(
-      n.n, n.capacity,
-      [=] WB_HD(int64_t e) {
-        if (!guard.active()) return 0.0;
-        const float w = fs.w[e];
-        q[e] = w > 0.f ? p[e] / double(w) + fs.col_b[e / 2] - fs.col_b[detail::film_across(d, e / 2, int(e % 2))]
-                       : p[e];
-        return p[e] * q[e];
-      },
-      pq, s);
-}
-
-void grid_film_transfers(GridDims d, FilmSolve fs, const double* x) {
-  // t = x + e. A face whose solved flow runs against the step's start has passed its yield point
-  // (the linearised law would pull paint back up): it stops there.
-  parallel_for(2 * int64_t(d.nx) * d.ny, [=] WB_HD(int64_t e) {
-    const float t = float(x[e]) + fs.e[e];
-    fs.e[e] = t * fs.dir[e] > 0.f ? t : 0.f;
-  });
-}
-
-/// Thickness (cells) face a -> b carries in a transport sub-step: its share t of the step's
-/// transfer (negative: b to a), at most a quarter of the upwind film (the column has four faces).
-WB_HD WB_INLINE float film_carry(const float* col, int64_t n, int64_t a, int64_t b, float t) {
-  const float hu = col[kFilmH * n + (t > 0.f ? a : b)];
-  if (!(hu > 0.f)) return 0.f;
-  return t > 0.f ? minf(t, 0.25f * hu) : -minf(-t, 0.25f * hu);
-}
-
-void grid_film_update(GridDims d, const float* col, const float* transfer, float share, FilmFlow f, float* next) {
+void grid_film_update(GridDims d, const float* col, FilmFlow f, float* next) {
   const int64_t n = int64_t(d.nx) * d.ny;
   parallel_for(n, [=] WB_HD(int64_t c) {
     // A column that is no film keeps only what its neighbours and the write read of it.
@@ -753,10 +594,10 @@ void grid_film_update(GridDims d, const float* col, const float* transfer, float
     // compute its transfer from the same values, bit for bit, so what one gains the other loses;
     // the window's own edges carry nothing.
     const int64_t from[4] = {c - 1, c + 1, c - d.nx, c + d.nx};
-    const float in[4] = {i > 0 ? film_carry(col, n, from[0], c, share * transfer[2 * from[0]]) : 0.f,
-                         i + 1 < d.nx ? -film_carry(col, n, c, from[1], share * transfer[2 * c]) : 0.f,
-                         j > 0 ? film_carry(col, n, from[2], c, share * transfer[2 * from[2] + 1]) : 0.f,
-                         j + 1 < d.ny ? -film_carry(col, n, c, from[3], share * transfer[2 * c + 1]) : 0.f};
+    const float in[4] = {i > 0 ? film_face(col, n, from[0], c, 0.f, f) : 0.f,
+                         i + 1 < d.nx ? -film_face(col, n, c, from[1], 0.f, f) : 0.f,
+                         j > 0 ? film_face(col, n, from[2], c, f.rho_g_sin, f) : 0.f,
+                         j + 1 < d.ny ? -film_face(col, n, c, from[3], f.rho_g_sin, f) : 0.f};
     float out = 0.f, gain = 0.f;
     for (int s = 0; s < 4; ++s) out += in[s] < 0.f ? -in[s] : 0.f, gain += in[s] > 0.f ? in[s] : 0.f;
     if (out == 0.f && gain == 0.f) return;
@@ -872,6 +713,18 @@ void grid_viscous_setup(GridView g, const uint32_t* list, ListCount n, const uin
   });
 }
 
+namespace detail {
+/// On the CPU backend the device's sums are the host's memory: an iteration launched past
+/// convergence returns before its pass (on CUDA its threads return at once).
+inline bool cpu_past_convergence(const CgGuard& guard) {
+#if defined(__CUDACC__)
+  (void)guard;
+  return false;
+#else
+  return !guard.active();
+#endif
+}
+}  // namespace detail
 
 void grid_viscous_apply(ListCount n, const float* nu, const int32_t* nb, const double* diag, const double* p,
                         double* q, double* pq, CgGuard guard, SumScratch s) {

@@ -87,11 +87,6 @@ struct GridParams {
   /// it has no pressure across it. Default 2 (0.4 mm), range [0, 4] (its explicit sub-steps grow as
   /// the cube: 7 a 1/60 s step at 2 cells, 56 at 4); 0 turns the film off.
   float film_max = 2.f;
-  /// Surface tension of the paint's free surface, N/m: the capillary pressure -sigma lap(s) of a
-  /// thin film's surface s, which levels brush marks in oily paint and not in paint whose yield
-  /// stress holds them (docs/GRID.md "Thin films"). Default 0.033 (linseed oil and oil paints:
-  /// 0.03-0.035 N/m), range [0, 0.1]; 0: gravity alone.
-  float surface_tension = 0.033f;
   /// Gravity in the canvas frame, cells/s^2: (0, g sin(tilt), -g cos(tilt)).
   Vec3 gravity_vector() const {
     const float a = tilt * (3.14159265f / 180.f);
