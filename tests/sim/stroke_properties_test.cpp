@@ -38,6 +38,7 @@ struct Stroke {
   float end = kX1;         ///< where the stroke lifts, cells
   int window_xy = 0;       ///< active window X and Y, cells (0: the scene's)
   SimCounters* counters = nullptr;  ///< receives the simulator's counters after the stroke
+  bool travel_back = false;  ///< after the lift, the lifted brush goes back to the start in one step
 };
 
 /// Power of the spectrum of v[i0, i0 + n) at bin k, after removing its least-squares quadratic
@@ -159,6 +160,14 @@ class StrokePropertiesTest : public SimulatorTest {
       x += v * dt;
     }
     for (int i = 0; i < lift; ++i) sim.step(pose(st.end, 0.f, false), dt);
+    if (st.travel_back) {
+      // Lifted all the way, a sub-step a brush length (StrokePlayer::lifted_move_limit).
+      const int n = int(std::ceil((st.end - kX0) / c.brush.length));
+      std::vector<BrushPose> back;
+      for (int k = 1; k <= n; ++k) back.push_back(pose(st.end + (kX0 - st.end) * float(k) / float(n), 0.f, false));
+      sim.step(back.data(), n, dt);
+      for (int i = 0; i < lift; ++i) sim.step(pose(kX0, 0.f, false), dt);
+    }
     if (std::getenv("WB_STROKE_TOTALS")) {
       const TransferTotals& t = sim.books().totals();
       std::printf("dt %.4f: emitted %.4g kg (%lld), absorbed %.4g (%lld), to_grid %.4g, to_particles %.4g, bristles left %.4g\n",
@@ -508,9 +517,20 @@ TEST_F(StrokePropertiesTest, WindowMovesReturnNoParticlesWhereTheParticleZoneFit
               (long long)fit.returned_at_moves, (long long)fit.zone_cut_steps, (long long)fit.steps,
               (long long)cut.returned_at_moves, (long long)cut.zone_cut_steps);
   EXPECT_EQ(fit.zone_cut_steps, 0) << "the 128-cell window holds the small brush and its zone";
+  // The lifted brush's travel back over the stroke spans more than the window: it goes in parts,
+  // and its zone, on paper cut, returns nothing at the moves (no warning names a larger window).
+  SimCounters back;
+  st.counters = &back;
+  st.window_xy = 128;
+  st.travel_back = true;
+  paint_stroke(st);
+  EXPECT_GT(back.split_steps, 0) << "the travel takes more than the window";
+  EXPECT_EQ(back.zone_cut_steps, 0) << "a lifted brush's travel cuts no zone that shows";
   EXPECT_GT(cut.zone_cut_steps, 0);
   EXPECT_LE(cut.zone_cut_steps, cut.steps) << "only steps count (the first placement is not one)";
-  EXPECT_LT(double(fit.returned_at_moves), 0.03 * double(std::max<int64_t>(cut.returned_at_moves, 1)));
+  // A twentieth at most: the fit window's returns vary from run to run with the order of the
+  // threads' atomic sums, 954-1137 against 37.5-37.8 K (2.5-3.0 %).
+  EXPECT_LT(double(fit.returned_at_moves), 0.05 * double(std::max<int64_t>(cut.returned_at_moves, 1)));
   const int n = kBody1 - kBody0, snap = small_config().params.grid.window_snap;
   EXPECT_LT(peak_ratio(v, kBody0, n, n / snap), 4.0) << "a peak at the window snap's period";
 }

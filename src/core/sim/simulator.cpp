@@ -648,10 +648,7 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
       ++counters_.box_reads;
     }
     resting = w.resting;
-    if (config_.particles) {
-      counters_.zone_cut_steps += w.zone_room < 0.f;
-      counters_.zone_room_min = std::min(counters_.zone_room_min, w.zone_room);
-    }
+    zone_room_ = w.zone_room;
     if (particles_.size() > 0) deposit_leaving_particles(w.origin);
     grid_->move_window(w.origin);
     grid_->set_flow_columns(w.flow);
@@ -714,6 +711,12 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
     running_.reset();
     if (resting && m[0] >= -m[1] && m[2] >= -m[3]) running_ = std::array<float, 4>{-m[1], m[0], -m[3], m[2]};
     counters_.returned_at_moves += rec.to_grid_at_moves;
+    // A cut zone counts where the window's move returned particles: the bands it lays. A lifted
+    // brush travelling farther than the window holds cuts it on paper and returns nothing.
+    if (config_.particles && zone_room_ < 0.f && rec.to_grid_at_moves > 0) {
+      ++counters_.zone_cut_steps;
+      counters_.zone_room_min = std::min(counters_.zone_room_min, zone_room_);
+    }
     box_ = box_from(last_record_.extent);
     box_miss_ = 0.f;
     for (int k = 0; k < 4; ++k) box_miss_ = std::max(box_miss_, std::abs(box_[k] - guess_[k]));

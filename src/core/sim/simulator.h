@@ -48,7 +48,8 @@ struct SimCounters {
   int64_t nonfinite_events = 0;  ///< steps whose state went non-finite and were contained
   int64_t particles_max = 0;
   /// Steps whose particle zone, at D0's floor, did not fit the window's kept box around the
-  /// samples (the brush is too large for its window: Simulator::place_window).
+  /// samples (the brush is too large for its window: Simulator::place_window) and whose window
+  /// move returned particles to the grid.
   int64_t zone_cut_steps = 0;
   /// Step parts whose window was placed on the samples' box read back at once, not on the last
   /// step's box moved by the pen (that box, widened by its last miss, would reach the window's
@@ -58,7 +59,7 @@ struct SimCounters {
   /// the parts they took in all.
   int64_t split_steps = 0;
   int64_t step_parts = 0;
-  /// The least room seen for D0 around the samples, cells (negative: the zone was cut).
+  /// The least room for D0 around the samples of the steps zone_cut_steps counts, cells.
   float zone_room_min = 1e30f;
   /// Particles returned to the grid because the window moved off them (deposit_leaving_particles):
   /// where the zone fits, only the slow ones beyond it that the step's own pass would return.
@@ -305,6 +306,7 @@ class Simulator {
   std::array<float, 2> slid_{};
   std::array<float, 4> guess_{};                 ///< this step's box as the pen's travel moves the last
   float box_miss_ = 0.f;                         ///< the last step's largest miss of guess_, cells
+  float zone_room_ = 1e30f;  ///< the step part's room for the particle zone (WindowPlace::zone_room)
   /// Top of the dried paint under the brush's footprint at the end of the last step, cells: the
   /// pen's pressure presses the brush into the surface it meets, not below the bare canvas.
   float ground_ = 0.f;
