@@ -11,6 +11,8 @@
 
 namespace wb::test {
 namespace {
+/// A window of 256 x 256 columns at the canvas's origin (swept_position keeps paint over it).
+constexpr CellField kColumns{nullptr, 256, 256, 1, 0, 0, 0};
 
 TEST(TransferCapacity, PotentialCapacityFallsWithPsiAndClampsAtMin) {
   const TransferParams p;
@@ -83,8 +85,7 @@ TEST(TransferSweep, ParticlesLayTheTrailAlongThePath) {
   const float dt = 1.f / 60.f;
   float lo = 1e9f, hi = -1e9f;
   for (int i = 0; i < 10; ++i) {
-    const Vec3 q = swept_position(x, vt, dt, 0.5f, 1.5f, i, 10, 0.5f, emission_pattern_point(i, 16), 0.f, Vec3(0, 0, 0),
-                                  Vec3(256, 256, 0));
+    const Vec3 q = swept_position(x, vt, dt, 0.5f, 1.5f, i, 10, 0.5f, emission_pattern_point(i, 16), 0.f, kColumns);
     lo = std::min(lo, q.x), hi = std::max(hi, q.x);
     EXPECT_NEAR(q.z, 2.f - 1.5f + 0.25f, 1e-5f);
   }
@@ -100,8 +101,7 @@ TEST(TransferSweep, OneParticleAStepLandsAnywhereAlongItsPath) {
   for (int64_t j : {0, 7, 4093}) {
     int bins[10] = {};
     for (int64_t step = 0; step < 2000; ++step) {
-      const Vec3 q = swept_position(x, vt, dt, 0.f, 1.5f, 0, 1, step_uniform(j, step), Vec3(), 0.f,
-                                    Vec3(0, 0, 0), Vec3(256, 256, 0));
+      const Vec3 q = swept_position(x, vt, dt, 0.f, 1.5f, 0, 1, step_uniform(j, step), Vec3(), 0.f, kColumns);
       const float u = (q.x - (x.x - vt.x * dt)) / (vt.x * dt);
       ASSERT_GE(u, 0.f);
       ASSERT_LT(u, 1.f);

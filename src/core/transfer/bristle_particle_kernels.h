@@ -207,15 +207,13 @@ WB_HD WB_INLINE int swept_count(float deposit, float travel, float emit_mass, fl
 /// that leaves one particle a step leaves it at the same point of every step's path, and the
 /// stroke is a chain of beads at the step period), across the cap's
 /// footprint (half-width a = sqrt(R_m^2 - r^2)) by pattern point `slot`, a quarter cell above
-/// the surface r_j below the sample (never below the canvas), and inside the columns [lo, hi)
-/// of the active window: particles live only there (a path that began outside the window, which
-/// moved with the brush, ends its trail at the window's wall).
+/// the surface r_j below the sample (never below the canvas), and over the active window's
+/// `columns`: particles live only there (a path that began outside the window, which moved with
+/// the brush, ends its trail at the window's wall).
 WB_HD WB_INLINE Vec3 swept_position(Vec3 x_j, Vec3 v_t, float dt, float a, float r, int i, int n, float jitter,
-                                    Vec3 pattern, float floor_z, Vec3 lo, Vec3 hi) {
+                                    Vec3 pattern, float floor_z, const CellField& columns) {
   const float u = (float(i) + jitter) / float(n);
-  Vec3 p = x_j - v_t * (dt * (1.f - u));
-  p.x = clampf(p.x + pattern.x * a, lo.x + 0.5f, hi.x - 0.5f);
-  p.y = clampf(p.y + pattern.y * a, lo.y + 0.5f, hi.y - 0.5f);
+  Vec3 p = into_columns(columns, x_j - v_t * (dt * (1.f - u)) + Vec3(pattern.x * a, pattern.y * a, 0.f));
   p.z = maxf(x_j.z - r, floor_z) + 0.25f;
   return p;
 }

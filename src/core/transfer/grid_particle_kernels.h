@@ -27,6 +27,19 @@ struct CellField {
   int ox, oy, oz;  ///< canvas cell of the field's (0,0,0)
 };
 
+/// Whether canvas point p lies over the columns of g, at any height: over the active window's,
+/// where the particles live and the swept contact lays paint.
+WB_HD WB_INLINE bool over_columns(const CellField& g, Vec3 p) {
+  return p.x >= float(g.ox) && p.x < float(g.ox + g.nx) && p.y >= float(g.oy) && p.y < float(g.oy + g.ny);
+}
+
+/// p moved over the columns of g, at least half a cell inside their walls.
+WB_HD WB_INLINE Vec3 into_columns(const CellField& g, Vec3 p) {
+  p.x = clampf(p.x, float(g.ox) + 0.5f, float(g.ox + g.nx) - 0.5f);
+  p.y = clampf(p.y, float(g.oy) + 0.5f, float(g.oy + g.ny) - 0.5f);
+  return p;
+}
+
 /// Fixed point of order-independent sums (DepositScratch): 2^-40 per unit (9e-13 of a cell,
 /// 7e-21 kg), exact for any float of at least 2^-40 and far from overflow (2^23 cells a cell).
 WB_HD WB_INLINE int64_t to_fixed(float v) { return llrintf(v * 1099511627776.f); }

@@ -34,8 +34,7 @@ void transfer_capacity(SampleView s, BristleLoadView load, CellField psi, CellFi
     // none: its trail would be put in the wall's column (swept_position keeps particles in the
     // window), a line along the wall as the window follows the stroke. Its paint stays on the
     // bristle until it is inside.
-    const bool inside = x.x >= float(density.ox) && x.x < float(density.ox + density.nx) &&
-                        x.y >= float(density.oy) && x.y < float(density.oy + density.ny);
+    const bool inside = over_columns(density, x);
     const Vec3 v = s.v[j];
     const float m = load.m[j];
     const float travel = slid_distance(v, dt);
@@ -419,7 +418,6 @@ void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, NewB
   const CellField density{pw.density, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
   const CellField dryness{pw.dryness, pw.nx, pw.ny, pw.nz, pw.ox, pw.oy, pw.oz};
   const float thr = prm.surface_density, march = prm.march_step;
-  const Vec3 lo(float(pw.ox), float(pw.oy), 0.f), hi(float(pw.ox + pw.nx), float(pw.oy + pw.ny), 0.f);
   const float cm = prm.cell_mass();
   parallel_for(load.count, [=] WB_HD(int64_t j) {
     emitted[j] = 0.f;
@@ -453,9 +451,9 @@ void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, NewB
         // (its surface more than half a cell lower than at the contact) moves to the next point
         // of the path that touches, else to the end of the path, where the contact is.
         const float reach = r + 0.5f;
-        Vec3 at = swept_position(xj, vt, dt, a, r, n_swept, n_swept, 0.f, pattern, floor_z, lo, hi);  // the end
+        Vec3 at = swept_position(xj, vt, dt, a, r, n_swept, n_swept, 0.f, pattern, floor_z, density);  // the end
         for (int t = 0; t < n_swept; ++t) {
-          const Vec3 cand = swept_position(xj, vt, dt, a, r, (q + t) % n_swept, n_swept, jitter, pattern, floor_z, lo, hi);
+          const Vec3 cand = swept_position(xj, vt, dt, a, r, (q + t) % n_swept, n_swept, jitter, pattern, floor_z, density);
           if (surface_distance(Vec3(cand.x, cand.y, xj.z), reach + march, floor_z, density, thr, march, dryness,
                                dry_threshold) <= reach) {
             at = cand;
