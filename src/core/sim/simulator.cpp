@@ -629,6 +629,7 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
   const Vec3 tips_before = footprint_centre(brush_->pose(), config_.brush.length);
   brush_stage(poses, substeps, dt);
   bool resting = false;
+  float zone_room = 1e30f;  // this part's room for the particle zone (WindowPlace::zone_room)
 
   // --- 3. Window: follow the brush; rasterise the bristles into it (boundary of §4.2) -----
   {
@@ -648,7 +649,7 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
       ++counters_.box_reads;
     }
     resting = w.resting;
-    zone_room_ = w.zone_room;
+    zone_room = w.zone_room;
     if (particles_.size() > 0) deposit_leaving_particles(w.origin);
     grid_->move_window(w.origin);
     grid_->set_flow_columns(w.flow);
@@ -713,9 +714,9 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
     counters_.returned_at_moves += rec.to_grid_at_moves;
     // A cut zone counts where the window's move returned particles: the bands it lays. A lifted
     // brush travelling farther than the window holds cuts it on paper and returns nothing.
-    if (config_.particles && zone_room_ < 0.f && rec.to_grid_at_moves > 0) {
+    if (config_.particles && zone_room < 0.f && rec.to_grid_at_moves > 0) {
       ++counters_.zone_cut_steps;
-      counters_.zone_room_min = std::min(counters_.zone_room_min, zone_room_);
+      counters_.zone_room_min = std::min(counters_.zone_room_min, zone_room);
     }
     box_ = box_from(last_record_.extent);
     box_miss_ = 0.f;

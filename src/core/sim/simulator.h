@@ -306,7 +306,6 @@ class Simulator {
   std::array<float, 2> slid_{};
   std::array<float, 4> guess_{};                 ///< this step's box as the pen's travel moves the last
   float box_miss_ = 0.f;                         ///< the last step's largest miss of guess_, cells
-  float zone_room_ = 1e30f;  ///< the step part's room for the particle zone (WindowPlace::zone_room)
   /// Top of the dried paint under the brush's footprint at the end of the last step, cells: the
   /// pen's pressure presses the brush into the surface it meets, not below the bare canvas.
   float ground_ = 0.f;
