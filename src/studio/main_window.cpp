@@ -471,7 +471,6 @@ void MainWindow::build_menus() {
 
 void MainWindow::push_clock(const ClockOutput& out) {
   sim_->push(out);
-  if (!out.samples.empty()) dirty_ = dirty_ || false;
 }
 
 void MainWindow::carry_brush(bool to_palette) {

@@ -75,6 +75,48 @@ TEST_F(SessionTest, AStrokeIsOneUndoUnitAndRedoPutsItBack) {
   EXPECT_FALSE(s.redo());
 }
 
+TEST_F(SessionTest, LiftedStepsBetweenStrokesAreNoStrokeOfTheirOwn) {
+  // Two strokes of a recording with the brush's lifted travel between them, each step followed by
+  // end_stroke as a painting program does whenever it has caught up with the pen and the pen is
+  // up. The travel (the first stroke's paint still landing, the window following the brush) is
+  // no undo step of its own: two strokes, two undos.
+  Session s(small_config(), 4);
+  const auto pen = [](double t, float x, float y, bool down) {
+    PenSample p;
+    p.t = t, p.x = x, p.y = y, p.pressure = down ? 0.7f : 0.f, p.down = down;
+    return p;
+  };
+  Stroke rec;
+  rec.canvas = s.dims();
+  rec.brush = s.config().brush;
+  rec.paint = red();
+  rec.samples = {pen(0.0, 100, 100, true), pen(0.3, 140, 100, true), pen(0.32, 140, 100, false),
+                 pen(0.9, 100, 160, false), pen(0.95, 100, 160, true), pen(1.25, 140, 160, true),
+                 pen(1.27, 140, 160, false)};
+  rec.source = "test";
+  StrokePlayer player(rec);
+  s.begin_stroke(player.pose_at(player.t_begin()), rec.paint);
+  PlayerStep st;
+  int records = 0, lifted_ends = 0;
+  FloatImage first;
+  while (player.next(st)) {
+    s.step(player, st, st.events, st.pen_down_edge);
+    if (st.pen_down) continue;
+    const bool kept = s.end_stroke();
+    records += kept;
+    if (kept && records == 1) first = s.height_map();
+    lifted_ends += st.t > 0.5 && st.t < 0.9;
+  }
+  EXPECT_GT(lifted_ends, 10) << "end_stroke was asked during the travel";
+  EXPECT_EQ(records, 2);
+  ASSERT_TRUE(s.undo());
+  const double after_undo = max_difference(s.height_map(), first);
+  ASSERT_TRUE(s.undo());
+  EXPECT_FALSE(s.undo()) << "two strokes, two undos";
+  EXPECT_LT(total(s.height_map()), 1e-3);
+  EXPECT_LT(after_undo, 1e-3) << "one undo goes back to the first stroke's painting";
+}
+
 TEST_F(SessionTest, ASavedPaintingOpensWithItsBrushPaperAndPaint) {
   SimConfig c = small_config();
   c.params.render.paper_rgb = Vec3(0.8f, 0.7f, 0.6f);

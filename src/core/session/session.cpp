@@ -184,12 +184,14 @@ void Session::capture_before_step(const BrushPose& to) {
 void Session::step(const BrushPose* poses, int substeps, float dt) {
   WB_REQUIRE(substeps >= 1, "Session::step: at least one pose");
   if (undo_levels_ > 0) capture_before_step(poses[substeps - 1]);
+  record_painted_ = true;  // poses carry no contact: any of them may touch
   sim_->step(poses, substeps, dt);
 }
 
 void Session::step(const StrokePlayer& player, const PlayerStep& step, std::span<const StrokeEvent> events,
                    bool reload) {
   if (undo_levels_ > 0) capture_before_step(player.pose_at(step.t));
+  record_painted_ = record_painted_ || step.pen_down;
   for (const StrokeEvent& e : events)
     if (e.kind == StrokeEventKind::Dry) reset_undo_records();
   drive_step(*sim_, player, step, events, reload, poses_);
@@ -206,8 +208,10 @@ void Session::apply(const StrokeEvent& event) {
 }
 
 bool Session::end_stroke() {
-  if (!record_open_) return false;
-  record_open_ = false;
+  // A record of lifted steps alone (the brush's travel, the last stroke's paint landing) is no
+  // stroke: it stays open, and the next stroke's undo takes it too.
+  if (!record_open_ || !record_painted_) return false;
+  record_open_ = record_painted_ = false;
   TileDiff diff;
   const Int3 o = sim_->grid().window().origin(), n = sim_->grid().window().dims();
   sim_->with_settled_canvas([&](TileStore& c) {
@@ -226,7 +230,7 @@ bool Session::end_stroke() {
 CanvasRect Session::restore(const TileDiff& d, bool after) {
   sim_->replace_canvas([&](TileStore& c) { after ? d.apply_after(c) : d.apply_before(c); });
   recorder_.reset();
-  record_open_ = false;
+  record_open_ = record_painted_ = false;
   int x0 = 1 << 30, y0 = 1 << 30, x1 = -1, y1 = -1;
   const int tiles_x = sim_->canvas().tiles_x();
   for (const TileSnapshot& t : d.before) {
@@ -255,7 +259,7 @@ void Session::abandon_stroke() {
   replay_.reset();
   player_.reset();
   const std::vector<TileSnapshot> before = recorder_.take_before();
-  record_open_ = false;
+  record_open_ = record_painted_ = false;
   std::unique_ptr<Simulator> old = std::move(sim_);
   const SimConfig& config = old->config();
   sim_ = std::make_unique<Simulator>(config, rest_pose(config));
@@ -267,7 +271,7 @@ void Session::abandon_stroke() {
 
 void Session::reset_undo_records() {
   recorder_.reset();
-  record_open_ = false;
+  record_open_ = record_painted_ = false;
   undo_.clear();
   redo_.clear();
 }

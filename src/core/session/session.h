@@ -102,7 +102,8 @@ class Session {
   /// A palette event (dip, wipe, clean, dry). Drying starts a new undo history: restoring wet
   /// tiles over the dried layer would undo the drying too.
   void apply(const StrokeEvent& event);
-  /// The stroke is over: its undo record is kept when the canvas changed (true).
+  /// The stroke is over: its undo record is kept when the pen came down in it and the canvas
+  /// changed (true). Lifted steps alone stay in the open record, for the next stroke's undo.
   bool end_stroke();
   bool can_undo() const { return !undo_.empty(); }
   bool can_redo() const { return !redo_.empty(); }
@@ -181,6 +182,7 @@ class Session {
   int undo_levels_ = 0;
   StrokeTileRecorder recorder_;
   bool record_open_ = false;
+  bool record_painted_ = false;  ///< the open record has a step with the pen down
   std::deque<TileDiff> undo_, redo_;
   std::vector<BrushPose> poses_;  ///< a step's sub-step poses (reused)
   std::unique_ptr<StrokePlayer> player_;
