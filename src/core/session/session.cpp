@@ -313,6 +313,8 @@ void Session::begin_replay(const Stroke& stroke) {
 
 bool Session::advance() {
   WB_REQUIRE(replay_ != nullptr, "Session::advance: no replay was begun");
+  // A stroke file is one undo unit, lifted steps and all.
+  record_painted_ = true;
   const bool more = undo_levels_ > 0 ? replay_->advance([this](const BrushPose& end) { capture_before_step(end); })
                                      : replay_->advance();
   if (more) return true;
