@@ -295,17 +295,33 @@ std::vector<int> TileStore::allocated_tile_ids() const {
   return {tile_of_slot_.begin(), tile_of_slot_.end()};
 }
 
+bool TileStore::tile_allocated(int tile_id) const {
+  WB_REQUIRE(tile_id >= 0 && size_t(tile_id) < host_slot_.size(), "tile_allocated: tile id out of range");
+  sync_host();
+  return host_slot_[size_t(tile_id)] >= 0;
+}
+
 TileData TileStore::read_tile(int tile_id) const {
+  TileData d;
+  read_tile(tile_id, d);
+  return d;
+}
+
+void TileStore::read_tile(int tile_id, TileData& d) const {
   WB_REQUIRE(tile_id >= 0 && size_t(tile_id) < host_slot_.size(), "read_tile: tile id out of range");
   sync_host();
-  TileData d;
   d.tile_x = tile_id % tiles_x_;
   d.tile_y = tile_id / tiles_x_;
   const size_t n = size_t(tile_cells());
-  d.density.assign(n, 0.f);
-  for (auto* v : {&d.pigment_r, &d.pigment_y, &d.pigment_b, &d.oil, &d.dryness}) v->assign(n, 0);
   const int32_t slot = host_slot_[size_t(tile_id)];
-  if (slot < 0) return d;
+  if (slot < 0) {
+    d.density.assign(n, 0.f);
+    for (auto* v : {&d.pigment_r, &d.pigment_y, &d.pigment_b, &d.oil, &d.dryness}) v->assign(n, 0);
+    return;
+  }
+  // Every element is copied over: a vector of the right size keeps its memory as it is.
+  d.density.resize(n);
+  for (auto* v : {&d.pigment_r, &d.pigment_y, &d.pigment_b, &d.oil, &d.dryness}) v->resize(n);
   const size_t at = size_t(slot) * n;
   density_.copy_range_to_host(d.density.data(), at, n);
   pigment_r_.copy_range_to_host(d.pigment_r.data(), at, n);
@@ -317,7 +333,6 @@ TileData TileStore::read_tile(int tile_id) const {
   if (lag > 0.f)
     for (size_t i = 0; i < n; ++i)
       if (d.density[i] > 0.f) d.dryness[i] = encode_unorm16(with_drying(decode_unorm16(d.dryness[i]), lag));
-  return d;
 }
 
 void TileStore::write_tile(const TileData& d) {

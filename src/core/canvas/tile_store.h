@@ -141,7 +141,11 @@ class TileStore {
   PaintCell read_cell(int x, int y, int z) const;
   /// Ids (ty * tiles_x + tx) of the allocated tiles, in slot order.
   std::vector<int> allocated_tile_ids() const;
+  /// Whether tile `tile_id` is allocated (a lookup in the slot table).
+  bool tile_allocated(int tile_id) const;
   TileData read_tile(int tile_id) const;
+  /// read_tile into `d`, reusing its vectors' memory (a caller reading many tiles).
+  void read_tile(int tile_id, TileData& d) const;
   /// Writes a whole tile (allocating it); sizes must be tile_cells().
   void write_tile(const TileData& data);
 

@@ -6,17 +6,19 @@
 
 #include <algorithm>
 #include <cstring>
+#include <exception>
+#include <memory>
 
 #include "core/exec/error.h"
 
 namespace wb {
 namespace {
 
+/// Copies v's bytes into out at `at` and moves `at` past them.
 template <class T>
-void append(std::vector<uint8_t>& out, const std::vector<T>& v) {
-  const size_t at = out.size();
-  out.resize(at + v.size() * sizeof(T));
+void put(std::vector<uint8_t>& out, size_t& at, const std::vector<T>& v) {
   std::memcpy(out.data() + at, v.data(), v.size() * sizeof(T));
+  at += v.size() * sizeof(T);
 }
 
 template <class T>
@@ -27,9 +29,18 @@ void take(const std::vector<uint8_t>& in, size_t& at, std::vector<T>& v, size_t 
   at += n * sizeof(T);
 }
 
-bool tile_present(const TileStore& canvas, int tile_id) {
-  const auto ids = canvas.allocated_tile_ids();
-  return std::find(ids.begin(), ids.end(), tile_id) != ids.end();
+/// A thread's buffers for snapshots: a stroke's first step takes a hundred or more tiles (the
+/// whole ground of a primed canvas under the brush's reach), each read, packed and compressed
+/// without allocating or zeroing a tile's worth of memory, through one compression context.
+struct SnapshotScratch {
+  TileData tile;
+  std::vector<uint8_t> raw, packed;
+  std::unique_ptr<ZSTD_CCtx, size_t (*)(ZSTD_CCtx*)> cctx{ZSTD_createCCtx(), ZSTD_freeCCtx};
+};
+
+SnapshotScratch& snapshot_scratch() {
+  thread_local SnapshotScratch s;
+  return s;
 }
 
 }  // namespace
@@ -37,23 +48,26 @@ bool tile_present(const TileStore& canvas, int tile_id) {
 TileSnapshot snapshot_tile(const TileStore& canvas, int tile_id) {
   TileSnapshot s;
   s.tile_id = tile_id;
-  s.present = tile_present(canvas, tile_id);
+  s.present = canvas.tile_allocated(tile_id);
   s.clock = canvas.drying_clock();
   if (!s.present) return s;
-  const TileData d = canvas.read_tile(tile_id);
-  std::vector<uint8_t> raw;
-  raw.reserve(size_t(canvas.tile_cells()) * kCellBytes);
-  append(raw, d.density);
-  append(raw, d.pigment_r);
-  append(raw, d.pigment_y);
-  append(raw, d.pigment_b);
-  append(raw, d.oil);
-  append(raw, d.dryness);
-  s.zdata.resize(ZSTD_compressBound(raw.size()));
-  const size_t n = ZSTD_compress(s.zdata.data(), s.zdata.size(), raw.data(), raw.size(), 1);
+  SnapshotScratch& k = snapshot_scratch();
+  if (!k.cctx) WB_THROW("undo tile snapshot: zstd could not make a compression context");
+  canvas.read_tile(tile_id, k.tile);
+  const TileData& d = k.tile;
+  k.raw.resize(size_t(canvas.tile_cells()) * kCellBytes);
+  size_t at = 0;
+  put(k.raw, at, d.density);
+  put(k.raw, at, d.pigment_r);
+  put(k.raw, at, d.pigment_y);
+  put(k.raw, at, d.pigment_b);
+  put(k.raw, at, d.oil);
+  put(k.raw, at, d.dryness);
+  WB_REQUIRE(at == k.raw.size(), "undo tile snapshot: the tile's fields do not fill it");
+  k.packed.resize(ZSTD_compressBound(k.raw.size()));
+  const size_t n = ZSTD_compressCCtx(k.cctx.get(), k.packed.data(), k.packed.size(), k.raw.data(), k.raw.size(), 1);
   if (ZSTD_isError(n)) WB_THROW(std::string("undo tile snapshot: zstd: ") + ZSTD_getErrorName(n));
-  s.zdata.resize(n);
-  s.zdata.shrink_to_fit();
+  s.zdata.assign(k.packed.begin(), k.packed.begin() + std::ptrdiff_t(n));
   return s;
 }
 
@@ -63,7 +77,7 @@ void restore_tile(TileStore& canvas, const TileSnapshot& snap) {
   d.tile_x = snap.tile_id % canvas.tiles_x();
   d.tile_y = snap.tile_id / canvas.tiles_x();
   if (!snap.present) {
-    if (!tile_present(canvas, snap.tile_id)) return;
+    if (!canvas.tile_allocated(snap.tile_id)) return;
     d.density.assign(cells, 0.f);
     for (auto* v : {&d.pigment_r, &d.pigment_y, &d.pigment_b, &d.oil, &d.dryness}) v->assign(cells, 0);
     canvas.write_tile(d);
@@ -96,15 +110,38 @@ void TileDiff::apply_after(TileStore& canvas) const {
   for (const TileSnapshot& s : after) restore_tile(canvas, s);
 }
 
+namespace {
+/// Snapshots of `ids`, the tiles compressed in parallel (each thread its own buffers).
+std::vector<TileSnapshot> snapshot_tiles(const TileStore& canvas, const std::vector<int>& ids) {
+  std::vector<TileSnapshot> out(ids.size());
+  if (ids.empty()) return out;
+  canvas.tile_allocated(ids.front());  // the host's slot table brought up to date here, not in the threads
+  std::exception_ptr failed;
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int64_t i = 0; i < int64_t(ids.size()); ++i) {
+    try {
+      out[size_t(i)] = snapshot_tile(canvas, ids[size_t(i)]);
+    } catch (...) {
+#pragma omp critical(wb_undo_snapshot)
+      failed = std::current_exception();
+    }
+  }
+  if (failed) std::rethrow_exception(failed);
+  return out;
+}
+}  // namespace
+
 void StrokeTileRecorder::capture_rect(const TileStore& canvas, int x0, int y0, int x1, int y1) {
   const int tx0 = std::max(0, x0 / kTileSize), ty0 = std::max(0, y0 / kTileSize);
   const int tx1 = std::min(canvas.tiles_x() - 1, (std::max(x1, 1) - 1) / kTileSize);
   const int ty1 = std::min(canvas.tiles_y() - 1, (std::max(y1, 1) - 1) / kTileSize);
+  std::vector<int> ids;
   for (int ty = ty0; ty <= ty1; ++ty)
     for (int tx = tx0; tx <= tx1; ++tx) {
       const int id = ty * canvas.tiles_x() + tx;
-      if (!before_.count(id)) before_.emplace(id, snapshot_tile(canvas, id));
+      if (!before_.count(id)) ids.push_back(id);
     }
+  for (TileSnapshot& s : snapshot_tiles(canvas, ids)) before_.emplace(s.tile_id, std::move(s));
 }
 
 TileDiff StrokeTileRecorder::finish(const TileStore& canvas) {
@@ -112,13 +149,13 @@ TileDiff StrokeTileRecorder::finish(const TileStore& canvas) {
   std::vector<int> ids;
   for (const auto& [id, snap] : before_) ids.push_back(id);
   std::sort(ids.begin(), ids.end());
-  for (int id : ids) {
-    TileSnapshot now = snapshot_tile(canvas, id);
-    TileSnapshot& was = before_[id];
+  std::vector<TileSnapshot> now = snapshot_tiles(canvas, ids);
+  for (TileSnapshot& after : now) {
+    TileSnapshot& was = before_[after.tile_id];
     // Same compressor, same level, same input: equal bytes exactly when the tile is unchanged.
-    if (now.present == was.present && now.zdata == was.zdata) continue;
+    if (after.present == was.present && after.zdata == was.zdata) continue;
     diff.before.push_back(std::move(was));
-    diff.after.push_back(std::move(now));
+    diff.after.push_back(std::move(after));
   }
   before_.clear();
   return diff;
