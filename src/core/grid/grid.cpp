@@ -300,9 +300,9 @@ void Grid::advect(float dt) {
     classify();
     advect_paint(dt);
   });
-  // Velocity: backtrace every open face through a copy of the field, up to the layers that can
-  // hold liquid in this step. Above, no face is fluid before the projection's extrapolation
-  // writes it again, and nothing in the step reads it where there is no paint (docs/GRID.md).
+  // Velocity: backtrace every fluid face through a copy of the field, up to the layers that can
+  // hold liquid in this step; an air face keeps its extrapolated velocity, and nothing in the step
+  // reads one where there is no paint (docs/GRID.md "Advection and mass").
   for (int c = 0; c < 3; ++c)
     mem::copy_on_device(d, vel_tmp_[c].data(), v.vel[c], size_t(g.faces(c)) * sizeof(float));
   within(advect_extent_.data() + 1,

@@ -484,6 +484,9 @@ void grid_advect_velocity(GridView g, const float* u, const float* v, const floa
       g.vel[c][f] = g.solid_vel[c][f];
       return;
     }
+    // An air face keeps the velocity the last projection extrapolated to it (docs/GRID.md
+    // "Advection and mass": the paint's momentum is carried where the paint is).
+    if (!g.fluid[c][f]) return;
     d.decompose_face(c, f, i, j, k);
     const Vec3 p = backtrace(u, v, w, d, face_position(c, i, j, k), dt);
     g.vel[c][f] = sample_component(c == 0 ? u : (c == 1 ? v : w), d, c, p);
