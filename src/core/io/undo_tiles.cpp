@@ -29,33 +29,19 @@ void take(const std::vector<uint8_t>& in, size_t& at, std::vector<T>& v, size_t 
   at += n * sizeof(T);
 }
 
-/// A thread's buffers for snapshots: a stroke's first step takes a hundred or more tiles (the
-/// whole ground of a primed canvas under the brush's reach), each read, packed and compressed
+/// A thread's buffers for packing snapshots: a stroke's first step takes a hundred or more tiles
+/// (the whole ground of a primed canvas under the brush's reach), each packed and compressed
 /// without allocating or zeroing a tile's worth of memory, through one compression context.
-struct SnapshotScratch {
-  TileData tile;
+struct Packer {
   std::vector<uint8_t> raw, packed;
   std::unique_ptr<ZSTD_CCtx, size_t (*)(ZSTD_CCtx*)> cctx{ZSTD_createCCtx(), ZSTD_freeCCtx};
 };
 
-SnapshotScratch& snapshot_scratch() {
-  thread_local SnapshotScratch s;
-  return s;
-}
-
-}  // namespace
-
-TileSnapshot snapshot_tile(const TileStore& canvas, int tile_id) {
-  TileSnapshot s;
-  s.tile_id = tile_id;
-  s.present = canvas.tile_allocated(tile_id);
-  s.clock = canvas.drying_clock();
-  if (!s.present) return s;
-  SnapshotScratch& k = snapshot_scratch();
+/// The tile's fields back to back, zstd level 1. Host work only: it may run on any thread.
+std::vector<uint8_t> pack_tile(const TileData& d) {
+  thread_local Packer k;
   if (!k.cctx) WB_THROW("undo tile snapshot: zstd could not make a compression context");
-  canvas.read_tile(tile_id, k.tile);
-  const TileData& d = k.tile;
-  k.raw.resize(size_t(canvas.tile_cells()) * kCellBytes);
+  k.raw.resize(d.density.size() * kCellBytes);
   size_t at = 0;
   put(k.raw, at, d.density);
   put(k.raw, at, d.pigment_r);
@@ -67,7 +53,59 @@ TileSnapshot snapshot_tile(const TileStore& canvas, int tile_id) {
   k.packed.resize(ZSTD_compressBound(k.raw.size()));
   const size_t n = ZSTD_compressCCtx(k.cctx.get(), k.packed.data(), k.packed.size(), k.raw.data(), k.raw.size(), 1);
   if (ZSTD_isError(n)) WB_THROW(std::string("undo tile snapshot: zstd: ") + ZSTD_getErrorName(n));
-  s.zdata.assign(k.packed.begin(), k.packed.begin() + std::ptrdiff_t(n));
+  return std::vector<uint8_t>(k.packed.begin(), k.packed.begin() + std::ptrdiff_t(n));
+}
+
+/// The snapshot of tile_id without its data: whether it is allocated, and the clock.
+TileSnapshot snapshot_header(const TileStore& canvas, int tile_id) {
+  TileSnapshot s;
+  s.tile_id = tile_id;
+  s.present = canvas.tile_allocated(tile_id);
+  s.clock = canvas.drying_clock();
+  return s;
+}
+
+/// Snapshots of `ids`. The tiles are read on the calling thread (the device's copies stay on its
+/// stream, after its kernels) a batch at a time, and the batch is compressed on every core.
+std::vector<TileSnapshot> snapshot_tiles(const TileStore& canvas, const std::vector<int>& ids) {
+  constexpr size_t kBatch = 32;  // 32 tiles read ahead: 3.7 MB at a depth of 32 cells
+  std::vector<TileSnapshot> out(ids.size());
+  // The calling thread's buffers, by reference: in the parallel loop the name of a thread_local
+  // would be each worker's own.
+  thread_local std::vector<TileData> batch;
+  std::vector<TileData>& read = batch;
+  read.resize(std::min(kBatch, ids.size()));
+  for (size_t b = 0; b < ids.size(); b += kBatch) {
+    const int64_t n = int64_t(std::min(kBatch, ids.size() - b));
+    for (int64_t j = 0; j < n; ++j) {
+      TileSnapshot& s = out[b + size_t(j)] = snapshot_header(canvas, ids[b + size_t(j)]);
+      if (s.present) canvas.read_tile(s.tile_id, read[size_t(j)]);
+    }
+    std::exception_ptr failed;
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int64_t j = 0; j < n; ++j) {
+      TileSnapshot& s = out[b + size_t(j)];
+      if (!s.present) continue;
+      try {
+        s.zdata = pack_tile(read[size_t(j)]);
+      } catch (...) {
+#pragma omp critical(wb_undo_snapshot)
+        failed = std::current_exception();
+      }
+    }
+    if (failed) std::rethrow_exception(failed);
+  }
+  return out;
+}
+
+}  // namespace
+
+TileSnapshot snapshot_tile(const TileStore& canvas, int tile_id) {
+  TileSnapshot s = snapshot_header(canvas, tile_id);
+  if (!s.present) return s;
+  thread_local TileData d;
+  canvas.read_tile(tile_id, d);
+  s.zdata = pack_tile(d);
   return s;
 }
 
@@ -109,27 +147,6 @@ void TileDiff::apply_before(TileStore& canvas) const {
 void TileDiff::apply_after(TileStore& canvas) const {
   for (const TileSnapshot& s : after) restore_tile(canvas, s);
 }
-
-namespace {
-/// Snapshots of `ids`, the tiles compressed in parallel (each thread its own buffers).
-std::vector<TileSnapshot> snapshot_tiles(const TileStore& canvas, const std::vector<int>& ids) {
-  std::vector<TileSnapshot> out(ids.size());
-  if (ids.empty()) return out;
-  canvas.tile_allocated(ids.front());  // the host's slot table brought up to date here, not in the threads
-  std::exception_ptr failed;
-#pragma omp parallel for schedule(dynamic, 4)
-  for (int64_t i = 0; i < int64_t(ids.size()); ++i) {
-    try {
-      out[size_t(i)] = snapshot_tile(canvas, ids[size_t(i)]);
-    } catch (...) {
-#pragma omp critical(wb_undo_snapshot)
-      failed = std::current_exception();
-    }
-  }
-  if (failed) std::rethrow_exception(failed);
-  return out;
-}
-}  // namespace
 
 void StrokeTileRecorder::capture_rect(const TileStore& canvas, int x0, int y0, int x1, int y1) {
   const int tx0 = std::max(0, x0 / kTileSize), ty0 = std::max(0, y0 / kTileSize);
