@@ -65,8 +65,8 @@ TileSnapshot snapshot_header(const TileStore& canvas, int tile_id) {
   return s;
 }
 
-/// Snapshots of `ids`. The tiles are read on the calling thread (the device's copies stay on its
-/// stream, after its kernels) a batch at a time, and the batch is compressed on every core.
+}  // namespace
+
 std::vector<TileSnapshot> snapshot_tiles(const TileStore& canvas, const std::vector<int>& ids) {
   constexpr size_t kBatch = 32;  // 32 tiles read ahead: 3.7 MB at a depth of 32 cells
   std::vector<TileSnapshot> out(ids.size());
@@ -74,7 +74,7 @@ std::vector<TileSnapshot> snapshot_tiles(const TileStore& canvas, const std::vec
   // would be each worker's own.
   thread_local std::vector<TileData> batch;
   std::vector<TileData>& read = batch;
-  read.resize(std::min(kBatch, ids.size()));
+  if (read.size() < std::min(kBatch, ids.size())) read.resize(std::min(kBatch, ids.size()));
   for (size_t b = 0; b < ids.size(); b += kBatch) {
     const int64_t n = int64_t(std::min(kBatch, ids.size() - b));
     for (int64_t j = 0; j < n; ++j) {
@@ -98,15 +98,16 @@ std::vector<TileSnapshot> snapshot_tiles(const TileStore& canvas, const std::vec
   return out;
 }
 
-}  // namespace
+TileSnapshot snapshot_tile(const TileStore& canvas, int tile_id) { return snapshot_tiles(canvas, {tile_id}).front(); }
 
-TileSnapshot snapshot_tile(const TileStore& canvas, int tile_id) {
-  TileSnapshot s = snapshot_header(canvas, tile_id);
-  if (!s.present) return s;
-  thread_local TileData d;
-  canvas.read_tile(tile_id, d);
-  s.zdata = pack_tile(d);
-  return s;
+std::vector<int> tile_ids_in_rect(const TileStore& canvas, int x0, int y0, int x1, int y1) {
+  const int tx0 = std::max(0, x0 / kTileSize), ty0 = std::max(0, y0 / kTileSize);
+  const int tx1 = std::min(canvas.tiles_x() - 1, (std::max(x1, 1) - 1) / kTileSize);
+  const int ty1 = std::min(canvas.tiles_y() - 1, (std::max(y1, 1) - 1) / kTileSize);
+  std::vector<int> ids;
+  for (int ty = ty0; ty <= ty1; ++ty)
+    for (int tx = tx0; tx <= tx1; ++tx) ids.push_back(ty * canvas.tiles_x() + tx);
+  return ids;
 }
 
 void restore_tile(TileStore& canvas, const TileSnapshot& snap) {
@@ -149,15 +150,8 @@ void TileDiff::apply_after(TileStore& canvas) const {
 }
 
 void StrokeTileRecorder::capture_rect(const TileStore& canvas, int x0, int y0, int x1, int y1) {
-  const int tx0 = std::max(0, x0 / kTileSize), ty0 = std::max(0, y0 / kTileSize);
-  const int tx1 = std::min(canvas.tiles_x() - 1, (std::max(x1, 1) - 1) / kTileSize);
-  const int ty1 = std::min(canvas.tiles_y() - 1, (std::max(y1, 1) - 1) / kTileSize);
-  std::vector<int> ids;
-  for (int ty = ty0; ty <= ty1; ++ty)
-    for (int tx = tx0; tx <= tx1; ++tx) {
-      const int id = ty * canvas.tiles_x() + tx;
-      if (!before_.count(id)) ids.push_back(id);
-    }
+  std::vector<int> ids = tile_ids_in_rect(canvas, x0, y0, x1, y1);
+  std::erase_if(ids, [&](int id) { return before_.count(id) > 0; });
   for (TileSnapshot& s : snapshot_tiles(canvas, ids)) before_.emplace(s.tile_id, std::move(s));
 }
 

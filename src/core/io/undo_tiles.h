@@ -20,6 +20,11 @@ struct TileSnapshot {
 
 /// Compresses one tile of the store (an unallocated tile gives present = false).
 TileSnapshot snapshot_tile(const TileStore& canvas, int tile_id);
+/// snapshot_tile of each of `ids`: the tiles read on the calling thread (a device's copies stay on
+/// its stream, after its kernels), compressed on every core.
+std::vector<TileSnapshot> snapshot_tiles(const TileStore& canvas, const std::vector<int>& ids);
+/// Ids of the canvas's tiles overlapping the cells [x0, x1) x [y0, y1), row by row.
+std::vector<int> tile_ids_in_rect(const TileStore& canvas, int x0, int y0, int x1, int y1);
 /// Writes the snapshot back, its paint with the drying the canvas has done since it was taken
 /// (undo removes a stroke; it does not make the rest of the painting wetter). An absent tile is
 /// written as an empty (all-zero) tile when it

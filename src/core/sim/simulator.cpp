@@ -298,13 +298,8 @@ void Simulator::with_settled_canvas(const std::function<void(TileStore&)>& fn) {
   const std::vector<std::vector<float>> window = w.to_host();
   const double gathered = win.gathered_mass();
   const ParticleCopy particles = copy_particles(particles_);
-  std::vector<TileSnapshot> tiles;
   const Int3 o = w.origin(), n = w.dims();
-  const int tx0 = std::max(0, o.x / kTileSize), ty0 = std::max(0, o.y / kTileSize);
-  const int tx1 = std::min(canvas.tiles_x() - 1, (o.x + n.x - 1) / kTileSize);
-  const int ty1 = std::min(canvas.tiles_y() - 1, (o.y + n.y - 1) / kTileSize);
-  for (int ty = ty0; ty <= ty1; ++ty)
-    for (int tx = tx0; tx <= tx1; ++tx) tiles.push_back(snapshot_tile(canvas, ty * canvas.tiles_x() + tx));
+  const std::vector<TileSnapshot> tiles = snapshot_tiles(canvas, tile_ids_in_rect(canvas, o.x, o.y, o.x + n.x, o.y + n.y));
   const auto restore = [&] {
     win.restore(window, gathered);
     restore_particles(particles_, particles);
