@@ -10,7 +10,7 @@ namespace wb::studio {
 void FrameCache::reset(Session& session) {
   const CanvasDims dims = session.dims();
   dims_ = dims;
-  cache_ = std::make_unique<CanvasImageCache>(session.renderer(), Camera::top(dims), 32);
+  cache_ = std::make_unique<CanvasImageCache>(session.renderer(), Camera::top(dims), 8);
   std::lock_guard lk(mu_);
   front_ = QImage(dims.width, dims.height, QImage::Format_RGBA8888);
   front_.fill(Qt::black);

@@ -172,7 +172,8 @@ void Renderer::render_tiles(TileStore& canvas, const Camera& camera, const std::
   prepare(canvas, camera, tiles, tile_px, live, particles);
   run(RenderOutput::Shaded, camera, tile_px, int(tiles.size()));
   // The kernel writes tile-major: copy the rendered tiles back and place them in the image.
-  std::vector<uint32_t> compact(size_t(tiles.size()) * tile_px * tile_px);
+  std::vector<uint32_t>& compact = host_rgba_;
+  compact.resize(size_t(tiles.size()) * tile_px * tile_px);
   rgba_.copy_to_host(compact.data(), compact.size());
   const int tiles_x = (img_w_ + tile_px - 1) / tile_px;
   const size_t per_tile = size_t(tile_px) * tile_px;

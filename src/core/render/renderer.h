@@ -102,6 +102,7 @@ class Renderer {
   DeviceBuffer<uint32_t> rgba_;
   DeviceBuffer<float> fout_;
   std::vector<uint16_t> host_blocks_;
+  std::vector<uint32_t> host_rgba_;  ///< the rendered tiles, tile-major, as read back
   int img_w_ = 0, img_h_ = 0;
   int64_t last_pixels_ = 0;
 };

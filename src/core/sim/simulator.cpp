@@ -684,6 +684,7 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
       // The absorption candidates are found against this step's samples, as far as the
       // largest load sphere reaches (Eq. 14 takes a particle only inside R_j).
       const float range = transfer_->params().absorb_range();
+      WB_PROFILE_SCOPE("transfer.nearest");
       build_sample_grid(range, 0.f);
       sample_grid_.query_nearest(particles_.view(), range);
     }
@@ -772,8 +773,11 @@ void Simulator::particle_stage(float dt) {
   particles_.sort_by_cell(grid_->window().origin(), grid_->window().dims(), ws_);
   // Samples are at t + dt, particles at t: file the samples rewound to t (sample_grid.h). The
   // query reaches D1, the range of Eq. 10: beyond it no sample moves a particle.
-  build_sample_grid(prm.D1, dt);
-  sample_grid_.query_nearest(particles_.view(), prm.D1);
+  {
+    WB_PROFILE_SCOPE("particles.nearest");
+    build_sample_grid(prm.D1, dt);
+    sample_grid_.query_nearest(particles_.view(), prm.D1);
+  }
   // The particles rest on the canvas and on dried paint (d_k of Eq. 8 is measured to both), and
   // free ones land on the wet paint's surface. The wet paint is the joint paint, grid and
   // particles, as the grid's liquid test counts it: near the bristles most of a layer is
