@@ -47,6 +47,24 @@ WB_HD WB_INLINE float column_solid_top(const PaintWindowView& pw, int64_t c, flo
   return floor_z;
 }
 
+/// column_solid_top of the `lanes` columns from c0 at once (a run of parallel_for_column_runs),
+/// down every column layer by layer without a branch a cell: top[l] and above[l] for c0 + l.
+WB_HD WB_INLINE void column_solid_tops(const PaintWindowView& pw, int64_t c0, int lanes, float dry_threshold,
+                                       float floor_z, float* top, int* above) {
+  const int64_t layer = int64_t(pw.nx) * pw.ny;
+  for (int l = 0; l < lanes; ++l) top[l] = floor_z, above[l] = -1;
+  for (int k = pw.nz - 1; k >= 0; --k) {
+    const int64_t id0 = int64_t(k) * layer + c0;
+    for (int l = 0; l < lanes; ++l) {
+      const float rho = pw.density[id0 + l];
+      const bool found = above[l] < 0 && dried_solid(rho, pw.dryness[id0 + l], dry_threshold);
+      top[l] = found ? maxf(floor_z, float(pw.oz + k) + minf(rho, 1.f)) : top[l];
+      above[l] = found ? k + 1 : above[l];
+    }
+  }
+  for (int l = 0; l < lanes; ++l) above[l] = above[l] < 0 ? 0 : above[l];
+}
+
 class PaintWindow {
  public:
   PaintWindow() = default;

@@ -146,5 +146,29 @@ void parallel_sum_count(const int64_t* count, int64_t capacity, F fn, double* ou
 #endif
 }
 
+/// Columns a column scan (a pass down every column of the window) takes together: on the CPU 16,
+/// a cache line of floats a layer, scanned layer by layer without a branch a cell so that the
+/// lanes vectorise (a column at a time, stopping at what it looked for, was four times slower:
+/// docs/PERFORMANCE.md "Column scans"); on CUDA 1, a warp's threads being the lanes.
+#if defined(__CUDACC__)
+inline constexpr int kColumnLanes = 1;
+#else
+inline constexpr int kColumnLanes = 16;
+#endif
+
+/// fn(col0, lanes) for each run of kColumnLanes consecutive columns (the last may be shorter) of
+/// `columns`: the run's lanes are columns col0 .. col0 + lanes - 1.
+template <typename F>
+void parallel_for_column_runs(int64_t columns, F fn) {
+  const int64_t runs = (columns + kColumnLanes - 1) / kColumnLanes;
+  parallel_for(
+      runs,
+      [=] WB_HD(int64_t r) {
+        const int64_t col0 = r * kColumnLanes, left = columns - col0;
+        fn(col0, int(left < kColumnLanes ? left : kColumnLanes));
+      },
+      kMinParallelSize / kColumnLanes);  // serial below as many columns as a loop over columns
+}
+
 }  // namespace WB_BACKEND_NS
 }  // namespace wb

@@ -156,32 +156,38 @@ void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float*
 void grid_column_tops(GridDims d, const float* rho, const float* dryness, float liquid_threshold, float dry_threshold,
                       const float* particle_density, float trace, float* out) {
   const int64_t n = int64_t(d.nx) * d.ny;
-  parallel_for(n, [=] WB_HD(int64_t col) {
+  parallel_for_column_runs(n, [=] WB_HD(int64_t col0, int lanes) {
     // The column's top layer (k + 1) holding paint above `trace`, and holding paint or particles;
     // where it holds either, its x, -x, y and -y, whose maxima are the box of such columns. Dried
     // paint counts only where the classification makes it liquid (classify_cell): a canvas's
     // ground or a dried layer is solid or air, never moves, and the cells of it that wet paint
-    // can reach lie within the box's margins.
-    const auto wet = [=](int64_t c) {
-      return rho[c] > trace &&
-             (!(dryness[c] >= dry_threshold) ||
-              classify_cell(rho[c], dryness[c], true, liquid_threshold, dry_threshold) == kCellLiquid);
-    };
-    float top = 0.f, joint = 0.f;
-    for (int k = d.nz - 1; k >= 0 && joint == 0.f; --k) {
-      const int64_t c = int64_t(k) * n + col;
-      if (wet(c)) top = joint = float(k + 1);
-      else if (particle_density && particle_density[c] > trace) joint = float(k + 1);
+    // can reach lie within the box's margins. Each layer of the run's columns at once, down the
+    // whole column (parallel_for_column_runs).
+    float top[kColumnLanes], joint[kColumnLanes];
+    for (int l = 0; l < lanes; ++l) top[l] = joint[l] = 0.f;
+    for (int k = d.nz - 1; k >= 0; --k) {
+      const int64_t c0 = int64_t(k) * n + col0;
+      const float level = float(k + 1);
+      for (int l = 0; l < lanes; ++l) {
+        const int64_t c = c0 + l;
+        const bool wet = rho[c] > trace && (!(dryness[c] >= dry_threshold) ||
+                                            classify_cell(rho[c], dryness[c], true, liquid_threshold, dry_threshold) ==
+                                                kCellLiquid);
+        const bool held = wet || (particle_density && particle_density[c] > trace);
+        top[l] = top[l] == 0.f && wet ? level : top[l];
+        joint[l] = joint[l] == 0.f && held ? level : joint[l];
+      }
     }
-    for (int k = int(joint) - 1; k >= 0 && top == 0.f; --k)
-      if (wet(int64_t(k) * n + col)) top = float(k + 1);
-    const float none = -INFINITY, i = float(col % d.nx), j = float(col / d.nx);
-    out[col] = top;
-    out[n + col] = joint;
-    out[2 * n + col] = joint > 0.f ? i : none;
-    out[3 * n + col] = joint > 0.f ? -i : none;
-    out[4 * n + col] = joint > 0.f ? j : none;
-    out[5 * n + col] = joint > 0.f ? -j : none;
+    for (int l = 0; l < lanes; ++l) {
+      const int64_t col = col0 + l;
+      const float none = -INFINITY, i = float(col % d.nx), j = float(col / d.nx);
+      out[col] = top[l];
+      out[n + col] = joint[l];
+      out[2 * n + col] = joint[l] > 0.f ? i : none;
+      out[3 * n + col] = joint[l] > 0.f ? -i : none;
+      out[4 * n + col] = joint[l] > 0.f ? j : none;
+      out[5 * n + col] = joint[l] > 0.f ? -j : none;
+    }
   });
 }
 

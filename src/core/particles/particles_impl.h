@@ -176,26 +176,36 @@ void particles_solid_height(PaintWindowView pw, const float* particle_density, f
   WB_REQUIRE(std::isfinite(dry_threshold) && dry_threshold > 0.f && std::isfinite(liquid_threshold) &&
                  liquid_threshold > 0.f && std::isfinite(floor_z),
              "particles_solid_height: bad threshold or floor");
-  parallel_for(int64_t(pw.nx) * pw.ny, [=] WB_HD(int64_t c) {
-    const int64_t layer = int64_t(pw.nx) * pw.ny;
-    int above = 0;
-    const float surface = column_solid_top(pw, c, dry_threshold, floor_z, above);
-    // The grid holds one state per cell: wet paint cannot share a cell with dried paint, so over
-    // a partly filled dried top the particles' floor is that cell's top.
-    const float top = above > 0 ? maxf(floor_z, float(pw.oz + above)) : surface;
-    height[c] = top;
-    if (!wet_top) return;
-    // The highest liquid cell over it (the grid's joint liquid test) is the wet paint's free surface.
-    float wet = top;
-    for (int k = pw.nz - 1; k >= above; --k) {
-      const int64_t id = int64_t(k) * layer + c;
-      const float joint = pw.density[id] + (particle_density ? particle_density[id] : 0.f);
-      if (joint >= liquid_threshold) {
-        wet = maxf(top, float(pw.oz + k) + minf(joint, 1.f));
-        break;
+  const int64_t layer = int64_t(pw.nx) * pw.ny;
+  parallel_for_column_runs(layer, [=] WB_HD(int64_t col0, int lanes) {
+    // Down each column of the run at once, layer by layer (parallel_for_column_runs): the highest
+    // dried solid (column_solid_top) and, above it, the highest liquid cell by the grid's joint
+    // test, whose top is the wet paint's free surface.
+    float solid[kColumnLanes], wet[kColumnLanes];
+    int above[kColumnLanes];  // the first layer over the solid; -1 while none is found
+    for (int l = 0; l < lanes; ++l) solid[l] = floor_z, wet[l] = -INFINITY, above[l] = -1;
+    for (int k = pw.nz - 1; k >= 0; --k) {
+      const int64_t c0 = int64_t(k) * layer + col0;
+      for (int l = 0; l < lanes; ++l) {
+        const int64_t id = c0 + l;
+        const float rho = pw.density[id];
+        const bool searching = above[l] < 0;
+        const bool is_solid = searching && dried_solid(rho, pw.dryness[id], dry_threshold);
+        const float joint = rho + (particle_density ? particle_density[id] : 0.f);
+        const bool liquid = searching && !is_solid && wet[l] == -INFINITY && joint >= liquid_threshold;
+        solid[l] = is_solid ? maxf(floor_z, float(pw.oz + k) + minf(rho, 1.f)) : solid[l];
+        above[l] = is_solid ? k + 1 : above[l];
+        wet[l] = liquid ? float(pw.oz + k) + minf(joint, 1.f) : wet[l];
       }
     }
-    wet_top[c] = wet;
+    for (int l = 0; l < lanes; ++l) {
+      const int64_t c = col0 + l;
+      // The grid holds one state per cell: wet paint cannot share a cell with dried paint, so over
+      // a partly filled dried top the particles' floor is that cell's top.
+      const float top = above[l] > 0 ? maxf(floor_z, float(pw.oz + above[l])) : solid[l];
+      height[c] = top;
+      if (wet_top) wet_top[c] = maxf(top, wet[l]);
+    }
   });
 }
 
@@ -208,19 +218,24 @@ void particles_ground_surface(PaintWindowView pw, const float* particle_density,
   WB_REQUIRE(std::isfinite(dry_threshold) && dry_threshold > 0.f && std::isfinite(liquid_threshold) &&
                  liquid_threshold > 0.f && std::isfinite(floor_z),
              "particles_ground_surface: bad threshold or floor");
-  parallel_for(int64_t(pw.nx) * pw.ny, [=] WB_HD(int64_t c) {
-    const int64_t layer = int64_t(pw.nx) * pw.ny;
-    int above = 0;
-    float top = column_solid_top(pw, c, dry_threshold, floor_z, above);
-    // Up from the solid through liquid cells (the joint test) to the first that is not, counting
-    // its partial fill: paint held up in the air by the bristles, above a gap, is not ground.
-    for (int k = above; k < pw.nz; ++k) {
-      const int64_t id = int64_t(k) * layer + c;
-      const float joint = pw.density[id] + (particle_density ? particle_density[id] : 0.f);
-      top = maxf(top, float(pw.oz + k) + minf(joint, 1.f));
-      if (joint < liquid_threshold) break;
+  const int64_t layer = int64_t(pw.nx) * pw.ny;
+  parallel_for_column_runs(layer, [=] WB_HD(int64_t col0, int lanes) {
+    float top[kColumnLanes];
+    int above[kColumnLanes];
+    column_solid_tops(pw, col0, lanes, dry_threshold, floor_z, top, above);
+    for (int l = 0; l < lanes; ++l) {
+      // Up from the solid through liquid cells (the joint test) to the first that is not, counting
+      // its partial fill: paint held up in the air by the bristles, above a gap, is not ground.
+      const int64_t c = col0 + l;
+      float t = top[l];
+      for (int k = above[l]; k < pw.nz; ++k) {
+        const int64_t id = int64_t(k) * layer + c;
+        const float joint = pw.density[id] + (particle_density ? particle_density[id] : 0.f);
+        t = maxf(t, float(pw.oz + k) + minf(joint, 1.f));
+        if (joint < liquid_threshold) break;
+      }
+      surface[c] = t;
     }
-    surface[c] = top;
   });
 }
 
