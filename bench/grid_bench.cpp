@@ -8,6 +8,7 @@
 #include "core/exec/device.h"
 #include "core/canvas/tile_store.h"
 #include "core/grid/solver_study.h"
+#include "core/particles/particles.h"
 
 namespace {
 
@@ -106,6 +107,35 @@ void BM_GridStep(benchmark::State& state) {
   for (auto _ : state) g.step(g.params().dt);
 }
 BENCHMARK(BM_GridStep)->Unit(benchmark::kMillisecond);
+
+// The passes down every column of the window (docs/PERFORMANCE.md "Column scans"): the tops of
+// the paint and particles (twice a step), the particles' floor and free surface, and their ground,
+// on the scene's wavy layer about 8 cells deep under 24 layers of air, with particles in a
+// quarter of the columns. Arg: 0 all three, 1 the tops, 2 the floor, 3 the ground.
+void BM_ColumnScans(benchmark::State& state) {
+  wb::Grid& g = scene().grid();
+  const wb::Device d = g.device();
+  const wb::GridDims gd = g.dims();
+  const int64_t columns = int64_t(gd.nx) * gd.ny;
+  wb::PaintWindow& paint = g.window().paint();
+  std::vector<float> pd(size_t(gd.cells()), 0.f);
+  for (int64_t c = 0; c < columns; c += 4) pd[size_t(10 * columns + c)] = 0.6f;  // a particle in layer 10
+  wb::DeviceBuffer<float> particles(d, pd.size()), out(d, size_t(6 * columns));
+  particles.copy_from_host(pd);
+  const float liquid = g.params().liquid_threshold, dry = g.params().dry_threshold;
+  const int which = int(state.range(0));
+  for (auto _ : state) {
+    if (which == 0 || which == 1)
+      wb::grid_column_tops(d, gd, paint.density.data(), paint.dryness.data(), liquid, dry, particles.data(), 0.f,
+                           out.data());
+    if (which == 0 || which == 2)
+      wb::particles_solid_height(d, paint.view(), particles.data(), dry, liquid, 0.f, out.data(), out.data() + columns);
+    if (which == 0 || which == 3)
+      wb::particles_ground_surface(d, paint.view(), particles.data(), dry, liquid, 0.f, out.data());
+    d.synchronize();
+  }
+}
+BENCHMARK(BM_ColumnScans)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
 
 // A step's cost must not grow with the painting: a 64 x 64 x 16 window with a 4-cell layer on a
 // canvas that holds state.range(0) painted tiles elsewhere (a 2-cell layer each; 10^4 tiles are

@@ -26,7 +26,7 @@ inline constexpr int kPaintFieldCount = 6;
 /// dried paint"). One rule for the grid, the particles, the transfer and the brush.
 inline constexpr float kSolidDensity = 0.5f;
 WB_HD WB_INLINE bool dried_solid(float density, float dryness, float dry_threshold) {
-  return density >= kSolidDensity && dryness >= dry_threshold;
+  return (density >= kSolidDensity) & (dryness >= dry_threshold);  // no branch: column scans vectorise over it
 }
 
 /// One cell's paint, decoded (host-side helper type for tests, I/O and probes).

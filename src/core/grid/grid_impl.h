@@ -159,10 +159,14 @@ void grid_column_tops(GridDims d, const float* rho, const float* dryness, float 
   parallel_for_column_runs(n, [=] WB_HD(int64_t col0, int lanes) {
     // The column's top layer (k + 1) holding paint above `trace`, and holding paint or particles;
     // where it holds either, its x, -x, y and -y, whose maxima are the box of such columns. Dried
-    // paint counts only where the classification makes it liquid (classify_cell): a canvas's
+    // paint counts only where the classification makes it liquid (liquid_on_canvas): a canvas's
     // ground or a dried layer is solid or air, never moves, and the cells of it that wet paint
     // can reach lie within the box's margins. Each layer of the run's columns at once, down the
     // whole column (parallel_for_column_runs).
+    // Without particles the paint's density stands in for theirs against a bound none passes, so
+    // that every lane does the same loads and compares (no branch: the run vectorises).
+    const float* pd = particle_density ? particle_density : rho;
+    const float pd_trace = particle_density ? trace : INFINITY;
     float top[kColumnLanes], joint[kColumnLanes];
     for (int l = 0; l < lanes; ++l) top[l] = joint[l] = 0.f;
     for (int k = d.nz - 1; k >= 0; --k) {
@@ -170,12 +174,11 @@ void grid_column_tops(GridDims d, const float* rho, const float* dryness, float 
       const float level = float(k + 1);
       for (int l = 0; l < lanes; ++l) {
         const int64_t c = c0 + l;
-        const bool wet = rho[c] > trace && (!(dryness[c] >= dry_threshold) ||
-                                            classify_cell(rho[c], dryness[c], true, liquid_threshold, dry_threshold) ==
-                                                kCellLiquid);
-        const bool held = wet || (particle_density && particle_density[c] > trace);
-        top[l] = top[l] == 0.f && wet ? level : top[l];
-        joint[l] = joint[l] == 0.f && held ? level : joint[l];
+        const float r = rho[c], dr = dryness[c];
+        const bool wet = (r > trace) & (!(dr >= dry_threshold) | liquid_on_canvas(r, dr, liquid_threshold, dry_threshold));
+        const bool held = wet | (pd[c] > pd_trace);
+        top[l] = (top[l] == 0.f) & wet ? level : top[l];
+        joint[l] = (joint[l] == 0.f) & held ? level : joint[l];
       }
     }
     for (int l = 0; l < lanes; ++l) {

@@ -190,9 +190,9 @@ void particles_solid_height(PaintWindowView pw, const float* particle_density, f
         const int64_t id = c0 + l;
         const float rho = pw.density[id];
         const bool searching = above[l] < 0;
-        const bool is_solid = searching && dried_solid(rho, pw.dryness[id], dry_threshold);
+        const bool is_solid = searching & dried_solid(rho, pw.dryness[id], dry_threshold);
         const float joint = rho + (particle_density ? particle_density[id] : 0.f);
-        const bool liquid = searching && !is_solid && wet[l] == -INFINITY && joint >= liquid_threshold;
+        const bool liquid = searching & !is_solid & (wet[l] == -INFINITY) & (joint >= liquid_threshold);
         solid[l] = is_solid ? maxf(floor_z, float(pw.oz + k) + minf(rho, 1.f)) : solid[l];
         above[l] = is_solid ? k + 1 : above[l];
         wet[l] = liquid ? float(pw.oz + k) + minf(joint, 1.f) : wet[l];
