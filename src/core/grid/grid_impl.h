@@ -541,33 +541,59 @@ void grid_film_columns(GridDims d, const GridExtent* e, PaintWindowView pw, Bris
                        const float* particle_density, FlowColumns flow, float dry_threshold, float film_max,
                        FilmFlow f, float* col) {
   const int64_t n = int64_t(d.nx) * d.ny;
-  parallel_for(n, [=] WB_HD(int64_t c) {
-    const int i = int(c % d.nx), j = int(c / d.nx);
-    col[kFilmH * n + c] = -1.f;
-    col[kFilmMoved * n + c] = 0.f;
-    if (e && (i < e->x0 || i >= e->x1 || j < e->y0 || j >= e->y1)) return;  // no paint there
-    if (!flow.contains(i + pw.ox, j + pw.oy)) return;                       // a wall (FlowColumns)
-    int above = 0;
-    const float base = column_solid_top(pw, c, dry_threshold, 0.f, above);
-    float h = 0.f, oil = 0.f, r = 0.f, y = 0.f, b = 0.f, dry = 0.f;
-    bool touched = false;
-    for (int k = above; k < (e ? e->layers : d.nz); ++k) {
-      const int64_t id = int64_t(k) * n + c;
-      const float rho = pw.density[id];
-      touched |= (br.psi && br.psi[id] > 0.f) || (particle_density && particle_density[id] > 0.f);
-      h += rho, oil += rho * pw.oil[id], dry += rho * pw.dryness[id];
-      r += rho * pw.pigment_r[id], y += rho * pw.pigment_y[id], b += rho * pw.pigment_b[id];
+  parallel_for_column_runs(n, [=] WB_HD(int64_t c0, int lanes) {
+    // Columns outside the paint's box (no paint there) or the flow's (a wall: FlowColumns) are no
+    // film; a run with none inside reads no cell.
+    bool in[kColumnLanes];
+    bool any = false;
+    for (int l = 0; l < lanes; ++l) {
+      const int64_t c = c0 + l;
+      const int i = int(c % d.nx), j = int(c / d.nx);
+      in[l] = (!e || (i >= e->x0 && i < e->x1 && j >= e->y0 && j < e->y1)) && flow.contains(i + pw.ox, j + pw.oy);
+      any |= in[l];
+      col[kFilmH * n + c] = -1.f;
+      col[kFilmMoved * n + c] = 0.f;
     }
-    // Means by division (a trace's h may be subnormal: its reciprocal overflows).
-    const auto mean = [h](float q) { return h > 0.f ? q / h : 0.f; };
-    // The bristles and the particles' paint are the grid's and the transfer's business; a bare
-    // column is a film of nothing that paint may flow onto.
-    col[kFilmH * n + c] = (h <= film_max && !touched) ? h : -1.f;
-    col[kFilmBase * n + c] = base;
-    col[kFilmAbove * n + c] = float(above);
-    col[kFilmOil * n + c] = mean(oil), col[kFilmDry * n + c] = mean(dry);
-    col[kFilmR * n + c] = mean(r), col[kFilmY * n + c] = mean(y), col[kFilmB * n + c] = mean(b);
-    film_rheology(col, n, c, f);
+    if (!any) return;
+    float base[kColumnLanes];
+    int above[kColumnLanes];
+    column_solid_tops(pw, c0, lanes, dry_threshold, 0.f, base, above);
+    // The paint over the solid, summed up each column from its first layer over it (the same sums
+    // in the same order as a column at a time: a layer below it adds an exact zero).
+    float h[kColumnLanes], oil[kColumnLanes], r[kColumnLanes], y[kColumnLanes], b[kColumnLanes], dry[kColumnLanes];
+    bool touched[kColumnLanes];
+    int first = e ? e->layers : d.nz;
+    for (int l = 0; l < lanes; ++l) {
+      h[l] = oil[l] = r[l] = y[l] = b[l] = dry[l] = 0.f;
+      touched[l] = false;
+      first = above[l] < first ? above[l] : first;
+    }
+    for (int k = first; k < (e ? e->layers : d.nz); ++k) {
+      const int64_t id0 = int64_t(k) * n + c0;
+      for (int l = 0; l < lanes; ++l) {
+        const int64_t id = id0 + l;
+        const bool over = k >= above[l];
+        const float rho = over ? pw.density[id] : 0.f;
+        touched[l] |= over && ((br.psi && br.psi[id] > 0.f) || (particle_density && particle_density[id] > 0.f));
+        h[l] += rho, oil[l] += rho * pw.oil[id], dry[l] += rho * pw.dryness[id];
+        r[l] += rho * pw.pigment_r[id], y[l] += rho * pw.pigment_y[id], b[l] += rho * pw.pigment_b[id];
+      }
+    }
+    for (int l = 0; l < lanes; ++l) {
+      if (!in[l]) continue;
+      const int64_t c = c0 + l;
+      // Means by division (a trace's h may be subnormal: its reciprocal overflows).
+      const float hl = h[l];
+      const auto mean = [hl](float q) { return hl > 0.f ? q / hl : 0.f; };
+      // The bristles and the particles' paint are the grid's and the transfer's business; a bare
+      // column is a film of nothing that paint may flow onto.
+      col[kFilmH * n + c] = (hl <= film_max && !touched[l]) ? hl : -1.f;
+      col[kFilmBase * n + c] = base[l];
+      col[kFilmAbove * n + c] = float(above[l]);
+      col[kFilmOil * n + c] = mean(oil[l]), col[kFilmDry * n + c] = mean(dry[l]);
+      col[kFilmR * n + c] = mean(r[l]), col[kFilmY * n + c] = mean(y[l]), col[kFilmB * n + c] = mean(b[l]);
+      film_rheology(col, n, c, f);
+    }
   });
 }
 
