@@ -1,5 +1,8 @@
 // The solid the particles rest on (Eq. 8's d_k): canvas floor plus dried paint, per column; and
 // the wet paint's surface, which free particles land on.
+#include <algorithm>
+#include <vector>
+
 #include "backend_fixture.h"
 #include "core/canvas/window.h"
 #include "core/particles/particles.h"
@@ -23,15 +26,16 @@ TEST_F(SolidHeightTest, DriedPaintRaisesTheFloorWetPaintDoesNot) {
     f[0][at(4, j, 4)] = 1.f, f[5][at(4, j, 4)] = 1.f;
   }
   w.from_host(f);
-  // The dried paint's own top per column (column_solid_top: the ground under the brush).
+  // The dried paint's own top per column (column_solid_tops: the ground under the brush), in runs
+  // of 5 columns, the last one shorter.
   PaintWindowView hv = w.view();
   hv.density = f[0].data();
   hv.dryness = f[5].data();
   std::vector<float> hh(size_t(n.x) * n.y);
-  for (int64_t c = 0; c < int64_t(hh.size()); ++c) {
-    int above = 0;
-    hh[size_t(c)] = column_solid_top(hv, c, 0.95f, 0.25f, above);
-  }
+  std::vector<int> above(hh.size());
+  for (int64_t c = 0; c < int64_t(hh.size()); c += 5)
+    column_solid_tops(hv, c, int(std::min<int64_t>(5, int64_t(hh.size()) - c)), 0.95f, 0.25f, &hh[size_t(c)],
+                      &above[size_t(c)]);
   for (int j = 0; j < n.y; ++j) {
     EXPECT_FLOAT_EQ(hh[size_t(j) * n.x + 0], 0.25f) << "no paint: the canvas floor";
     EXPECT_FLOAT_EQ(hh[size_t(j) * n.x + 1], 2.5f) << "top of the dried layer, half-full top cell";

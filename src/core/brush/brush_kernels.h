@@ -122,7 +122,7 @@ WB_HD WB_INLINE bool solid_cell(const SolidField& s, int cx, int cy, int cz) {
 
 /// Top of the dried paint in cell (cx, cy, cz), the top of a run of dried cells: the paint fills
 /// the cell from below to its density (as the particles' and the transfer's dried surface reads
-/// it, column_solid_top and dried_density_at), so a half-filled top cell is a half-cell step, not
+/// it, column_solid_tops and dried_density_at), so a half-filled top cell is a half-cell step, not
 /// a whole one. A whole-cell top held the bristles up to half a cell above the surface that the
 /// transfer measured their gap from, and a light brush laid nothing on such a stroke.
 WB_HD WB_INLINE float dried_top_of(const SolidField& s, int cx, int cy, int cz) {

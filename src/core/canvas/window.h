@@ -29,26 +29,11 @@ struct PaintWindowView {
   WB_HD int64_t size() const { return int64_t(nx) * ny * nz; }
 };
 
-/// Top of the dried paint in window column c (absolute canvas z), or floor_z where none: the
-/// highest cell the grid counts as solid (cell_is_solid), a partly filled one holding its paint at
-/// the bottom (the surface is rho up). `above` receives the first layer over it (0 where none).
-WB_HD WB_INLINE float column_solid_top(const PaintWindowView& pw, int64_t c, float dry_threshold, float floor_z,
-                                       int& above) {
-  const int64_t layer = int64_t(pw.nx) * pw.ny;
-  above = 0;
-  for (int k = pw.nz - 1; k >= 0; --k) {
-    const int64_t id = int64_t(k) * layer + c;
-    const float rho = pw.density[id];
-    if (dried_solid(rho, pw.dryness[id], dry_threshold)) {
-      above = k + 1;
-      return maxf(floor_z, float(pw.oz + k) + minf(rho, 1.f));
-    }
-  }
-  return floor_z;
-}
-
-/// column_solid_top of the `lanes` columns from c0 at once (a run of parallel_for_column_runs),
-/// down every column layer by layer without a branch a cell: top[l] and above[l] for c0 + l.
+/// Top of the dried paint in window columns c0 .. c0 + lanes - 1 (absolute canvas z), or floor_z
+/// where none: the highest cell the grid counts as solid (cell_is_solid), a partly filled one
+/// holding its paint at the bottom (the surface is rho up), into top[l]; above[l] receives the
+/// first layer over it (0 where none). The columns of a run of parallel_for_column_runs at once,
+/// down every column layer by layer without a branch a cell.
 WB_HD WB_INLINE void column_solid_tops(const PaintWindowView& pw, int64_t c0, int lanes, float dry_threshold,
                                        float floor_z, float* top, int* above) {
   const int64_t layer = int64_t(pw.nx) * pw.ny;

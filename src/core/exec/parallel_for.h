@@ -1,6 +1,8 @@
 // parallel_for(n, fn): the one loop construct of every stage driver. Under nvcc it is a
 // grid-stride kernel on the simulator's stream (checked after launch); under g++ an
 // OpenMP loop (guided chunks), serial below a size where threading costs more than it saves.
+// The other loops here are built on it or mirror it: over a count the device wrote, with a sum,
+// and over runs of columns.
 #pragma once
 #include <cstdint>
 

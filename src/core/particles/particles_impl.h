@@ -165,7 +165,7 @@ void particles_init_scratch(ParticleView p, int64_t first, int64_t n) {
 /// Height fields of what the particles rest on over the window's columns (SolidView), absolute
 /// canvas z, nx * ny floats each: `height`, the top of the highest dried cell (dryness at or above
 /// dry_threshold, the grid's solid test) as a whole cell (the grid holds one state a cell, so
-/// wet paint over a partly filled dried cell starts at its top; column_solid_top gives the paint's
+/// wet paint over a partly filled dried cell starts at its top; column_solid_tops gives the paint's
 /// own top), or floor_z where none; `wet_top` (nullable), the top
 /// of the highest liquid cell above it, or `height` where none. Liquid is the grid's joint test:
 /// density plus `particle_density` (the particles' raster, nullable) at or above liquid_threshold;
@@ -179,7 +179,7 @@ void particles_solid_height(PaintWindowView pw, const float* particle_density, f
   const int64_t layer = int64_t(pw.nx) * pw.ny;
   parallel_for_column_runs(layer, [=] WB_HD(int64_t col0, int lanes) {
     // Down each column of the run at once, layer by layer (parallel_for_column_runs): the highest
-    // dried solid (column_solid_top) and, above it, the highest liquid cell by the grid's joint
+    // dried solid (column_solid_tops) and, above it, the highest liquid cell by the grid's joint
     // test, whose top is the wet paint's free surface.
     float solid[kColumnLanes], wet[kColumnLanes];
     int above[kColumnLanes];  // the first layer over the solid; -1 while none is found

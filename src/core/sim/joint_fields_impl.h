@@ -37,7 +37,7 @@ void joint_clear_raster(TouchList list, int64_t n, FloatPair* pairs, float* dens
   });
 }
 
-/// Per window column: the dried paint's top (column_solid_top) where the column's centre lies
+/// Per window column: the dried paint's top (column_solid_tops) where the column's centre lies
 /// within r of (cx, cy) and the top is above floor_z, else 0 (their maximum is the ground under a
 /// brush footprint). Only the columns under the footprint are scanned.
 void joint_ground_under(PaintWindowView pw, float dry_threshold, float cx, float cy, float r, float floor_z,
@@ -47,7 +47,8 @@ void joint_ground_under(PaintWindowView pw, float dry_threshold, float cx, float
     const float dx = float(pw.ox + int(c % pw.nx)) + 0.5f - cx, dy = float(pw.oy + int(c / pw.nx)) + 0.5f - cy;
     if (!(dx * dx + dy * dy <= r * r)) return;
     int above = 0;
-    const float h = column_solid_top(pw, c, dry_threshold, floor_z, above);
+    float h = floor_z;
+    column_solid_tops(pw, c, 1, dry_threshold, floor_z, &h, &above);
     if (h > floor_z) out[c] = h;
   });
 }
