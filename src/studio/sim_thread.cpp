@@ -438,7 +438,7 @@ void SimThread::run() {
       render(0.0);
     } else {
       // Behind the pen: a frame a fifth of a second shows the painting going on, and the rest of
-      // the thread's time goes to catching up (a frame costs about 3.6 ms; at 30 a second frames
+      // the thread's time goes to catching up (a frame costs about 2 ms; at 30 a second frames
       // held the simulation below real time: docs/STUDIO.md "Pen-to-paint latency").
       render(kBehindFrameInterval);
     }
