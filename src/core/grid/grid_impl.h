@@ -562,13 +562,14 @@ void grid_film_columns(GridDims d, const GridExtent* e, PaintWindowView pw, Bris
     // in the same order as a column at a time: a layer below it adds an exact zero).
     float h[kColumnLanes], oil[kColumnLanes], r[kColumnLanes], y[kColumnLanes], b[kColumnLanes], dry[kColumnLanes];
     bool touched[kColumnLanes];
-    int first = e ? e->layers : d.nz;
+    const int layers = e ? e->layers : d.nz;
+    int first = layers;
     for (int l = 0; l < lanes; ++l) {
       h[l] = oil[l] = r[l] = y[l] = b[l] = dry[l] = 0.f;
       touched[l] = false;
       first = above[l] < first ? above[l] : first;
     }
-    for (int k = first; k < (e ? e->layers : d.nz); ++k) {
+    for (int k = first; k < layers; ++k) {
       const int64_t id0 = int64_t(k) * n + c0;
       for (int l = 0; l < lanes; ++l) {
         const int64_t id = id0 + l;

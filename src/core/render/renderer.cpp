@@ -165,13 +165,15 @@ void Renderer::run(RenderOutput mode, const Camera& camera, int tile_px, int nti
 }
 
 void Renderer::render_tiles(TileStore& canvas, const Camera& camera, const std::vector<int32_t>& tiles, int tile_px,
-                            uint32_t* rgba, PaintWindow* live, const ParticleOverlay* particles) {
+                            Image& image, PaintWindow* live, const ParticleOverlay* particles) {
   WB_REQUIRE(tile_px > 0 && tile_px <= 1024, "render: tile size must be in [1, 1024] pixels");
+  WB_REQUIRE(image.width == camera.width && image.height == camera.height, "render: the image is not the camera's size");
   last_pixels_ = 0;
   if (tiles.empty()) return;
   prepare(canvas, camera, tiles, tile_px, live, particles);
   run(RenderOutput::Shaded, camera, tile_px, int(tiles.size()));
-  // The kernel writes tile-major: copy the rendered tiles back and place them in the image.
+  // The kernel writes tile-major (packed little-endian RGBA8): read the tiles back and place
+  // their rows in the image.
   std::vector<uint32_t>& compact = host_rgba_;
   compact.resize(size_t(tiles.size()) * tile_px * tile_px);
   rgba_.copy_to_host(compact.data(), compact.size());
@@ -184,7 +186,7 @@ void Renderer::render_tiles(TileStore& canvas, const Camera& camera, const std::
       if (y >= img_h_) break;
       const int x = tx * tile_px;
       const int cnt = std::min(tile_px, img_w_ - x);
-      std::copy_n(&compact[k * per_tile + size_t(ly) * tile_px], cnt, rgba + size_t(y) * img_w_ + x);
+      std::memcpy(image.at(x, y), &compact[k * per_tile + size_t(ly) * tile_px], size_t(cnt) * 4);
     }
   }
 }
@@ -193,9 +195,7 @@ Image Renderer::render(TileStore& canvas, const Camera& camera, PaintWindow* liv
   WB_PROFILE_SCOPE("render.full");
   constexpr int kTile = 32;
   Image img(camera.width, camera.height);
-  std::vector<uint32_t> px(size_t(camera.width) * camera.height);
-  render_tiles(canvas, camera, all_tiles(camera.width, camera.height, kTile), kTile, px.data(), live, particles);
-  std::memcpy(img.rgba.data(), px.data(), px.size() * 4);  // packed little-endian RGBA
+  render_tiles(canvas, camera, all_tiles(camera.width, camera.height, kTile), kTile, img, live, particles);
   return img;
 }
 
@@ -260,7 +260,6 @@ void CanvasImageCache::set_camera(const Camera& camera) {
   tiles_x_ = (camera.width + tile_px_ - 1) / tile_px_;
   tiles_y_ = (camera.height + tile_px_ - 1) / tile_px_;
   dirty_.assign(size_t(tiles_x_) * tiles_y_, 1);
-  pixels_.assign(size_t(camera.width) * camera.height, 0);
   image_ = Image(camera.width, camera.height);
 }
 
@@ -298,20 +297,14 @@ int CanvasImageCache::dirty_tiles() const { return int(std::count(dirty_.begin()
 
 const Image& CanvasImageCache::update(TileStore& canvas, PaintWindow* live, const ParticleOverlay* particles) {
   WB_PROFILE_SCOPE("render.incremental");
-  std::vector<int32_t> tiles;
+  std::vector<int32_t>& tiles = dirty_list_;
+  tiles.clear();
   for (size_t i = 0; i < dirty_.size(); ++i)
     if (dirty_[i]) tiles.push_back(int32_t(i));
   last_tiles_ = int(tiles.size());
   if (tiles.empty()) return image_;
-  renderer_.render_tiles(canvas, camera_, tiles, tile_px_, pixels_.data(), live, particles);
+  renderer_.render_tiles(canvas, camera_, tiles, tile_px_, image_, live, particles);
   std::fill(dirty_.begin(), dirty_.end(), uint8_t(0));
-  // Copy the re-rendered rows of the image (packed RGBA8, little-endian).
-  for (int32_t t : tiles) {
-    const int x = (t % tiles_x_) * tile_px_, y0 = (t / tiles_x_) * tile_px_;
-    const int cnt = std::min(tile_px_, camera_.width - x);
-    for (int y = y0; y < std::min(y0 + tile_px_, camera_.height); ++y)
-      std::memcpy(image_.at(x, y), &pixels_[size_t(y) * camera_.width + x], size_t(cnt) * 4);
-  }
   return image_;
 }
 

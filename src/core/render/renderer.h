@@ -76,9 +76,9 @@ class Renderer {
   std::optional<Vec3> pigment_at(TileStore& canvas, int x, int y, PaintWindow* live = nullptr);
 
   /// Renders the pixels of the listed image tiles (tile id = ty * tiles_x + tx, tiles of
-  /// `tile_px` pixels) into `rgba` (host, width*height, packed RGBA8). Used by the cache.
+  /// `tile_px` pixels) into their places in `image` (the camera's size). Used by the cache.
   void render_tiles(TileStore& canvas, const Camera& camera, const std::vector<int32_t>& tiles, int tile_px,
-                    uint32_t* rgba, PaintWindow* live = nullptr, const ParticleOverlay* particles = nullptr);
+                    Image& image, PaintWindow* live = nullptr, const ParticleOverlay* particles = nullptr);
 
   /// Pixels shaded by the last call (for tests and statistics).
   int64_t last_pixels() const { return last_pixels_; }
@@ -135,7 +135,7 @@ class CanvasImageCache {
   int tile_px_;
   int tiles_x_ = 0, tiles_y_ = 0;
   std::vector<uint8_t> dirty_;
-  std::vector<uint32_t> pixels_;
+  std::vector<int32_t> dirty_list_;  ///< the dirty tiles' ids of an update (kept: no allocation a frame)
   Image image_;
   int last_tiles_ = 0;
 };
