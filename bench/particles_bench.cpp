@@ -64,6 +64,10 @@ struct Scene {
     }
     store.append(ph);
     region = test::region_around(ph.x, prm.D0);
+    // In the order the simulator keeps them: by cell (Simulator::particle_stage).
+    const Int3 lo(int(std::floor(region.lo.x)), int(std::floor(region.lo.y)), int(std::floor(region.lo.z)));
+    store.sort_by_cell(lo, Int3(int(region.hi.x) + 1 - lo.x, int(region.hi.y) + 1 - lo.y, int(region.hi.z) + 1 - lo.z),
+                       ws);
   }
 };
 

@@ -1,4 +1,4 @@
-// The passes down every column of the window in runs of columns (parallel_for_column_runs) give
+// The passes down every column of the window in runs of columns (parallel_for_runs<kColumnLanes>) give
 // what a column at a time gives: the tops of the paint and particles, the particles' floor and
 // free surface, and their ground, on windows whose column count is no multiple of a run, with and
 // without particles, over dried, wet and floating paint.

@@ -88,6 +88,55 @@ TEST_F(SampleGridTest, NearestSampleEqualsBruteForce) {
   EXPECT_GT(hits, 100);
 }
 
+TEST_F(SampleGridTest, NeighbouringParticlesQueriedTogetherEqualBruteForce) {
+  // The CPU queries runs of neighbouring particles together (kQueryLanes): particles sorted by
+  // cell, many to a cell, as the simulator keeps them, with exact ties (a bristle's samples
+  // filed twice: the lower index wins) and non-finite points among them.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> U(0.f, 1.f);
+  HostSamples hs;
+  hs.resize(24, 32);
+  for (int b = 0; b < 24; ++b) {
+    Vec3 p(500.f + 30.f * U(rng), 500.f + 30.f * U(rng), 10.f + 20.f * U(rng));
+    for (int j = 0; j < 32; ++j) {
+      hs.x[size_t(b) * 32 + j] = b >= 20 ? hs.x[size_t(b - 20) * 32 + j] : p;  // 20..23 repeat 0..3
+      p += normalize(Vec3(U(rng) - 0.5f, U(rng) - 0.5f, -1.f)) * 0.8f;
+    }
+  }
+  std::vector<Vec3> px;
+  for (int k = 0; k < 6000; ++k) {
+    // Dense clusters around samples and sparse ones between them.
+    const Vec3 c = hs.x[size_t(k / 12 * 5) % hs.x.size()];
+    px.push_back(c + Vec3(U(rng) - 0.5f, U(rng) - 0.5f, U(rng) - 0.5f) * (k % 3 == 0 ? 30.f : 4.f));
+  }
+  px[100] = Vec3(NAN, 0.f, 0.f);
+  px[2001] = Vec3(INFINITY, 500.f, 10.f);
+  DeviceSamples ds(device_);
+  ds.upload(hs);
+  ParticleStore store(device_);
+  store.append(particles_at(px));
+  store.sort_by_cell(Int3(450, 450, -40), Int3(140, 140, 120), ws_);
+  std::vector<Vec3> sorted = store.x.to_host();
+  sorted.resize(px.size());  // the buffer may hold more than the particles
+  SampleGrid grid(device_);
+  int ties = 0;
+  for (float h : {1.f, 2.f, 4.f}) {
+    for (float range : {1.f, 6.f, 15.f}) {
+      grid.build(ds.view(), h, Vec3(420.f, 420.f, -60.f), Vec3(620.f, 620.f, 120.f), ws_);
+      grid.query_nearest(store.view(), range);
+      const auto nearest = store.nearest.to_host();
+      const auto dB = store.d_B.to_host();
+      for (size_t k = 0; k < sorted.size(); ++k) {
+        const NearestSample ref = nearest_sample_brute_force(hs.x.data(), int64_t(hs.x.size()), sorted[k], range);
+        ASSERT_EQ(nearest[k], ref.index) << "h=" << h << " range=" << range << " particle " << k;
+        ASSERT_NEAR(dB[k], ref.dist, 1e-5f * std::max(1.f, ref.dist)) << "h=" << h << " particle " << k;
+        ties += ref.index >= 0 && ref.index < 4 * 32;  // its twin 20 bristles on is as near
+      }
+    }
+  }
+  EXPECT_GT(ties, 1000);
+}
+
 TEST_F(SampleGridTest, RewindFilesStartOfStepPositions) {
   // A bristle that moved by v dt: with rewind the particle at the old place is on it.
   HostSamples hs;

@@ -32,7 +32,7 @@ struct PaintWindowView {
 /// Top of the dried paint in window columns c0 .. c0 + lanes - 1 (absolute canvas z), or floor_z
 /// where none: the highest cell the grid counts as solid (cell_is_solid), a partly filled one
 /// holding its paint at the bottom (the surface is rho up), into top[l]; above[l] receives the
-/// first layer over it (0 where none). The columns of a run of parallel_for_column_runs at once,
+/// first layer over it (0 where none). The columns of a run of parallel_for_runs<kColumnLanes> at once,
 /// down every column layer by layer without a branch a cell.
 WB_HD WB_INLINE void column_solid_tops(const PaintWindowView& pw, int64_t c0, int lanes, float dry_threshold,
                                        float floor_z, float* top, int* above) {

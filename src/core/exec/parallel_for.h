@@ -2,7 +2,7 @@
 // grid-stride kernel on the simulator's stream (checked after launch); under g++ an
 // OpenMP loop (guided chunks), serial below a size where threading costs more than it saves.
 // The other loops here are built on it or mirror it: over a count the device wrote, with a sum,
-// and over runs of columns.
+// and over runs of consecutive elements.
 #pragma once
 #include <cstdint>
 
@@ -158,18 +158,18 @@ inline constexpr int kColumnLanes = 1;
 inline constexpr int kColumnLanes = 16;
 #endif
 
-/// fn(col0, lanes) for each run of kColumnLanes consecutive columns (the last may be shorter) of
-/// `columns`: the run's lanes are columns col0 .. col0 + lanes - 1.
-template <typename F>
-void parallel_for_column_runs(int64_t columns, F fn) {
-  const int64_t runs = (columns + kColumnLanes - 1) / kColumnLanes;
+/// fn(i0, lanes) for each run of Lanes consecutive elements (the last may be shorter) of n: the
+/// run's lanes are elements i0 .. i0 + lanes - 1. Column scans take kColumnLanes columns a run.
+template <int Lanes, typename F>
+void parallel_for_runs(int64_t n, F fn) {
+  const int64_t runs = (n + Lanes - 1) / Lanes;
   parallel_for(
       runs,
       [=] WB_HD(int64_t r) {
-        const int64_t col0 = r * kColumnLanes, left = columns - col0;
-        fn(col0, int(left < kColumnLanes ? left : kColumnLanes));
+        const int64_t i0 = r * Lanes, left = n - i0;
+        fn(i0, int(left < Lanes ? left : Lanes));
       },
-      kMinParallelSize / kColumnLanes);  // serial below as many columns as a loop over columns
+      kMinParallelSize / Lanes);  // serial below as many elements as a loop over them
 }
 
 }  // namespace WB_BACKEND_NS

@@ -156,13 +156,13 @@ void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float*
 void grid_column_tops(GridDims d, const float* rho, const float* dryness, float liquid_threshold, float dry_threshold,
                       const float* particle_density, float trace, float* out) {
   const int64_t n = int64_t(d.nx) * d.ny;
-  parallel_for_column_runs(n, [=] WB_HD(int64_t col0, int lanes) {
+  parallel_for_runs<kColumnLanes>(n, [=] WB_HD(int64_t col0, int lanes) {
     // The column's top layer (k + 1) holding paint above `trace`, and holding paint or particles;
     // where it holds either, its x, -x, y and -y, whose maxima are the box of such columns. Dried
     // paint counts only where the classification makes it liquid (liquid_on_canvas): a canvas's
     // ground or a dried layer is solid or air, never moves, and the cells of it that wet paint
     // can reach lie within the box's margins. Each layer of the run's columns at once, down the
-    // whole column (parallel_for_column_runs).
+    // whole column (parallel_for_runs<kColumnLanes>).
     // Without particles the paint's density stands in for theirs against a bound none passes, so
     // that every lane does the same loads and compares (no branch: the run vectorises).
     const float* pd = particle_density ? particle_density : rho;
@@ -541,7 +541,7 @@ void grid_film_columns(GridDims d, const GridExtent* e, PaintWindowView pw, Bris
                        const float* particle_density, FlowColumns flow, float dry_threshold, float film_max,
                        FilmFlow f, float* col) {
   const int64_t n = int64_t(d.nx) * d.ny;
-  parallel_for_column_runs(n, [=] WB_HD(int64_t c0, int lanes) {
+  parallel_for_runs<kColumnLanes>(n, [=] WB_HD(int64_t c0, int lanes) {
     // Columns outside the paint's box (no paint there) or the flow's (a wall: FlowColumns) are no
     // film; a run with none inside reads no cell.
     bool in[kColumnLanes];

@@ -24,7 +24,7 @@ WB_HD WB_INLINE uint8_t classify_cell(float density, float dryness, bool on_canv
 }
 
 /// classify_cell(density, dryness, true, ...) == kCellLiquid as one expression, without a branch
-/// (a column scan's lanes vectorise over it: parallel_for_column_runs).
+/// (a column scan's lanes vectorise over it: parallel_for_runs<kColumnLanes>).
 WB_HD WB_INLINE bool liquid_on_canvas(float density, float dryness, float liquid_threshold, float dry_threshold) {
   return !dried_solid(density, dryness, dry_threshold) & (density >= liquid_threshold);
 }

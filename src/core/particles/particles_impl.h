@@ -177,8 +177,8 @@ void particles_solid_height(PaintWindowView pw, const float* particle_density, f
                  liquid_threshold > 0.f && std::isfinite(floor_z),
              "particles_solid_height: bad threshold or floor");
   const int64_t layer = int64_t(pw.nx) * pw.ny;
-  parallel_for_column_runs(layer, [=] WB_HD(int64_t col0, int lanes) {
-    // Down each column of the run at once, layer by layer (parallel_for_column_runs): the highest
+  parallel_for_runs<kColumnLanes>(layer, [=] WB_HD(int64_t col0, int lanes) {
+    // Down each column of the run at once, layer by layer (parallel_for_runs<kColumnLanes>): the highest
     // dried solid (column_solid_tops) and, above it, the highest liquid cell by the grid's joint
     // test, whose top is the wet paint's free surface.
     float solid[kColumnLanes], wet[kColumnLanes];
@@ -219,7 +219,7 @@ void particles_ground_surface(PaintWindowView pw, const float* particle_density,
                  liquid_threshold > 0.f && std::isfinite(floor_z),
              "particles_ground_surface: bad threshold or floor");
   const int64_t layer = int64_t(pw.nx) * pw.ny;
-  parallel_for_column_runs(layer, [=] WB_HD(int64_t col0, int lanes) {
+  parallel_for_runs<kColumnLanes>(layer, [=] WB_HD(int64_t col0, int lanes) {
     float top[kColumnLanes];
     int above[kColumnLanes];
     column_solid_tops(pw, col0, lanes, dry_threshold, floor_z, top, above);

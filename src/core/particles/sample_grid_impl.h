@@ -110,10 +110,30 @@ void sample_grid_near(const int32_t* box, const uint8_t* occupied, int reach, in
 }
 
 void sample_grid_query(SampleGridView g, ParticleView p, float max_range) {
-  parallel_for(p.count, [=] WB_HD(int64_t k) {
-    const NearestSample s = nearest_sample(g, p.x[k], max_range);
-    p.nearest[k] = s.index;
-    p.d_B[k] = s.dist;
+  // Runs of kQueryLanes particles; of a run, each stretch whose cells span at most two a side is
+  // one query (the particles are sorted by cell: most runs are one or two).
+  parallel_for_runs<kQueryLanes>(p.count, [=] WB_HD(int64_t k0, int lanes) {
+    const float inv_h = 1.f / g.h;
+    NearestSample found[kQueryLanes];
+    int start = 0, b0[3] = {0, 0, 0}, b1[3] = {0, 0, 0};
+    for (int j = 0; j <= lanes; ++j) {
+      int c[3] = {0, 0, 0};
+      if (j < lanes) sample_cell_of(p.x[k0 + j], inv_h, c[0], c[1], c[2]);
+      if (j > start && (j == lanes || !query_joins(b0, b1, c))) {
+        nearest_samples(g, p.x + k0 + start, j - start, max_range, found + start);
+        start = j;
+      }
+      if (j == start)
+        for (int a = 0; a < 3; ++a) b0[a] = b1[a] = c[a];
+      for (int a = 0; a < 3; ++a) {
+        b0[a] = imin(b0[a], c[a]);
+        b1[a] = imax(b1[a], c[a]);
+      }
+    }
+    for (int j = 0; j < lanes; ++j) {
+      p.nearest[k0 + j] = found[j].index;
+      p.d_B[k0 + j] = found[j].dist;
+    }
   });
 }
 

@@ -55,101 +55,169 @@ struct NearestSample {
   float dist;     ///< distance to it, or the range when none
 };
 
-/// Rings (cells along one axis) from cell c to the nearest cell of [lo, hi]: 0 inside.
-WB_HD WB_INLINE int ring_near(int lo, int hi, int c) { return c < lo ? lo - c : (c > hi ? c - hi : 0); }
-/// Rings from cell c to the farthest cell of [lo, hi].
-WB_HD WB_INLINE int ring_far(int lo, int hi, int c) { return c - lo > hi - c ? c - lo : hi - c; }
+/// Rings (cells along one axis) from the cells [b0, b1] to the nearest cell of [lo, hi]: 0 where
+/// they overlap.
+WB_HD WB_INLINE int ring_near(int lo, int hi, int b0, int b1) { return b1 < lo ? lo - b1 : (b0 > hi ? b0 - hi : 0); }
+/// Rings from the cells [b0, b1] to the farthest cell of [lo, hi].
+WB_HD WB_INLINE int ring_far(int lo, int hi, int b0, int b1) { return imax(imax(b0 - lo, hi - b1), 0); }
 
-/// Checks the sorted slots [s, end) against the best so far (ties to the lower sample index).
-WB_HD WB_INLINE void nearest_in(const SampleGridView& g, Vec3 p, uint32_t s, uint32_t end, float& best_d2,
-                                int32_t& best) {
+/// Points a nearest-sample query takes together: on the CPU 16 consecutive particles (sorted by
+/// cell, they are neighbours), which read each row of the sorted list once for all and test each
+/// sample against all of them in vector lanes; on CUDA 1, a warp's threads being the lanes.
+#if defined(__CUDACC__)
+inline constexpr int kQueryLanes = 1;
+#else
+inline constexpr int kQueryLanes = 16;
+#endif
+
+/// The points of one query that take part, one lane each.
+struct QueryLanes {
+  int n;                       ///< lanes in use
+  int slot[kQueryLanes];       ///< the point's place among the query's points
+  float x[kQueryLanes], y[kQueryLanes], z[kQueryLanes];
+  float best_d2[kQueryLanes];  ///< squared distance of the best sample so far
+  int32_t best[kQueryLanes];   ///< its index, INT32_MAX while none
+  float edge[kQueryLanes];     ///< distance to the nearest face of the query's cells
+};
+
+/// Tests the sorted slots [s, end) against every lane: the nearer sample wins, and of two as near
+/// the lower index, so that the answer does not depend on the order of the visits.
+WB_HD WB_INLINE void nearest_in(const SampleGridView& g, uint32_t s, uint32_t end, QueryLanes& q) {
+  if (q.n == 1) {  // one point (always on CUDA): most samples cost one compare, no index read
+    const Vec3 p(q.x[0], q.y[0], q.z[0]);
+    for (; s < end; ++s) {
+      const float d2 = length2(g.sorted_x[s] - p);
+      if (!(d2 <= q.best_d2[0])) continue;  // and a NaN
+      const int32_t idx = int32_t(g.sorted_index[s]);
+      if (d2 < q.best_d2[0] || idx < q.best[0]) {
+        q.best_d2[0] = d2;
+        q.best[0] = idx;
+      }
+    }
+    return;
+  }
   for (; s < end; ++s) {
-    const float d2 = length2(g.sorted_x[s] - p);
-    if (!(d2 <= best_d2)) continue;  // most samples (and a NaN): one compare, no index read
+    const Vec3 v = g.sorted_x[s];
     const int32_t idx = int32_t(g.sorted_index[s]);
-    if (d2 < best_d2 || (best >= 0 && idx < best)) {
-      best_d2 = d2;
-      best = idx;
+    for (int j = 0; j < q.n; ++j) {  // no branch: the lanes vectorise
+      const float dx = v.x - q.x[j], dy = v.y - q.y[j], dz = v.z - q.z[j];
+      const float d2 = dx * dx + dy * dy + dz * dz;  // length2's order of sums
+      const bool better = (d2 < q.best_d2[j]) | ((d2 == q.best_d2[j]) & (idx < q.best[j]));
+      q.best_d2[j] = better ? d2 : q.best_d2[j];
+      q.best[j] = better ? idx : q.best[j];
     }
   }
 }
 
-/// Nearest sample to p within max_range. Shells of cells at Chebyshev ring R = 0, 1, ...
-/// around p's cell are visited in order, clipped to the box's cells that the cube of
-/// half-side max_range around p reaches; after ring R every unvisited sample is farther than
-/// R h plus p's distance to the nearest face of its cell, so the search stops once the best
-/// distance is below that or R h reaches max_range. A shell's cells lie in rows along x: on its
-/// two z faces and two y faces whole rows, each one range of the sorted list (two loads for
-/// up to 2R + 1 cells); inside them the rows' two end cells. Ties go to the lower sample index,
-/// so the answer does not depend on the order of the visits.
+/// Nearest sample within max_range to each of the points p[0 .. m) (m <= kQueryLanes), written to
+/// out. The points' cells span at most two cells along each axis (the caller groups them so), the
+/// box B of cells. Shells of cells at Chebyshev ring R = 0, 1, ... around B are visited in order,
+/// clipped to the grid's box and to the cells that the cube of half-side max_range around the
+/// points reaches; after ring R every unvisited sample is farther from a point than R h plus the
+/// point's distance to the nearest face of B, so the search stops once every point's best
+/// distance is below that, or R h reaches max_range. A shell's cells lie in rows along x: on its
+/// two z faces and two y faces whole rows, each one range of the sorted list (two loads for up to
+/// 2R + |B| cells); inside them the rows' two end cells.
 ///
-/// Most particles of a stroke lie beyond the range of every sample: the coarse cell's flag
-/// (SampleGridView::near) tells them with one load.
-WB_HD WB_INLINE NearestSample nearest_sample(const SampleGridView& g, Vec3 p, float max_range) {
-  NearestSample out{-1, max_range};
-  if (g.count == 0 || !isfinite3(p)) return out;  // a non-finite point has no neighbour
+/// Most particles of a stroke lie beyond the range of every sample: a point's coarse cell flag
+/// (SampleGridView::near) tells it with one load, and it takes no part.
+WB_HD WB_INLINE void nearest_samples(const SampleGridView& g, const Vec3* p, int m, float max_range,
+                                     NearestSample* out) {
   const float inv_h = 1.f / g.h;
   const int blo[3] = {g.box[0], g.box[1], g.box[2]}, bhi[3] = {g.box[3], g.box[4], g.box[5]};
-  const float pc[3] = {p.x, p.y, p.z};
-  // The cells visited: those of the box that the cube of half-side max_range around p reaches
-  // (no sample within max_range lies outside it). For a short range this is a few cells of
-  // ring 1, not the whole ring.
-  int lo[3], hi[3], c[3];
-  for (int a = 0; a < 3; ++a) {
-    lo[a] = imax(blo[a], cell_coord((pc[a] - max_range) * inv_h));
-    hi[a] = imin(bhi[a], cell_coord((pc[a] + max_range) * inv_h));
-    if (lo[a] > hi[a]) return out;  // no sample's cell within reach
-    c[a] = cell_coord(pc[a] * inv_h);
-  }
   const int64_t nx = int64_t(bhi[0]) - blo[0] + 1, ny = int64_t(bhi[1]) - blo[1] + 1;
-  if (c[0] >= blo[0] && c[0] <= bhi[0] && c[1] >= blo[1] && c[1] <= bhi[1] && c[2] >= blo[2] && c[2] <= bhi[2]) {
-    // p's coarse cell (a point outside the box goes on to the shells).
-    const int64_t cc = (int64_t((c[2] - blo[2]) >> kCoarseShift) * coarse_count(ny) + ((c[1] - blo[1]) >> kCoarseShift)) *
-                           coarse_count(nx) +
-                       ((c[0] - blo[0]) >> kCoarseShift);
-    if (!g.near[cc]) return out;
+  QueryLanes q;
+  q.n = 0;
+  int b0[3] = {INT32_MAX, INT32_MAX, INT32_MAX}, b1[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+  float p0[3] = {INFINITY, INFINITY, INFINITY}, p1[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (int j = 0; j < m; ++j) {
+    out[j] = NearestSample{-1, max_range};
+    if (g.count == 0 || !isfinite3(p[j])) continue;  // a non-finite point has no neighbour
+    const float pc[3] = {p[j].x, p[j].y, p[j].z};
+    int c[3];
+    for (int a = 0; a < 3; ++a) c[a] = cell_coord(pc[a] * inv_h);
+    if (c[0] >= blo[0] && c[0] <= bhi[0] && c[1] >= blo[1] && c[1] <= bhi[1] && c[2] >= blo[2] && c[2] <= bhi[2]) {
+      // The point's coarse cell (a point outside the box goes on to the shells).
+      const int64_t cc = (int64_t((c[2] - blo[2]) >> kCoarseShift) * coarse_count(ny) + ((c[1] - blo[1]) >> kCoarseShift)) *
+                             coarse_count(nx) +
+                         ((c[0] - blo[0]) >> kCoarseShift);
+      if (!g.near[cc]) continue;
+    }
+    const int l = q.n++;
+    q.slot[l] = j;
+    q.x[l] = pc[0];
+    q.y[l] = pc[1];
+    q.z[l] = pc[2];
+    q.best_d2[l] = max_range * max_range;
+    q.best[l] = INT32_MAX;
+    for (int a = 0; a < 3; ++a) {
+      b0[a] = imin(b0[a], c[a]);
+      b1[a] = imax(b1[a], c[a]);
+      p0[a] = fminf(p0[a], pc[a]);
+      p1[a] = fmaxf(p1[a], pc[a]);
+    }
+  }
+  if (q.n == 0) return;
+  // The cells visited: those of the box that the cubes of half-side max_range around the points
+  // reach (no sample within max_range lies outside them).
+  int lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = imax(blo[a], cell_coord((p0[a] - max_range) * inv_h));
+    hi[a] = imin(bhi[a], cell_coord((p1[a] + max_range) * inv_h));
+    if (lo[a] > hi[a]) return;  // no sample's cell within reach
   }
   // Rings of the nearest and farthest cells visited. Each distance is a difference of the two
   // ends taken in the order that makes it non-negative: nvcc 13.0 (sm_90) folded the
   // equivalent nested max(lo, -hi, 0) of the negated differences wrongly (the query then
   // skipped ring 0).
-  const int r_box = imax(imax(ring_far(lo[0], hi[0], c[0]), ring_far(lo[1], hi[1], c[1])), ring_far(lo[2], hi[2], c[2]));
-  const int r_start = imax(imax(ring_near(lo[0], hi[0], c[0]), ring_near(lo[1], hi[1], c[1])), ring_near(lo[2], hi[2], c[2]));
-  // After ring R every unvisited cell lies beyond the cube of rings 0..R, at least R h plus
-  // p's distance to the nearest face of its own cell away.
-  float edge = g.h;
-  for (int a = 0; a < 3; ++a) {
-    const float in_cell = pc[a] - float(c[a]) * g.h;
-    edge = fminf(edge, fminf(in_cell, g.h - in_cell));
+  const int r_box = imax(imax(ring_far(lo[0], hi[0], b0[0], b1[0]), ring_far(lo[1], hi[1], b0[1], b1[1])),
+                         ring_far(lo[2], hi[2], b0[2], b1[2]));
+  const int r_start = imax(imax(ring_near(lo[0], hi[0], b0[0], b1[0]), ring_near(lo[1], hi[1], b0[1], b1[1])),
+                           ring_near(lo[2], hi[2], b0[2], b1[2]));
+  // After ring R every unvisited cell lies beyond the cells of rings 0..R, at least R h plus the
+  // point's distance to the nearest face of B away; less the round-off of p - c h far from the
+  // origin.
+  for (int j = 0; j < q.n; ++j) {
+    const float pc[3] = {q.x[j], q.y[j], q.z[j]};
+    float e = INFINITY;
+    for (int a = 0; a < 3; ++a) e = fminf(e, fminf(pc[a] - float(b0[a]) * g.h, float(b1[a] + 1) * g.h - pc[a]));
+    q.edge[j] = fmaxf(e - 1e-3f * g.h, 0.f);
   }
-  edge = fmaxf(edge - 1e-3f * g.h, 0.f);  // less the round-off of p - c h far from the origin
-  float best_d2 = max_range * max_range;
-  int32_t best = -1;
   // Cells of ring R hold points at distance <= max_range only while (R - 1) h < max_range.
   const int r_max = imin(int(ceilf(max_range * inv_h)) + 1, r_box);
   for (int R = r_start; R <= r_max; ++R) {
     if (R > 0 && float(R - 1) * g.h >= max_range) break;
-    const int z0 = imax(c[2] - R, lo[2]), z1 = imin(c[2] + R, hi[2]), y0 = imax(c[1] - R, lo[1]);
-    const int y1 = imin(c[1] + R, hi[1]), x0 = imax(c[0] - R, lo[0]), x1 = imin(c[0] + R, hi[0]);
+    const int z0 = imax(b0[2] - R, lo[2]), z1 = imin(b1[2] + R, hi[2]), y0 = imax(b0[1] - R, lo[1]);
+    const int y1 = imin(b1[1] + R, hi[1]), x0 = imax(b0[0] - R, lo[0]), x1 = imin(b1[0] + R, hi[0]);
     for (int z = z0; z <= z1; ++z)
       for (int y = y0; y <= y1; ++y) {
         const int64_t row = ((int64_t(z) - blo[2]) * ny + (int64_t(y) - blo[1])) * nx - blo[0];
-        if (z == c[2] - R || z == c[2] + R || y == c[1] - R || y == c[1] + R) {
-          if (x0 <= x1) nearest_in(g, p, g.first[row + x0], g.first[row + x1 + 1], best_d2, best);
+        if (R == 0 || z == b0[2] - R || z == b1[2] + R || y == b0[1] - R || y == b1[1] + R) {
+          if (x0 <= x1) nearest_in(g, g.first[row + x0], g.first[row + x1 + 1], q);
         } else {
           // Inside the shell's faces only the row's two end cells lie on the shell.
-          if (c[0] - R >= lo[0]) nearest_in(g, p, g.first[row + c[0] - R], g.first[row + c[0] - R + 1], best_d2, best);
-          if (c[0] + R <= hi[0]) nearest_in(g, p, g.first[row + c[0] + R], g.first[row + c[0] + R + 1], best_d2, best);
+          if (b0[0] - R >= lo[0]) nearest_in(g, g.first[row + b0[0] - R], g.first[row + b0[0] - R + 1], q);
+          if (b1[0] + R <= hi[0]) nearest_in(g, g.first[row + b1[0] + R], g.first[row + b1[0] + R + 1], q);
         }
       }
-    const float reach = float(R) * g.h + edge;
-    if (best >= 0 && best_d2 < reach * reach) break;
+    bool done = true;
+    for (int j = 0; j < q.n; ++j) {
+      const float reach = float(R) * g.h + q.edge[j];
+      done = done && q.best[j] != INT32_MAX && q.best_d2[j] < reach * reach;
+    }
+    if (done) break;
   }
-  if (best >= 0 && best_d2 < max_range * max_range) {
-    out.index = best;
-    out.dist = sqrtf(best_d2);
-  }
-  return out;
+  for (int j = 0; j < q.n; ++j)
+    if (q.best[j] != INT32_MAX && q.best_d2[j] < max_range * max_range)
+      out[q.slot[j]] = NearestSample{q.best[j], sqrtf(q.best_d2[j])};
+}
+
+/// Whether a point in cell c may join a query whose cells are [b0, b1]: the query's cells then
+/// span at most two along each axis.
+WB_HD WB_INLINE bool query_joins(const int* b0, const int* b1, const int* c) {
+  for (int a = 0; a < 3; ++a)
+    if (imax(b1[a], c[a]) - imin(b0[a], c[a]) > 1) return false;
+  return true;
 }
 
 }  // namespace wb
