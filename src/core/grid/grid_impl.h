@@ -206,9 +206,9 @@ void grid_running_columns(GridView g, PaintWindowView pw, float dry_threshold, f
     for (int k = 0; k < d.nz && !running; ++k) {
       const int64_t c = d.cell(i, j, k);
       if (!(pw.density[c] > 0.f) || pw.dryness[c] >= dry_threshold) continue;
-      const float u = fmaxf(fabsf(g.vel[0][d.uidx(i, j, k)]), fabsf(g.vel[0][d.uidx(i + 1, j, k)]));
-      const float v = fmaxf(fabsf(g.vel[1][d.vidx(i, j, k)]), fabsf(g.vel[1][d.vidx(i, j + 1, k)]));
-      running = fmaxf(u, v) > speed;
+      const float u = maxf(fabsf(g.vel[0][d.uidx(i, j, k)]), fabsf(g.vel[0][d.uidx(i + 1, j, k)]));
+      const float v = maxf(fabsf(g.vel[1][d.vidx(i, j, k)]), fabsf(g.vel[1][d.vidx(i, j + 1, k)]));
+      running = maxf(u, v) > speed;  // maxf: fmaxf is a library call on the CPU
     }
     const float none = -INFINITY, x = float(i + pw.ox) + 0.5f, y = float(j + pw.oy) + 0.5f;
     out[col] = running ? x : none;

@@ -153,8 +153,8 @@ WB_HD WB_INLINE void nearest_samples(const SampleGridView& g, const Vec3* p, int
     for (int a = 0; a < 3; ++a) {
       b0[a] = imin(b0[a], c[a]);
       b1[a] = imax(b1[a], c[a]);
-      p0[a] = fminf(p0[a], pc[a]);
-      p1[a] = fmaxf(p1[a], pc[a]);
+      p0[a] = minf(p0[a], pc[a]);
+      p1[a] = maxf(p1[a], pc[a]);
     }
   }
   if (q.n == 0) return;
@@ -180,8 +180,8 @@ WB_HD WB_INLINE void nearest_samples(const SampleGridView& g, const Vec3* p, int
   for (int j = 0; j < q.n; ++j) {
     const float pc[3] = {q.x[j], q.y[j], q.z[j]};
     float e = INFINITY;
-    for (int a = 0; a < 3; ++a) e = fminf(e, fminf(pc[a] - float(b0[a]) * g.h, float(b1[a] + 1) * g.h - pc[a]));
-    q.edge[j] = fmaxf(e - 1e-3f * g.h, 0.f);
+    for (int a = 0; a < 3; ++a) e = minf(e, minf(pc[a] - float(b0[a]) * g.h, float(b1[a] + 1) * g.h - pc[a]));
+    q.edge[j] = maxf(e - 1e-3f * g.h, 0.f);
   }
   // Cells of ring R hold points at distance <= max_range only while (R - 1) h < max_range.
   const int r_max = imin(int(ceilf(max_range * inv_h)) + 1, r_box);

@@ -277,8 +277,10 @@ struct DistanceBlocks {
                 fz = (q.z + shift.z) * inv - 0.5f + float(margin);
     const int i0 = imin(imax(int(floorf(fx)), 0), bx - 2), j0 = imin(imax(int(floorf(fy)), 0), by - 2),
               k0 = imin(imax(int(floorf(fz)), 0), bz - 2);
-    const float tx = fminf(fmaxf(fx - float(i0), 0.f), 1.f), ty = fminf(fmaxf(fy - float(j0), 0.f), 1.f),
-                tz = fminf(fmaxf(fz - float(k0), 0.f), 1.f);
+    // minf / maxf, not fminf / fmaxf: the CPU build calls the library for those (their NaN rule)
+    // on every particle.
+    const float tx = minf(maxf(fx - float(i0), 0.f), 1.f), ty = minf(maxf(fy - float(j0), 0.f), 1.f),
+                tz = minf(maxf(fz - float(k0), 0.f), 1.f);
     float d = 0.f;
     for (int c = 0; c < 8; ++c) {
       const int di = c & 1, dj = (c >> 1) & 1, dk = c >> 2;
