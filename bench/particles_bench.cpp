@@ -113,8 +113,9 @@ void BM_AdhesionStep(benchmark::State& state) {
   s.grid.query_nearest(s.store.view(), s.prm.D0);
   const ParticleHost start = s.store.to_host();
   SolidView solid;
+  DeviceBuffer<SampleMotion> motion(s.d, size_t(s.ds.view().count()));
   for (auto _ : state) {
-    particles_adhesion_step(s.d, s.store.view(), s.ds.view(), solid, s.prm, s.dt);
+    particles_adhesion_step(s.d, s.store.view(), s.ds.view(), solid, s.prm, s.dt, motion.data());
     s.d.synchronize();
     state.PauseTiming();
     s.store.clear();

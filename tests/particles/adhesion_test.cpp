@@ -50,7 +50,7 @@ TEST_F(AdhesionTest, FrictionDampsNearTheSurfaceOnly) {
   store.append(particles_at(x, Vec3(300.f, -120.f, 0.f)));  // no sample: nearest = -1
   ParticleParams prm;
   prm.gravity = Vec3();
-  particles_adhesion_step(device_, store.view(), SampleView{}, floor_at(0.f), prm, kDt);
+  particles_adhesion_step(device_, store.view(), SampleView{}, floor_at(0.f), prm, kDt, nullptr);
   const ParticleHost h = store.to_host();
   float prev = -1.f;
   for (size_t k = 0; k < heights.size(); ++k) {
@@ -97,11 +97,12 @@ TEST_F(AdhesionTest, BlendWeightsOfEq10) {
   ParticleParams prm;
   prm.gravity = Vec3();
   const SolidView solid = floor_at(-1000.f);
-  particles_adhesion_step(device_, store.view(), ds.view(), solid, prm, kDt);
+  DeviceBuffer<SampleMotion> motion(device_, hs.x.size());
+  particles_adhesion_step(device_, store.view(), ds.view(), solid, prm, kDt, motion.data());
   const ParticleHost h = store.to_host();
   // Host references.
   SampleFrame s{hs.x[3], hs.t[3], hs.n[3], hs.b[3], hs.v[3], hs.omega[3], hs.a[3], hs.alpha[3]};
-  const Vec3 local = local_frame_step(start[0], v0, Vec3(), s, prm.beta_L, kDt);
+  const Vec3 local = local_frame_step(start[0], v0, Vec3(), sample_motion(s, kDt), prm.beta_L, kDt);
   const Vec3 canvas = canvas_frame_step(start[1], v0, Vec3(), kDt);
   EXPECT_NEAR(length(h.x[0] - local), 0.f, 1e-3f);
   EXPECT_NEAR(length(h.x[1] - canvas), 0.f, 1e-3f);
@@ -127,11 +128,11 @@ TEST_F(AdhesionTest, BetaZeroCarriesARotatingFrameRigidly) {
              b0 = rotate_axis_angle(s.b, axis, -w * kDt);
   const Vec3 p = s.x + to_canvas(t0, n0, b0, rl);
   const Vec3 v = cross(s.omega, p - s.x);
-  const Vec3 pn = local_frame_step(p, v, Vec3(), s, 0.f, kDt);
+  const Vec3 pn = local_frame_step(p, v, Vec3(), sample_motion(s, kDt), 0.f, kDt);
   const Vec3 expect = s.x + to_canvas(s.t, s.n, s.b, rl);
   EXPECT_NEAR(length(pn - expect), 0.f, 1e-4f);
   // With beta_L = 1 the frame's rotation is felt in full: a particle at rest stays (to O(dt^2)).
-  const Vec3 rest = local_frame_step(p, Vec3(), Vec3(), s, 1.f, kDt);
+  const Vec3 rest = local_frame_step(p, Vec3(), Vec3(), sample_motion(s, kDt), 1.f, kDt);
   EXPECT_LT(length(rest - p), 0.5f * w * w * length(rl) * kDt * kDt * 4.f);
   EXPECT_GT(length(pn - p), 10.f * length(rest - p));
 }
@@ -144,7 +145,7 @@ TEST_F(AdhesionTest, SpinAboutTheTangentDoesNotSwingParticles) {
   s.t = Vec3(1, 0, 0), s.n = Vec3(0, 1, 0), s.b = Vec3(0, 0, 1);
   s.omega = s.t * 300.f;  // 5 rad per step: a parallel-transport artefact
   const Vec3 p = s.x + Vec3(0.f, 4.f, 0.f);
-  EXPECT_NEAR(length(local_frame_step(p, Vec3(), Vec3(), s, 0.f, kDt) - p), 0.f, 1e-4f);
+  EXPECT_NEAR(length(local_frame_step(p, Vec3(), Vec3(), sample_motion(s, kDt), 0.f, kDt) - p), 0.f, 1e-4f);
   // A turn across the tangent is kept whole, whatever its rate; only the spin goes.
   s.omega = Vec3(0.f, 0.f, 600.f) + s.t * 200.f;  // 10 rad per step across t, plus spin
   const SampleFrame c = physical_rotation(s);
@@ -186,12 +187,14 @@ TEST_F(AdhesionTest, BristleJoltMovesPaintOnTheCanvasLittleAndTheSameWhateverThe
     s.v = Vec3(600.f, 0.f, 0.f);
     s.a = s.v / dt;
     Vec3 p(50.f, 51.f, z), v;
-    adhesion_update(p, v, &s, 1.f, floor_at(0.f), prm, dt);
+    SampleMotion m = sample_motion(s, dt);
+    adhesion_update(p, v, &m, 1.f, floor_at(0.f), prm, dt);
     // Later steps: the sample keeps its velocity; the particle's own velocity decays.
     s.a = Vec3();
     for (int k = 0; k < 4; ++k) {
       s.x += s.v * dt;
-      adhesion_update(p, v, &s, 1.f, floor_at(0.f), prm, dt);
+      m = sample_motion(s, dt);
+      adhesion_update(p, v, &m, 1.f, floor_at(0.f), prm, dt);
     }
     return p.x - 50.f;
   };
@@ -209,7 +212,8 @@ TEST_F(AdhesionTest, RelativeVelocityAfterASuddenChangeIsBetaTimesIt) {
   SampleFrame s{Vec3(10.f, 10.f, 50.f), Vec3(0, 1, 0), Vec3(1, 0, 0), Vec3(0, 0, -1), dV, Vec3(), dV / kDt, Vec3()};
   for (float beta : {0.f, 0.1f, 0.2f, 1.f}) {
     Vec3 p = s.x - s.v * kDt + Vec3(0.f, 0.f, 0.f), v;
-    adhesion_update(p, v, &s, 0.f, floor_at(0.f), params(Vec3(), 0.1f, beta, 15.f), kDt);
+    const SampleMotion m = sample_motion(s, kDt);
+    adhesion_update(p, v, &m, 0.f, floor_at(0.f), params(Vec3(), 0.1f, beta, 15.f), kDt);
     EXPECT_NEAR(v.z, (1.f - beta) * 600.f, 1e-2f) << beta;
     EXPECT_NEAR(v.x, 0.f, 1e-3f);
   }
@@ -225,10 +229,10 @@ TEST_F(AdhesionTest, ParticlesStayAboveTheSolid) {
   SolidView solid = floor_at(0.f);
   solid.height = hmap.data();
   solid.nx = 2, solid.ny = 2, solid.ox = 5, solid.oy = 4;
-  particles_adhesion_step(device_, store.view(), SampleView{}, solid, prm, kDt);
+  particles_adhesion_step(device_, store.view(), SampleView{}, solid, prm, kDt, nullptr);
   const ParticleHost h = store.to_host();
   for (size_t k = 0; k < 2; ++k) EXPECT_GE(h.x[k].z, 2.f);
-  EXPECT_THROW(particles_adhesion_step(device_, store.view(), SampleView{}, solid, prm, 0.f), Error);
+  EXPECT_THROW(particles_adhesion_step(device_, store.view(), SampleView{}, solid, prm, 0.f, nullptr), Error);
 }
 
 // ---- Figure 8 --------------------------------------------------------------------------
@@ -256,6 +260,7 @@ float figure8_max_distance(const Device& device, Workspace& ws, Method method, V
   ParticleStore store(device);
   store.append(particles_at(x0, V));
   DeviceSamples ds(device);
+  DeviceBuffer<SampleMotion> motion(device, hs.x.size());
   SampleGrid grid(device);
   ParticleParams prm;
   prm.gravity = Vec3();
@@ -275,7 +280,7 @@ float figure8_max_distance(const Device& device, Workspace& ws, Method method, V
       const Region r = region_around(store.to_host().x, prm.D0);
       grid.build(ds.view(), prm.sample_cell, r.lo, r.hi, ws, kDt);
       grid.query_nearest(store.view(), prm.D0);
-      particles_adhesion_step(device, store.view(), ds.view(), solid, prm, kDt);
+      particles_adhesion_step(device, store.view(), ds.view(), solid, prm, kDt, motion.data());
       h = store.to_host();
     } else {
       h = store.to_host();

@@ -1,4 +1,5 @@
-// Scratch memory for the algorithms (radix-sort ping-pong buffers, CUB temp storage).
+// Scratch memory for the algorithms (radix-sort ping-pong buffers, CUB temp storage) and a
+// stage's scratch between two of its launches (the samples' motion of the adhesion step).
 // It grows geometrically and is kept, so the per-step path never allocates once warm.
 #pragma once
 #include <cstddef>

@@ -108,52 +108,66 @@ WB_HD WB_INLINE SampleFrame physical_rotation(SampleFrame s) {
   return s;
 }
 
-/// Eq. 9, the local-frame update; returns p' in the canvas frame.
-/// The sample holds its state at the end of the brush step (t + dt), with velocities from
-/// position differences (v = dx/dt, a = dv/dt, rotation over the step = omega dt, as
-/// position-based dynamics produces them). The frame at t is therefore x - v dt, axes
-/// rotated by -omega dt, velocity v - a dt, angular velocity omega - alpha dt. In it:
+/// A sample's part of Eq. 9, the same for every particle it holds (worked out once a sample a
+/// step: sample_motion). The sample holds its state at the end of the brush step (t + dt), with
+/// velocities from position differences (v = dx/dt, a = dv/dt, rotation over the step = omega dt,
+/// as position-based dynamics produces them). The frame at t is therefore x - v dt, axes rotated
+/// by -omega dt, velocity v - a dt, angular velocity omega - alpha dt.
+struct SampleMotion {
+  Vec3 x0, v0, w0;  ///< the frame's origin, velocity and angular velocity at t (canvas)
+  Vec3 t0, n0, b0;  ///< its axes at t: R_L's rows
+  Vec3 W, Wdot, A;  ///< R_L omega_j, R_L alpha_j, R_L a_j
+  Vec3 x, t, n, b;  ///< the frame at t + dt, where p^l maps back
+};
+
+WB_HD WB_INLINE SampleMotion sample_motion(const SampleFrame& s_in, float dt) {
+  const SampleFrame s = physical_rotation(s_in);
+  SampleMotion m;
+  m.x0 = s.x - s.v * dt;
+  m.v0 = s.v - s.a * dt;
+  m.w0 = s.omega - s.alpha * dt;
+  m.t0 = s.t, m.n0 = s.n, m.b0 = s.b;
+  const float wl = length(s.omega);
+  if (wl * dt > 1e-7f) {
+    const Vec3 axis = s.omega / wl;
+    m.t0 = rotate_axis_angle(s.t, axis, -wl * dt);
+    m.n0 = rotate_axis_angle(s.n, axis, -wl * dt);
+    m.b0 = rotate_axis_angle(s.b, axis, -wl * dt);
+  }
+  m.W = to_local(m.t0, m.n0, m.b0, m.w0);
+  m.Wdot = to_local(m.t0, m.n0, m.b0, s.alpha);
+  m.A = to_local(m.t0, m.n0, m.b0, s.a);
+  m.x = s.x, m.t = s.t, m.n = s.n, m.b = s.b;
+  return m;
+}
+
+/// Eq. 9, the local-frame update; returns p' in the canvas frame. In the sample's frame at t:
 ///   p^l = R_L (p - x_j),  v^l = R_L (v_k - v_j - omega_j x (p - x_j)),
 ///   dv^l/dt = R_L a_k - beta_L (R_L a_j + w x (w x p^l) + R_L alpha_j x p^l + 2 w x v^l),  w = R_L omega_j,
 /// integrated by symplectic Euler, and p^l mapped back with the frame at t + dt.
 /// With beta_L = 0 and a_k = 0 a particle moving with the sample stays rigidly attached.
-WB_HD WB_INLINE Vec3 local_frame_step(Vec3 p, Vec3 v, Vec3 a_k, const SampleFrame& s_in, float beta_L, float dt) {
-  const SampleFrame s = physical_rotation(s_in);
-  // The frame at the start of the step.
-  const Vec3 x0 = s.x - s.v * dt;
-  const Vec3 v0 = s.v - s.a * dt;
-  const Vec3 w0 = s.omega - s.alpha * dt;
-  Vec3 t0 = s.t, n0 = s.n, b0 = s.b;
-  const float wl = length(s.omega);
-  if (wl * dt > 1e-7f) {
-    const Vec3 axis = s.omega / wl;
-    t0 = rotate_axis_angle(s.t, axis, -wl * dt);
-    n0 = rotate_axis_angle(s.n, axis, -wl * dt);
-    b0 = rotate_axis_angle(s.b, axis, -wl * dt);
-  }
-  const Vec3 r = p - x0;
-  Vec3 pl = to_local(t0, n0, b0, r);
-  Vec3 vl = to_local(t0, n0, b0, v - v0 - cross(w0, r));
-  const Vec3 W = to_local(t0, n0, b0, w0);
-  const Vec3 Wdot = to_local(t0, n0, b0, s.alpha);
-  const Vec3 A = to_local(t0, n0, b0, s.a);
-  const Vec3 inertial = A + cross(W, cross(W, pl)) + cross(Wdot, pl) + cross(W, vl) * 2.f;
-  const Vec3 acc = to_local(t0, n0, b0, a_k) - inertial * beta_L;
+WB_HD WB_INLINE Vec3 local_frame_step(Vec3 p, Vec3 v, Vec3 a_k, const SampleMotion& m, float beta_L, float dt) {
+  const Vec3 r = p - m.x0;
+  Vec3 pl = to_local(m.t0, m.n0, m.b0, r);
+  Vec3 vl = to_local(m.t0, m.n0, m.b0, v - m.v0 - cross(m.w0, r));
+  const Vec3 inertial = m.A + cross(m.W, cross(m.W, pl)) + cross(m.Wdot, pl) + cross(m.W, vl) * 2.f;
+  const Vec3 acc = to_local(m.t0, m.n0, m.b0, a_k) - inertial * beta_L;
   vl += acc * dt;
   pl += vl * dt;
-  return s.x + to_canvas(s.t, s.n, s.b, pl);
+  return m.x + to_canvas(m.t, m.n, m.b, pl);
 }
 
 /// One particle's two-step update (§4.3): external acceleration a_k = g; p' from the nearest
 /// sample's frame (Eq. 9, only when d_B < D1), p'' in the canvas frame; blend (Eq. 10); the
 /// friction of Eq. 8 slows the step's motion relative to the canvas, a velocity the bristle gave
-/// within the step included; keep it above the solid. `sample` may be null when no sample is near.
+/// within the step included; keep it above the solid. `sample` (the nearest sample's motion) may
+/// be null when no sample is near.
 /// One gravity for grid and particles: a particle inside the wet paint is part of it, and the grid
 /// gives that paint its weight and its support (§4.2 gravity with the hydrostatic part, resisted
 /// by the yield stress), which FLIP hands to the particle (Eq. 11); so g enters a_k only above
 /// the paint. There a free particle falls onto the wet surface and rests on it, as on the solid;
 /// a bristle holding it (Eq. 10 weight > 0) can still press it into the wet paint.
-WB_HD WB_INLINE void adhesion_update(Vec3& p, Vec3& v, const SampleFrame* sample, float d_B, const SolidView& solid,
+WB_HD WB_INLINE void adhesion_update(Vec3& p, Vec3& v, const SampleMotion* sample, float d_B, const SolidView& solid,
                                      const ParticleParams& prm, float dt) {
   const float d = solid_distance(solid, p);
   const bool in_paint = p.z < paint_surface_z(solid, p);

@@ -21,8 +21,9 @@ namespace wb {
 // The particle stage's backend drivers (particles_impl.h, where each is described), one list
 // (core/exec/dispatch.h).
 #define WB_PARTICLES_KERNELS(X)                                                                                        \
-  X(void, particles_adhesion_step, (ParticleView p, SampleView s, SolidView solid, ParticleParams prm, float dt),      \
-    (p, s, solid, prm, dt))                                                                                            \
+  X(void, particles_adhesion_step,                                                                                    \
+    (ParticleView p, SampleView s, SolidView solid, ParticleParams prm, float dt, SampleMotion* motion),               \
+    (p, s, solid, prm, dt, motion))                                                                                    \
   X(void, particles_rasterise, (ParticleView p, ParticleRasterView g), (p, g))                                         \
   X(void, particles_face_velocity, (ParticleRasterView g, float* u, float* v, float* w, float empty),                  \
     (g, u, v, w, empty))                                                                                               \

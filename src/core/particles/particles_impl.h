@@ -29,20 +29,25 @@ void check_grid(int nx, int ny, int nz, const char* what) {
 
 /// Two-step adhesion update of every particle (Eq. 8-10) over dt seconds. Needs the
 /// particles' nearest / d_B from SampleGrid::query_nearest with a range >= prm.D1 on
-/// the same samples. Positions and velocities are updated in place.
-void particles_adhesion_step(ParticleView p, SampleView s, SolidView solid, ParticleParams prm, float dt) {
+/// the same samples. Positions and velocities are updated in place; `motion` is scratch for
+/// s.count() samples.
+void particles_adhesion_step(ParticleView p, SampleView s, SolidView solid, ParticleParams prm, float dt,
+                             SampleMotion* motion) {
   detail::check_params(prm, dt);
   WB_REQUIRE(p.count >= 0, "particles_adhesion_step: negative particle count");
   WB_REQUIRE(solid.height == nullptr || (solid.nx > 0 && solid.ny > 0),
              "particles_adhesion_step: solid height map without extent");
   const int64_t n_samples = s.count();
+  WB_REQUIRE(n_samples == 0 || motion, "particles_adhesion_step: no room for the samples' motion");
+  // Each sample's part of Eq. 9 once, not once for each particle it holds.
+  parallel_for(n_samples, [=] WB_HD(int64_t j) { motion[j] = sample_motion(load_sample(s, j), dt); });
   parallel_for(p.count, [=] WB_HD(int64_t k) {
     Vec3 x = p.x[k], v = p.v[k];
     if (!isfinite3(x) || !isfinite3(v)) return;  // left as it is for the step's containment to remove
     const int32_t j = p.nearest[k];
     if (j >= 0 && j < n_samples) {
-      const SampleFrame f = load_sample(s, j);
-      adhesion_update(x, v, &f, p.d_B[k], solid, prm, dt);
+      const SampleMotion m = motion[j];
+      adhesion_update(x, v, &m, p.d_B[k], solid, prm, dt);
     } else {
       adhesion_update(x, v, nullptr, p.d_B[k], solid, prm, dt);
     }

@@ -800,7 +800,9 @@ void Simulator::particle_stage(float dt) {
   solid.ny = win.dims().y;
   solid.ox = win.origin().x;
   solid.oy = win.origin().y;
-  particles_adhesion_step(device(), particles_.view(), brush_->samples(), solid, prm, dt);
+  const SampleView samples = brush_->samples();
+  auto* motion = static_cast<SampleMotion*>(ws_.get(sizeof(SampleMotion) * size_t(samples.count())));
+  particles_adhesion_step(device(), particles_.view(), samples, solid, prm, dt, motion);
   clamp_particles_to_canvas();
 }
 
