@@ -69,7 +69,11 @@ struct FrictionDecay {
 WB_HD WB_INLINE FrictionDecay friction_decay(float d, float delta, float rate, float dt) {
   const float x = rate * friction_weight(d, delta) * dt;
   if (x < 1e-6f) return FrictionDecay{};
-  return FrictionDecay{-expm1f(-x) / x, expf(-x)};
+  // (1 - e^-x) / x from e^-x alone (one expf, not expm1f as well: 3 % of a step's CPU time);
+  // below x = 0.01, where 1 - e^-x would lose digits, its series (the next term x^4 / 120).
+  const float end = expf(-x);
+  const float mean = x < 1e-2f ? 1.f - x * (0.5f - x * (1.f / 6.f - x * (1.f / 24.f))) : (1.f - end) / x;
+  return FrictionDecay{mean, end};
 }
 
 /// Eq. 10 weight of the local-frame result: max(1 - d_B / D1, 0).
