@@ -113,14 +113,20 @@ void sample_grid_query(SampleGridView g, ParticleView p, float max_range) {
   // Runs of kQueryLanes particles; of a run, each stretch whose cells span at most two a side is
   // one query (the particles are sorted by cell: most runs are one or two).
   parallel_for_runs<kQueryLanes>(p.count, [=] WB_HD(int64_t k0, int lanes) {
-    const float inv_h = 1.f / g.h;
+    // Neighbours on a lattice of at most 2-cell cells (the default grid's): on a coarser grid
+    // two of its cells would hold points too far apart to share much of their walk.
+    const float inv_h = 1.f / fminf(g.h, 2.f);
     NearestSample found[kQueryLanes];
     int start = 0, b0[3] = {0, 0, 0}, b1[3] = {0, 0, 0};
     for (int j = 0; j <= lanes; ++j) {
       int c[3] = {0, 0, 0};
       if (j < lanes) sample_cell_of(p.x[k0 + j], inv_h, c[0], c[1], c[2]);
       if (j > start && (j == lanes || !query_joins(b0, b1, c))) {
-        nearest_samples(g, p.x + k0 + start, j - start, max_range, found + start);
+        if (j - start >= kQueryMinLanes) {
+          nearest_samples(g, p.x + k0 + start, j - start, max_range, found + start);
+        } else {  // too few to share the walk: one at a time, one compare a sample
+          for (int i = start; i < j; ++i) nearest_samples(g, p.x + k0 + i, 1, max_range, found + i);
+        }
         start = j;
       }
       if (j == start)

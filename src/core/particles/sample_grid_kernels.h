@@ -69,6 +69,10 @@ inline constexpr int kQueryLanes = 1;
 #else
 inline constexpr int kQueryLanes = 16;
 #endif
+/// Fewer neighbours than this are queried one at a time: a lane's branch-free test costs a few
+/// times the single query's one compare a sample, and a few lanes' shared walk reads more samples
+/// than each one's.
+inline constexpr int kQueryMinLanes = 4;
 
 /// The points of one query that take part, one lane each.
 struct QueryLanes {
