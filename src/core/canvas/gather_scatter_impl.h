@@ -23,32 +23,57 @@ WB_HD WB_INLINE CanvasCellRef locate(const TileStoreView& t, int cx, int cy, int
   r.at = int64_t(slot) * t.tile_cells() + t.cell_offset(cx % kTileSize, cy % kTileSize, cz);
   return r;
 }
-/// A window's cells number fewer than 2^32 (PaintWindow requires it): two 32-bit divisions, a
-/// fraction of the three 64-bit ones' cost (a GPU emulates those in software).
-WB_HD WB_INLINE void decompose(const PaintWindowView& w, int64_t i, int& x, int& y, int& z) {
-  const uint32_t t = uint32_t(i), nx = uint32_t(w.nx), ny = uint32_t(w.ny);
-  const uint32_t row = t / nx, layer = row / ny;
-  x = int(t - row * nx);
-  y = int(row - layer * ny);
-  z = int(layer);
+
+/// Cells of a window row a gather or scatter takes together: on the CPU the row's run within one
+/// tile (kTileSize cells, contiguous in the tile: one lookup of the tile's slot, no division a
+/// cell, and the run's loads and stores vectorise); on CUDA one cell, a thread each.
+#if defined(__CUDACC__)
+inline constexpr int kRowRun = 1;
+#else
+inline constexpr int kRowRun = kTileSize;
+#endif
+
+WB_HD WB_INLINE int floor_div(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+
+/// fn(i0, at0, slot, len, on) for each run of a window row lying in one run of kRowRun canvas
+/// columns (tile-aligned): window cells i0 .. i0 + len - 1 are pool cells at0 .. at0 + len - 1
+/// of slot `slot`, where `on(k)` (the k-th lies on the canvas and its tile is allocated); at0 is
+/// -1 where none is.
+template <typename F>
+void for_window_runs(const TileStoreView& t, const PaintWindowView& w, F fn) {
+  const int first = floor_div(w.ox, kRowRun), runs = floor_div(w.ox + w.nx - 1, kRowRun) - first + 1;
+  const int64_t rows = int64_t(w.ny) * w.nz;
+  parallel_for(
+      rows * runs,
+      [=] WB_HD(int64_t u) {
+        // 32-bit divisions (a GPU emulates 64-bit ones): a window's cells number fewer than 2^32
+        // (PaintWindow requires it), and its runs no more than its cells and rows.
+        const uint32_t row = uint32_t(u) / uint32_t(runs), ny = uint32_t(w.ny);
+        const int r = int(uint32_t(u) - row * uint32_t(runs));
+        const int y = int(row % ny), z = int(row / ny);
+        const int xa = imax(w.ox, (first + r) * kRowRun), xb = imin(w.ox + w.nx, (first + r + 1) * kRowRun);
+        const CanvasCellRef c = locate(t, xa, y + w.oy, z + w.oz);
+        // Of the run's cells on the canvas's rows and layers, those past its last column are off it.
+        const int on_canvas = c.at < 0 ? 0 : imin(xb, t.width) - xa;
+        fn(int64_t(row) * w.nx + (xa - w.ox), c.at, c.slot, xb - xa, on_canvas);
+      },
+      kMinParallelSize / kRowRun);
 }
 }  // namespace detail
 
 void tiles_gather_window(TileStoreView t, PaintWindowView w) {
-  parallel_for(w.size(), [=] WB_HD(int64_t i) {
-    int x, y, z;
-    detail::decompose(w, i, x, y, z);
-    const auto c = detail::locate(t, x + w.ox, y + w.oy, z + w.oz);
-    if (c.at < 0) {
-      w.density[i] = w.pigment_r[i] = w.pigment_y[i] = w.pigment_b[i] = w.oil[i] = w.dryness[i] = 0.f;
-      return;
+  detail::for_window_runs(t, w, [=] WB_HD(int64_t i0, int64_t at0, int32_t slot, int len, int on) {
+    for (int k = 0; k < on; ++k) {
+      const int64_t i = i0 + k, at = at0 + k;
+      w.density[i] = t.density[at];
+      w.pigment_r[i] = decode_unorm16(t.pigment_r[at]);
+      w.pigment_y[i] = decode_unorm16(t.pigment_y[at]);
+      w.pigment_b[i] = decode_unorm16(t.pigment_b[at]);
+      w.oil[i] = decode_unorm16(t.oil[at]);
+      w.dryness[i] = t.dryness_at(slot, at);
     }
-    w.density[i] = t.density[c.at];
-    w.pigment_r[i] = decode_unorm16(t.pigment_r[c.at]);
-    w.pigment_y[i] = decode_unorm16(t.pigment_y[c.at]);
-    w.pigment_b[i] = decode_unorm16(t.pigment_b[c.at]);
-    w.oil[i] = decode_unorm16(t.oil[c.at]);
-    w.dryness[i] = t.dryness_at(c.slot, c.at);
+    for (int64_t i = i0 + on; i < i0 + len; ++i)  // off the canvas, or in a tile with no paint
+      w.density[i] = w.pigment_r[i] = w.pigment_y[i] = w.pigment_b[i] = w.oil[i] = w.dryness[i] = 0.f;
   });
 }
 
@@ -73,15 +98,27 @@ void tiles_settle_window(TileStoreView t, int tx0, int ty0, int ntx, int nty) {
 
 void tiles_allocate_painted(TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int nty, int32_t* flags,
                             TileSlots slots) {
-  parallel_for(w.size(), [=] WB_HD(int64_t i) {
-    if (w.density[i] == 0.f) return;
-    int x, y, z;
-    detail::decompose(w, i, x, y, z);
-    const int cx = x + w.ox, cy = y + w.oy, cz = z + w.oz;
-    if (!t.inside(cx, cy, cz)) return;
-    const int f = (cy / kTileSize - ty0) * ntx + (cx / kTileSize - tx0);
-    if (flags[f] == 0) atomic_or(&flags[f], 1);
-  });
+  // A run's cells on the canvas lie in one tile: the tile is painted when any of them is. Cells
+  // of unallocated tiles count here (locate gives no slot for them, so this asks the run's first
+  // cell on the canvas directly).
+  const int first = detail::floor_div(w.ox, detail::kRowRun);
+  const int runs = detail::floor_div(w.ox + w.nx - 1, detail::kRowRun) - first + 1;
+  parallel_for(
+      int64_t(w.ny) * w.nz * runs,
+      [=] WB_HD(int64_t u) {
+        const uint32_t row = uint32_t(u) / uint32_t(runs), ny = uint32_t(w.ny);  // as in for_window_runs
+        const int r = int(uint32_t(u) - row * uint32_t(runs));
+        const int cy = int(row % ny) + w.oy, cz = int(row / ny) + w.oz;
+        const int xa = imax(imax(w.ox, (first + r) * detail::kRowRun), 0);
+        const int xb = imin(imin(w.ox + w.nx, (first + r + 1) * detail::kRowRun), t.width);
+        if (xa >= xb || !t.inside(xa, cy, cz)) return;
+        bool painted = false;
+        const int64_t i0 = int64_t(row) * w.nx - w.ox;
+        for (int64_t i = i0 + xa; i < i0 + xb; ++i) painted |= w.density[i] != 0.f;
+        const int f = (cy / kTileSize - ty0) * ntx + (xa / kTileSize - tx0);
+        if (painted && flags[f] == 0) atomic_or(&flags[f], 1);
+      },
+      kMinParallelSize / detail::kRowRun);
   // A painted tile without a slot takes the next: the pool holds them (TileStore::scatter sizes
   // it for every tile of the window), and its slot is empty and up to date with the clock.
   parallel_for(int64_t(ntx) * nty, [=] WB_HD(int64_t f) {
@@ -95,20 +132,20 @@ void tiles_allocate_painted(TileStoreView t, PaintWindowView w, int tx0, int ty0
 }
 
 void tiles_scatter_window(TileStoreView t, PaintWindowView w, float* before, float* after) {
-  parallel_for(w.size(), [=] WB_HD(int64_t i) {
-    int x, y, z;
-    detail::decompose(w, i, x, y, z);
-    const auto c = detail::locate(t, x + w.ox, y + w.oy, z + w.oz);
+  detail::for_window_runs(t, w, [=] WB_HD(int64_t i0, int64_t at0, int32_t, int len, int on) {
     // The density overwritten and written, for the canvas's running mass.
-    before[i] = c.at >= 0 ? t.density[c.at] : 0.f;
-    after[i] = c.at >= 0 ? w.density[i] : 0.f;
-    if (c.at < 0) return;  // off-canvas, or an unallocated tile that received no paint
-    t.density[c.at] = w.density[i];
-    t.pigment_r[c.at] = encode_unorm16(w.pigment_r[i]);
-    t.pigment_y[c.at] = encode_unorm16(w.pigment_y[i]);
-    t.pigment_b[c.at] = encode_unorm16(w.pigment_b[i]);
-    t.oil[c.at] = encode_unorm16(w.oil[i]);
-    t.dryness[c.at] = encode_unorm16(w.dryness[i]);
+    for (int k = 0; k < on; ++k) {
+      const int64_t i = i0 + k, at = at0 + k;
+      before[i] = t.density[at];
+      after[i] = w.density[i];
+      t.density[at] = w.density[i];
+      t.pigment_r[at] = encode_unorm16(w.pigment_r[i]);
+      t.pigment_y[at] = encode_unorm16(w.pigment_y[i]);
+      t.pigment_b[at] = encode_unorm16(w.pigment_b[i]);
+      t.oil[at] = encode_unorm16(w.oil[i]);
+      t.dryness[at] = encode_unorm16(w.dryness[i]);
+    }
+    for (int64_t i = i0 + on; i < i0 + len; ++i) before[i] = after[i] = 0.f;  // off-canvas, or no tile
   });
 }
 
