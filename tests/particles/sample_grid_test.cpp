@@ -104,10 +104,10 @@ TEST_F(SampleGridTest, NeighbouringParticlesQueriedTogetherEqualBruteForce) {
     }
   }
   std::vector<Vec3> px;
-  for (int k = 0; k < 6000; ++k) {
-    // Dense clusters around samples and sparse ones between them.
-    const Vec3 c = hs.x[size_t(k / 12 * 5) % hs.x.size()];
-    px.push_back(c + Vec3(U(rng) - 0.5f, U(rng) - 0.5f, U(rng) - 0.5f) * (k % 3 == 0 ? 30.f : 4.f));
+  for (int k = 0; k < 16000; ++k) {
+    // Dense clusters (several particles a cell) around samples and sparse ones between them.
+    const Vec3 c = hs.x[size_t(k / 40 * 5) % hs.x.size()];
+    px.push_back(c + Vec3(U(rng) - 0.5f, U(rng) - 0.5f, U(rng) - 0.5f) * (k % 4 == 0 ? 30.f : 2.5f));
   }
   px[100] = Vec3(NAN, 0.f, 0.f);
   px[2001] = Vec3(INFINITY, 500.f, 10.f);

@@ -61,6 +61,12 @@ WB_HD WB_INLINE int ring_near(int lo, int hi, int b0, int b1) { return b1 < lo ?
 /// Rings from the cells [b0, b1] to the farthest cell of [lo, hi].
 WB_HD WB_INLINE int ring_far(int lo, int hi, int b0, int b1) { return imax(imax(b0 - lo, hi - b1), 0); }
 
+/// Distance along one axis from cell i's slab [i h, (i + 1) h] to the span [a, b] of points, 0
+/// where they overlap, less a thousandth of a cell for the round-off of i h far from the origin.
+WB_HD WB_INLINE float gap_to_span(int i, float a, float b, float h) {
+  return maxf(maxf(float(i) * h - b, a - float(i + 1) * h) - 1e-3f * h, 0.f);
+}
+
 /// Points a nearest-sample query takes together: on the CPU 16 consecutive particles (sorted by
 /// cell, they are neighbours), which read each row of the sorted list once for all and test each
 /// sample against all of them in vector lanes; on CUDA 1, a warp's threads being the lanes.
@@ -193,17 +199,42 @@ WB_HD WB_INLINE void nearest_samples(const SampleGridView& g, const Vec3* p, int
     if (R > 0 && float(R - 1) * g.h >= max_range) break;
     const int z0 = imax(b0[2] - R, lo[2]), z1 = imin(b1[2] + R, hi[2]), y0 = imax(b0[1] - R, lo[1]);
     const int y1 = imin(b1[1] + R, hi[1]), x0 = imax(b0[0] - R, lo[0]), x1 = imin(b1[0] + R, hi[0]);
-    for (int z = z0; z <= z1; ++z)
+    // A query of several points reads only the rows, and the cells of a row, nearer to the
+    // points' box than the farthest of their best distances so far (ties kept: `>`); its lanes
+    // share the arithmetic. A single point's walk is cheaper without it (most rows hold nothing).
+    const bool cull = q.n > 1;
+    float far2 = 0.f;
+    for (int j = 0; j < q.n; ++j) far2 = maxf(far2, q.best_d2[j]);
+    for (int z = z0; z <= z1; ++z) {
+      const float gz = cull ? gap_to_span(z, p0[2], p1[2], g.h) : 0.f;
       for (int y = y0; y <= y1; ++y) {
+        float off2 = 0.f;
+        if (cull) {
+          const float gy = gap_to_span(y, p0[1], p1[1], g.h);
+          off2 = gz * gz + gy * gy;
+          if (off2 > far2) continue;
+        }
         const int64_t row = ((int64_t(z) - blo[2]) * ny + (int64_t(y) - blo[1])) * nx - blo[0];
         if (R == 0 || z == b0[2] - R || z == b1[2] + R || y == b0[1] - R || y == b1[1] + R) {
-          if (x0 <= x1) nearest_in(g, g.first[row + x0], g.first[row + x1 + 1], q);
+          int xa = x0, xb = x1;
+          if (cull) {
+            const float half = sqrtf(far2 - off2) + 1e-3f * g.h;  // and the round-off along x
+            xa = imax(xa, cell_coord((p0[0] - half) * inv_h));
+            xb = imin(xb, cell_coord((p1[0] + half) * inv_h));
+          }
+          if (xa <= xb) nearest_in(g, g.first[row + xa], g.first[row + xb + 1], q);
         } else {
           // Inside the shell's faces only the row's two end cells lie on the shell.
-          if (b0[0] - R >= lo[0]) nearest_in(g, g.first[row + b0[0] - R], g.first[row + b0[0] - R + 1], q);
-          if (b1[0] + R <= hi[0]) nearest_in(g, g.first[row + b1[0] + R], g.first[row + b1[0] + R + 1], q);
+          const int xa = b0[0] - R, xb = b1[0] + R;
+          auto near_cell = [&](int x) {
+            const float gx = gap_to_span(x, p0[0], p1[0], g.h);
+            return !cull || off2 + gx * gx <= far2;
+          };
+          if (xa >= lo[0] && near_cell(xa)) nearest_in(g, g.first[row + xa], g.first[row + xa + 1], q);
+          if (xb <= hi[0] && near_cell(xb)) nearest_in(g, g.first[row + xb], g.first[row + xb + 1], q);
         }
       }
+    }
     bool done = true;
     for (int j = 0; j < q.n; ++j) {
       const float reach = float(R) * g.h + q.edge[j];
