@@ -44,6 +44,28 @@ WB_HD WB_INLINE float sample_nodes(const float* f, int ex, int ey, int ez, float
   return c0 * (1.f - sz.w1) + c1 * sz.w1;
 }
 
+/// Trilinear samples of two fields on the same node grid at q, the stencil worked out once (each
+/// value as sample_nodes gives it).
+WB_HD WB_INLINE void sample_nodes_pair(const float* f, const float* g, int ex, int ey, int ez, float ox, float oy,
+                                       float oz, Vec3 q, float& fq, float& gq) {
+  const Stencil1 sx = stencil1(q.x, ox, ex), sy = stencil1(q.y, oy, ey), sz = stencil1(q.z, oz, ez);
+  const int64_t n[8] = {(int64_t(sz.i0) * ey + sy.i0) * ex + sx.i0, (int64_t(sz.i0) * ey + sy.i0) * ex + sx.i1,
+                        (int64_t(sz.i0) * ey + sy.i1) * ex + sx.i0, (int64_t(sz.i0) * ey + sy.i1) * ex + sx.i1,
+                        (int64_t(sz.i1) * ey + sy.i0) * ex + sx.i0, (int64_t(sz.i1) * ey + sy.i0) * ex + sx.i1,
+                        (int64_t(sz.i1) * ey + sy.i1) * ex + sx.i0, (int64_t(sz.i1) * ey + sy.i1) * ex + sx.i1};
+  auto blend = [&](const float* h) {
+    const float c00 = h[n[0]] * (1.f - sx.w1) + h[n[1]] * sx.w1;
+    const float c10 = h[n[2]] * (1.f - sx.w1) + h[n[3]] * sx.w1;
+    const float c01 = h[n[4]] * (1.f - sx.w1) + h[n[5]] * sx.w1;
+    const float c11 = h[n[6]] * (1.f - sx.w1) + h[n[7]] * sx.w1;
+    const float c0 = c00 * (1.f - sy.w1) + c10 * sy.w1;
+    const float c1 = c01 * (1.f - sy.w1) + c11 * sy.w1;
+    return c0 * (1.f - sz.w1) + c1 * sz.w1;
+  };
+  fq = blend(f);
+  gq = blend(g);
+}
+
 /// Velocity of the MAC field (u, v, w) at q (window cells): each component trilinear on its
 /// own faces, clamped at the window's edges. u(i,j,k) sits on the face at (i, j+1/2, k+1/2),
 /// v(i,j,k) at (i+1/2, j, k+1/2), w(i,j,k) at (i+1/2, j+1/2, k); u: (nx+1) x ny x nz,
