@@ -46,8 +46,7 @@ void particles_adhesion_step(ParticleView p, SampleView s, SolidView solid, Part
     if (!isfinite3(x) || !isfinite3(v)) return;  // left as it is for the step's containment to remove
     const int32_t j = p.nearest[k];
     if (j >= 0 && j < n_samples) {
-      const SampleMotion m = motion[j];
-      adhesion_update(x, v, &m, p.d_B[k], solid, prm, dt);
+      adhesion_update(x, v, motion + j, p.d_B[k], solid, prm, dt);
     } else {
       adhesion_update(x, v, nullptr, p.d_B[k], solid, prm, dt);
     }
