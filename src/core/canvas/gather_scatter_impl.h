@@ -26,7 +26,7 @@ WB_HD WB_INLINE CanvasCellRef locate(const TileStoreView& t, int cx, int cy, int
 
 /// Cells of a window row a gather or scatter takes together: on the CPU the row's run within one
 /// tile (kTileSize cells, contiguous in the tile: one lookup of the tile's slot, no division a
-/// cell, and the run's loads and stores vectorise); on CUDA one cell, a thread each.
+/// cell); on CUDA one cell, a thread each.
 #if defined(__CUDACC__)
 inline constexpr int kRowRun = 1;
 #else
@@ -35,10 +35,10 @@ inline constexpr int kRowRun = kTileSize;
 
 WB_HD WB_INLINE int floor_div(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
-/// fn(i0, at0, slot, len, on) for each run of a window row lying in one run of kRowRun canvas
-/// columns (tile-aligned): window cells i0 .. i0 + len - 1 are pool cells at0 .. at0 + len - 1
-/// of slot `slot`, where `on(k)` (the k-th lies on the canvas and its tile is allocated); at0 is
-/// -1 where none is.
+/// fn(i0, at0, slot, len, on) for each part of a window row within one tile-aligned run of
+/// kRowRun canvas columns: window cells i0 .. i0 + len - 1, of which the first `on` lie on the
+/// canvas in an allocated tile, at pool cells at0 .. at0 + on - 1 of slot `slot`; the others (off
+/// the canvas, or in a tile with no slot) have no place in the pool.
 template <typename F>
 void for_window_runs(const TileStoreView& t, const PaintWindowView& w, F fn) {
   const int first = floor_div(w.ox, kRowRun), runs = floor_div(w.ox + w.nx - 1, kRowRun) - first + 1;
