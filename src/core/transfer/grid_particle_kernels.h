@@ -246,7 +246,7 @@ struct KeepBox {
 };
 
 struct DistanceBlocks {
-  float* d2;  ///< squared distance to the nearest occupied block, in blocks^2
+  float* d;  ///< distance to the nearest occupied block, in blocks (kFarDistance2 where none)
   int bx, by, bz;
   int block;
   int margin;
@@ -281,14 +281,14 @@ struct DistanceBlocks {
     // on every particle.
     const float tx = minf(maxf(fx - float(i0), 0.f), 1.f), ty = minf(maxf(fy - float(j0), 0.f), 1.f),
                 tz = minf(maxf(fz - float(k0), 0.f), 1.f);
-    float d = 0.f;
+    float dist = 0.f;
     for (int c = 0; c < 8; ++c) {
       const int di = c & 1, dj = (c >> 1) & 1, dk = c >> 2;
-      const float v = d2[index(i0 + di, j0 + dj, k0 + dk)];
+      const float v = d[index(i0 + di, j0 + dj, k0 + dk)];
       if (v >= kFarDistance2) return 1e30f;
-      d += (di ? tx : 1.f - tx) * (dj ? ty : 1.f - ty) * (dk ? tz : 1.f - tz) * sqrtf(v);
+      dist += (di ? tx : 1.f - tx) * (dj ? ty : 1.f - ty) * (dk ? tz : 1.f - tz) * v;
     }
-    return d * float(block);
+    return dist * float(block);
   }
   /// Within D0 of the bristles; nothing is near when D0 is 0 (grid-only paint, Fig. 7).
   WB_HD bool near(Vec3 q) const { return D0 > 0.f && distance(q) <= D0; }

@@ -304,27 +304,28 @@ void Transfer::update_distance(const SampleView& samples, const TransferEnv& env
   edt_v_.resize(size_t(total));
   edt_z_.resize(size_t(2 * total));
   occ_.fill_zero();
-  db.d2 = d2_.data();
+  db.d = d2_.data();
   transfer_distance_occupancy(device_, samples, db, occ_.data(), pw.ox, pw.oy, pw.oz);
   transfer_distance_init(device_, occ_.data(), d2_.data(), total);
-  // Separable exact squared distance transform: x (d2 -> tmp), y (tmp -> d2), z (d2 -> tmp).
+  // Separable exact squared distance transform: x (d2 -> tmp), y (tmp -> d2), z (d2 -> tmp), whose
+  // pass takes the roots.
   transfer_distance_pass(device_, db, 0, d2_.data(), d2_tmp_.data(), edt_v_.data(), edt_z_.data());
   transfer_distance_pass(device_, db, 1, d2_tmp_.data(), d2_.data(), edt_v_.data(), edt_z_.data());
   transfer_distance_pass(device_, db, 2, d2_.data(), d2_tmp_.data(), edt_v_.data(), edt_z_.data());
   d2_.swap(d2_tmp_);
-  db.d2 = d2_.data();
+  db.d = d2_.data();
   blocks_ = db;
 }
 
 DistanceBlocks Transfer::distance_view() {
-  WB_REQUIRE(blocks_.d2 != nullptr, "Transfer: update_distance has not run");
+  WB_REQUIRE(blocks_.d != nullptr, "Transfer: update_distance has not run");
   return blocks_;
 }
 
 std::vector<float> Transfer::distance_to_host() {
   const DistanceBlocks db = distance_view();
   std::vector<float> d = d2_.to_host();
-  for (float& v : d) v = v >= kFarDistance2 ? 1e30f : std::sqrt(v) * float(db.block);
+  for (float& v : d) v = v >= kFarDistance2 ? 1e30f : v * float(db.block);
   return d;
 }
 

@@ -301,6 +301,13 @@ void transfer_distance_pass(DistanceBlocks db, int axis, const float* src, float
       stride = int64_t(db.bx) * db.by;
     }
     edt_line(src + base, dst + base, n, stride, v + L * n, z + L * (n + 1));
+    // After the last axis the field holds distances, not their squares: a particle's lookup
+    // blends eight of them (DistanceBlocks::distance), a root each taken here once.
+    if (axis == 2)
+      for (int q = 0; q < n; ++q) {
+        float& e = dst[base + q * stride];
+        e = e >= kFarDistance2 ? kFarDistance2 : sqrtf(e);
+      }
   });
 }
 
