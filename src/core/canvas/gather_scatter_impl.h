@@ -35,10 +35,19 @@ inline constexpr int kRowRun = kTileSize;
 
 WB_HD WB_INLINE int floor_div(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
-/// fn(i0, at0, slot, len, on) for each part of a window row within one tile-aligned run of
-/// kRowRun canvas columns: window cells i0 .. i0 + len - 1, of which the first `on` lie on the
-/// canvas in an allocated tile, at pool cells at0 .. at0 + on - 1 of slot `slot`; the others (off
-/// the canvas, or in a tile with no slot) have no place in the pool.
+/// A part of a window row within one tile-aligned run of kRowRun canvas columns: window cells
+/// i0 .. i0 + len - 1, canvas columns cx .. cx + len - 1 of row cy, layer cz. The first
+/// `on_canvas` of them lie on the canvas (all in one tile); where that tile is allocated
+/// (at0 >= 0) they are pool cells at0 .. of slot `slot`.
+struct WindowRun {
+  int64_t i0, at0;
+  int32_t slot;
+  int len, on_canvas, cx, cy, cz;
+  /// The cells with a place in the pool.
+  WB_HD int in_pool() const { return at0 >= 0 ? on_canvas : 0; }
+};
+
+/// fn(run) for each WindowRun of the window.
 template <typename F>
 void for_window_runs(const TileStoreView& t, const PaintWindowView& w, F fn) {
   const int first = floor_div(w.ox, kRowRun), runs = floor_div(w.ox + w.nx - 1, kRowRun) - first + 1;
@@ -50,29 +59,36 @@ void for_window_runs(const TileStoreView& t, const PaintWindowView& w, F fn) {
         // (PaintWindow requires it), and its runs no more than its cells and rows.
         const uint32_t row = uint32_t(u) / uint32_t(runs), ny = uint32_t(w.ny);
         const int r = int(uint32_t(u) - row * uint32_t(runs));
-        const int y = int(row % ny), z = int(row / ny);
-        const int xa = imax(w.ox, (first + r) * kRowRun), xb = imin(w.ox + w.nx, (first + r + 1) * kRowRun);
-        const CanvasCellRef c = locate(t, xa, y + w.oy, z + w.oz);
-        // Of the run's cells on the canvas's rows and layers, those past its last column are off it.
-        const int on_canvas = c.at < 0 ? 0 : imin(xb, t.width) - xa;
-        fn(int64_t(row) * w.nx + (xa - w.ox), c.at, c.slot, xb - xa, on_canvas);
+        WindowRun run;
+        run.cy = int(row % ny) + w.oy, run.cz = int(row / ny) + w.oz;
+        run.cx = imax(w.ox, (first + r) * kRowRun);
+        run.len = imin(w.ox + w.nx, (first + r + 1) * kRowRun) - run.cx;
+        run.i0 = int64_t(row) * w.nx + (run.cx - w.ox);
+        // A run is tile-aligned: all of it lies left of the canvas or none; past its last column
+        // the rest is off it.
+        run.on_canvas = t.inside(run.cx, run.cy, run.cz) ? imin(run.len, t.width - run.cx) : 0;
+        const CanvasCellRef c = locate(t, run.cx, run.cy, run.cz);
+        run.at0 = c.at;
+        run.slot = c.slot;
+        fn(run);
       },
       kMinParallelSize / kRowRun);
 }
 }  // namespace detail
 
 void tiles_gather_window(TileStoreView t, PaintWindowView w) {
-  detail::for_window_runs(t, w, [=] WB_HD(int64_t i0, int64_t at0, int32_t slot, int len, int on) {
+  detail::for_window_runs(t, w, [=] WB_HD(const detail::WindowRun& run) {
+    const int on = run.in_pool();
     for (int k = 0; k < on; ++k) {
-      const int64_t i = i0 + k, at = at0 + k;
+      const int64_t i = run.i0 + k, at = run.at0 + k;
       w.density[i] = t.density[at];
       w.pigment_r[i] = decode_unorm16(t.pigment_r[at]);
       w.pigment_y[i] = decode_unorm16(t.pigment_y[at]);
       w.pigment_b[i] = decode_unorm16(t.pigment_b[at]);
       w.oil[i] = decode_unorm16(t.oil[at]);
-      w.dryness[i] = t.dryness_at(slot, at);
+      w.dryness[i] = t.dryness_at(run.slot, at);
     }
-    for (int64_t i = i0 + on; i < i0 + len; ++i)  // off the canvas, or in a tile with no paint
+    for (int64_t i = run.i0 + on; i < run.i0 + run.len; ++i)  // off the canvas, or in a tile with no paint
       w.density[i] = w.pigment_r[i] = w.pigment_y[i] = w.pigment_b[i] = w.oil[i] = w.dryness[i] = 0.f;
   });
 }
@@ -98,27 +114,13 @@ void tiles_settle_window(TileStoreView t, int tx0, int ty0, int ntx, int nty) {
 
 void tiles_allocate_painted(TileStoreView t, PaintWindowView w, int tx0, int ty0, int ntx, int nty, int32_t* flags,
                             TileSlots slots) {
-  // A run's cells on the canvas lie in one tile: the tile is painted when any of them is. Cells
-  // of unallocated tiles count here (locate gives no slot for them, so this asks the run's first
-  // cell on the canvas directly).
-  const int first = detail::floor_div(w.ox, detail::kRowRun);
-  const int runs = detail::floor_div(w.ox + w.nx - 1, detail::kRowRun) - first + 1;
-  parallel_for(
-      int64_t(w.ny) * w.nz * runs,
-      [=] WB_HD(int64_t u) {
-        const uint32_t row = uint32_t(u) / uint32_t(runs), ny = uint32_t(w.ny);  // as in for_window_runs
-        const int r = int(uint32_t(u) - row * uint32_t(runs));
-        const int cy = int(row % ny) + w.oy, cz = int(row / ny) + w.oz;
-        const int xa = imax(imax(w.ox, (first + r) * detail::kRowRun), 0);
-        const int xb = imin(imin(w.ox + w.nx, (first + r + 1) * detail::kRowRun), t.width);
-        if (xa >= xb || !t.inside(xa, cy, cz)) return;
-        bool painted = false;
-        const int64_t i0 = int64_t(row) * w.nx - w.ox;
-        for (int64_t i = i0 + xa; i < i0 + xb; ++i) painted |= w.density[i] != 0.f;
-        const int f = (cy / kTileSize - ty0) * ntx + (xa / kTileSize - tx0);
-        if (painted && flags[f] == 0) atomic_or(&flags[f], 1);
-      },
-      kMinParallelSize / detail::kRowRun);
+  // A run's cells on the canvas lie in one tile, allocated or not: it is painted when any is.
+  detail::for_window_runs(t, w, [=] WB_HD(const detail::WindowRun& run) {
+    bool painted = false;
+    for (int64_t i = run.i0; i < run.i0 + run.on_canvas; ++i) painted |= w.density[i] != 0.f;
+    const int f = (run.cy / kTileSize - ty0) * ntx + (run.cx / kTileSize - tx0);
+    if (painted && flags[f] == 0) atomic_or(&flags[f], 1);
+  });
   // A painted tile without a slot takes the next: the pool holds them (TileStore::scatter sizes
   // it for every tile of the window), and its slot is empty and up to date with the clock.
   parallel_for(int64_t(ntx) * nty, [=] WB_HD(int64_t f) {
@@ -132,10 +134,11 @@ void tiles_allocate_painted(TileStoreView t, PaintWindowView w, int tx0, int ty0
 }
 
 void tiles_scatter_window(TileStoreView t, PaintWindowView w, float* before, float* after) {
-  detail::for_window_runs(t, w, [=] WB_HD(int64_t i0, int64_t at0, int32_t, int len, int on) {
+  detail::for_window_runs(t, w, [=] WB_HD(const detail::WindowRun& run) {
     // The density overwritten and written, for the canvas's running mass.
+    const int on = run.in_pool();
     for (int k = 0; k < on; ++k) {
-      const int64_t i = i0 + k, at = at0 + k;
+      const int64_t i = run.i0 + k, at = run.at0 + k;
       before[i] = t.density[at];
       after[i] = w.density[i];
       t.density[at] = w.density[i];
@@ -145,7 +148,7 @@ void tiles_scatter_window(TileStoreView t, PaintWindowView w, float* before, flo
       t.oil[at] = encode_unorm16(w.oil[i]);
       t.dryness[at] = encode_unorm16(w.dryness[i]);
     }
-    for (int64_t i = i0 + on; i < i0 + len; ++i) before[i] = after[i] = 0.f;  // off-canvas, or no tile
+    for (int64_t i = run.i0 + on; i < run.i0 + run.len; ++i) before[i] = after[i] = 0.f;  // off-canvas, or no tile
   });
 }
 

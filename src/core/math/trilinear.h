@@ -31,48 +31,51 @@ WB_HD WB_INLINE Stencil1 stencil1(float q, float off, int n) {
   return Stencil1{i0, i0 + 1 < n ? i0 + 1 : n - 1, w1};
 }
 
+/// The eight nodes around q on a node grid of ex x ey x ez nodes at offsets (ox, oy, oz) cells and
+/// their weights, worked out once for as many fields on that grid as are sampled at q.
+struct NodeStencil {
+  int64_t n[8];  ///< (i, j, k) of the lower corner plus (n & 1, (n >> 1) & 1, n >> 2), x fastest
+  float wx, wy, wz;
+  WB_HD float of(const float* f) const {
+    const float c00 = f[n[0]] * (1.f - wx) + f[n[1]] * wx;
+    const float c10 = f[n[2]] * (1.f - wx) + f[n[3]] * wx;
+    const float c01 = f[n[4]] * (1.f - wx) + f[n[5]] * wx;
+    const float c11 = f[n[6]] * (1.f - wx) + f[n[7]] * wx;
+    const float c0 = c00 * (1.f - wy) + c10 * wy;
+    const float c1 = c01 * (1.f - wy) + c11 * wy;
+    return c0 * (1.f - wz) + c1 * wz;
+  }
+};
+WB_HD WB_INLINE NodeStencil node_stencil(int ex, int ey, int ez, float ox, float oy, float oz, Vec3 q) {
+  const Stencil1 sx = stencil1(q.x, ox, ex), sy = stencil1(q.y, oy, ey), sz = stencil1(q.z, oz, ez);
+  NodeStencil s;
+  const int ix[2] = {sx.i0, sx.i1}, iy[2] = {sy.i0, sy.i1}, iz[2] = {sz.i0, sz.i1};
+  for (int c = 0; c < 8; ++c) s.n[c] = (int64_t(iz[c >> 2]) * ey + iy[(c >> 1) & 1]) * ex + ix[c & 1];
+  s.wx = sx.w1, s.wy = sy.w1, s.wz = sz.w1;
+  return s;
+}
+
 /// Trilinear sample of one node grid of ex x ey x ez nodes at offsets (ox, oy, oz) cells.
 WB_HD WB_INLINE float sample_nodes(const float* f, int ex, int ey, int ez, float ox, float oy, float oz, Vec3 q) {
-  const Stencil1 sx = stencil1(q.x, ox, ex), sy = stencil1(q.y, oy, ey), sz = stencil1(q.z, oz, ez);
-  auto at = [&](int i, int j, int k) { return f[(int64_t(k) * ey + j) * ex + i]; };
-  const float c00 = at(sx.i0, sy.i0, sz.i0) * (1.f - sx.w1) + at(sx.i1, sy.i0, sz.i0) * sx.w1;
-  const float c10 = at(sx.i0, sy.i1, sz.i0) * (1.f - sx.w1) + at(sx.i1, sy.i1, sz.i0) * sx.w1;
-  const float c01 = at(sx.i0, sy.i0, sz.i1) * (1.f - sx.w1) + at(sx.i1, sy.i0, sz.i1) * sx.w1;
-  const float c11 = at(sx.i0, sy.i1, sz.i1) * (1.f - sx.w1) + at(sx.i1, sy.i1, sz.i1) * sx.w1;
-  const float c0 = c00 * (1.f - sy.w1) + c10 * sy.w1;
-  const float c1 = c01 * (1.f - sy.w1) + c11 * sy.w1;
-  return c0 * (1.f - sz.w1) + c1 * sz.w1;
+  return node_stencil(ex, ey, ez, ox, oy, oz, q).of(f);
 }
 
-/// Trilinear samples of two fields on the same node grid at q, the stencil worked out once (each
-/// value as sample_nodes gives it).
-WB_HD WB_INLINE void sample_nodes_pair(const float* f, const float* g, int ex, int ey, int ez, float ox, float oy,
-                                       float oz, Vec3 q, float& fq, float& gq) {
-  const Stencil1 sx = stencil1(q.x, ox, ex), sy = stencil1(q.y, oy, ey), sz = stencil1(q.z, oz, ez);
-  const int64_t n[8] = {(int64_t(sz.i0) * ey + sy.i0) * ex + sx.i0, (int64_t(sz.i0) * ey + sy.i0) * ex + sx.i1,
-                        (int64_t(sz.i0) * ey + sy.i1) * ex + sx.i0, (int64_t(sz.i0) * ey + sy.i1) * ex + sx.i1,
-                        (int64_t(sz.i1) * ey + sy.i0) * ex + sx.i0, (int64_t(sz.i1) * ey + sy.i0) * ex + sx.i1,
-                        (int64_t(sz.i1) * ey + sy.i1) * ex + sx.i0, (int64_t(sz.i1) * ey + sy.i1) * ex + sx.i1};
-  auto blend = [&](const float* h) {
-    const float c00 = h[n[0]] * (1.f - sx.w1) + h[n[1]] * sx.w1;
-    const float c10 = h[n[2]] * (1.f - sx.w1) + h[n[3]] * sx.w1;
-    const float c01 = h[n[4]] * (1.f - sx.w1) + h[n[5]] * sx.w1;
-    const float c11 = h[n[6]] * (1.f - sx.w1) + h[n[7]] * sx.w1;
-    const float c0 = c00 * (1.f - sy.w1) + c10 * sy.w1;
-    const float c1 = c01 * (1.f - sy.w1) + c11 * sy.w1;
-    return c0 * (1.f - sz.w1) + c1 * sz.w1;
-  };
-  fq = blend(f);
-  gq = blend(g);
-}
-
-/// Velocity of the MAC field (u, v, w) at q (window cells): each component trilinear on its
-/// own faces, clamped at the window's edges. u(i,j,k) sits on the face at (i, j+1/2, k+1/2),
+/// The three stencils of a MAC field at q (window cells): each component trilinear on its own
+/// faces, clamped at the window's edges. u(i,j,k) sits on the face at (i, j+1/2, k+1/2),
 /// v(i,j,k) at (i+1/2, j, k+1/2), w(i,j,k) at (i+1/2, j+1/2, k); u: (nx+1) x ny x nz,
 /// v: nx x (ny+1) x nz, w: nx x ny x (nz+1), x fastest.
+struct MacStencil {
+  NodeStencil u, v, w;
+  WB_HD Vec3 of(const float* fu, const float* fv, const float* fw) const { return Vec3(u.of(fu), v.of(fv), w.of(fw)); }
+};
+WB_HD WB_INLINE MacStencil mac_stencil(int nx, int ny, int nz, Vec3 q) {
+  return MacStencil{node_stencil(nx + 1, ny, nz, 0.f, 0.5f, 0.5f, q), node_stencil(nx, ny + 1, nz, 0.5f, 0.f, 0.5f, q),
+                    node_stencil(nx, ny, nz + 1, 0.5f, 0.5f, 0.f, q)};
+}
+
+/// Velocity of the MAC field (u, v, w) at q (window cells) (mac_stencil).
 WB_HD WB_INLINE Vec3 sample_mac(const float* u, const float* v, const float* w, int nx, int ny, int nz, Vec3 q) {
-  return Vec3(sample_nodes(u, nx + 1, ny, nz, 0.f, 0.5f, 0.5f, q), sample_nodes(v, nx, ny + 1, nz, 0.5f, 0.f, 0.5f, q),
-              sample_nodes(w, nx, ny, nz + 1, 0.5f, 0.5f, 0.f, q));
+  return mac_stencil(nx, ny, nz, q).of(u, v, w);
 }
 
 }  // namespace wb

@@ -101,14 +101,9 @@ void particles_flip_pic(ParticleView p, MacView before, MacView after, float gam
                  before.oy == after.oy && before.oz == after.oz,
              "particles_flip_pic: the fields before and after projection cover different windows");
   parallel_for(p.count, [=] WB_HD(int64_t k) {
-    // Both fields at the particle, each component's stencil worked out once for the two.
-    const Vec3 q = before.local(p.x[k]);
-    const int nx = before.nx, ny = before.ny, nz = before.nz;
-    Vec3 ub, ua;
-    sample_nodes_pair(before.u, after.u, nx + 1, ny, nz, 0.f, 0.5f, 0.5f, q, ub.x, ua.x);
-    sample_nodes_pair(before.v, after.v, nx, ny + 1, nz, 0.5f, 0.f, 0.5f, q, ub.y, ua.y);
-    sample_nodes_pair(before.w, after.w, nx, ny, nz + 1, 0.5f, 0.5f, 0.f, q, ub.z, ua.z);
-    p.v[k] = flip_pic_velocity(p.v[k], ub, ua, gamma);
+    // Both fields at the particle from one stencil (the windows are the same).
+    const MacStencil s = mac_stencil(before.nx, before.ny, before.nz, before.local(p.x[k]));
+    p.v[k] = flip_pic_velocity(p.v[k], s.of(before.u, before.v, before.w), s.of(after.u, after.v, after.w), gamma);
   });
 }
 
