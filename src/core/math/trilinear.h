@@ -46,14 +46,25 @@ struct NodeStencil {
     return c0 * (1.f - wz) + c1 * wz;
   }
 };
-WB_HD WB_INLINE NodeStencil node_stencil(int ex, int ey, int ez, float ox, float oy, float oz, Vec3 q) {
-  const Stencil1 sx = stencil1(q.x, ox, ex), sy = stencil1(q.y, oy, ey), sz = stencil1(q.z, oz, ez);
+/// A node grid's stencil at q from its three axes' stencils (ex x ey nodes a layer)...
+WB_HD WB_INLINE NodeStencil node_stencil(int ex, int ey, const Stencil1& sx, const Stencil1& sy, const Stencil1& sz) {
   NodeStencil s;
   const int ix[2] = {sx.i0, sx.i1}, iy[2] = {sy.i0, sy.i1}, iz[2] = {sz.i0, sz.i1};
   for (int c = 0; c < 8; ++c) s.n[c] = (int64_t(iz[c >> 2]) * ey + iy[(c >> 1) & 1]) * ex + ix[c & 1];
   s.wx = sx.w1, s.wy = sy.w1, s.wz = sz.w1;
   return s;
 }
+/// ... or from q on a grid of ex x ey x ez nodes at offsets (ox, oy, oz) cells.
+WB_HD WB_INLINE NodeStencil node_stencil(int ex, int ey, int ez, float ox, float oy, float oz, Vec3 q) {
+  return node_stencil(ex, ey, stencil1(q.x, ox, ex), stencil1(q.y, oy, ey), stencil1(q.z, oz, ez));
+}
+
+/// Along one axis of a window of n cells, the stencils of the cells' centres (n nodes at 1/2)
+/// and of the faces across the axis (n + 1 nodes at 0): the two node grids a window has on it.
+struct AxisStencils {
+  Stencil1 centre, face;
+};
+WB_HD WB_INLINE AxisStencils axis_stencils(float q, int n) { return {stencil1(q, 0.5f, n), stencil1(q, 0.f, n + 1)}; }
 
 /// Trilinear sample of one node grid of ex x ey x ez nodes at offsets (ox, oy, oz) cells.
 WB_HD WB_INLINE float sample_nodes(const float* f, int ex, int ey, int ez, float ox, float oy, float oz, Vec3 q) {
@@ -69,8 +80,9 @@ struct MacStencil {
   WB_HD Vec3 of(const float* fu, const float* fv, const float* fw) const { return Vec3(u.of(fu), v.of(fv), w.of(fw)); }
 };
 WB_HD WB_INLINE MacStencil mac_stencil(int nx, int ny, int nz, Vec3 q) {
-  return MacStencil{node_stencil(nx + 1, ny, nz, 0.f, 0.5f, 0.5f, q), node_stencil(nx, ny + 1, nz, 0.5f, 0.f, 0.5f, q),
-                    node_stencil(nx, ny, nz + 1, 0.5f, 0.5f, 0.f, q)};
+  const AxisStencils x = axis_stencils(q.x, nx), y = axis_stencils(q.y, ny), z = axis_stencils(q.z, nz);
+  return MacStencil{node_stencil(nx + 1, ny, x.face, y.centre, z.centre), node_stencil(nx, ny + 1, x.centre, y.face, z.centre),
+                    node_stencil(nx, ny, x.centre, y.centre, z.face)};
 }
 
 /// Velocity of the MAC field (u, v, w) at q (window cells) (mac_stencil).

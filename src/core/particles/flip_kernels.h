@@ -48,10 +48,10 @@ struct SplatRun {
       }
     base = -1;
   }
-  /// The weights of the pair (a, b) at q, into the run (flushed first if q's corner is another).
-  WB_HD void add(FloatPair* f, const TouchList& list, int ex, int ey, int ez, float ox, float oy, float oz, Vec3 q,
-                 float a, float b) {
-    const Stencil1 sx = stencil1(q.x, ox, ex), sy = stencil1(q.y, oy, ey), sz = stencil1(q.z, oz, ez);
+  /// The weights of the pair (a, b) at the node stencil of sx, sy, sz on a grid of ex x ey nodes a
+  /// layer, into the run (flushed first if the stencil's corner is another).
+  WB_HD void add(FloatPair* f, const TouchList& list, int ex, int ey, const Stencil1& sx, const Stencil1& sy,
+                 const Stencil1& sz, float a, float b) {
     const int64_t corner = (int64_t(sz.i0) * ey + sy.i0) * ex + sx.i0;
     if (corner != base) {
       flush(f, list);
@@ -76,25 +76,33 @@ WB_HD WB_INLINE bool inside_window(Vec3 q, int nx, int ny, int nz) {
   return q.x >= 0.f && q.y >= 0.f && q.z >= 0.f && q.x < float(nx) && q.y < float(ny) && q.z < float(nz);
 }
 
-/// Rasterises particles [k0, k1) of p, a run at a time (SplatRun): mass and oil onto the cell
-/// centres, weight m and momentum m v_c onto the faces of each component c (the cells alone when
-/// g.face[0] is null). Particles outside the window are skipped.
+/// Rasterises particles [k0, k1) of p, a run at a time on each grid (SplatRun): mass and oil onto
+/// the cell centres, weight m and momentum m v_c onto the faces of each component c (the cells
+/// alone when g.face[0] is null). A particle's axes are placed once for the four grids
+/// (axis_stencils). Particles outside the window are skipped.
 WB_HD WB_INLINE void rasterise_particles(const ParticleRasterView& g, const Vec3* x, const Vec3* v, const float* m,
                                          const float* oil, int64_t k0, int64_t k1) {
   const Vec3 o(float(g.ox), float(g.oy), float(g.oz));
-  const int grids = g.face[0] == nullptr ? 1 : 4;
-  for (int c = 0; c < grids; ++c) {
-    SplatRun run;
-    for (int64_t k = k0; k < k1; ++k) {
-      const Vec3 q = x[k] - o;
-      if (!inside_window(q, g.nx, g.ny, g.nz)) continue;
-      if (c == 0) run.add(g.cell, g.cell_list, g.nx, g.ny, g.nz, 0.5f, 0.5f, 0.5f, q, m[k], m[k] * oil[k]);
-      if (c == 1) run.add(g.face[0], g.face_list[0], g.nx + 1, g.ny, g.nz, 0.f, 0.5f, 0.5f, q, m[k], m[k] * v[k].x);
-      if (c == 2) run.add(g.face[1], g.face_list[1], g.nx, g.ny + 1, g.nz, 0.5f, 0.f, 0.5f, q, m[k], m[k] * v[k].y);
-      if (c == 3) run.add(g.face[2], g.face_list[2], g.nx, g.ny, g.nz + 1, 0.5f, 0.5f, 0.f, q, m[k], m[k] * v[k].z);
+  const bool faces = g.face[0] != nullptr;
+  SplatRun cell, face[3];
+  for (int64_t k = k0; k < k1; ++k) {
+    const Vec3 q = x[k] - o;
+    if (!inside_window(q, g.nx, g.ny, g.nz)) continue;
+    const float mk = m[k];
+    if (!faces) {
+      cell.add(g.cell, g.cell_list, g.nx, g.ny, stencil1(q.x, 0.5f, g.nx), stencil1(q.y, 0.5f, g.ny),
+               stencil1(q.z, 0.5f, g.nz), mk, mk * oil[k]);
+      continue;
     }
-    run.flush(c == 0 ? g.cell : g.face[c - 1], c == 0 ? g.cell_list : g.face_list[c - 1]);
+    const AxisStencils sx = axis_stencils(q.x, g.nx), sy = axis_stencils(q.y, g.ny), sz = axis_stencils(q.z, g.nz);
+    const Vec3 vk = v[k];
+    cell.add(g.cell, g.cell_list, g.nx, g.ny, sx.centre, sy.centre, sz.centre, mk, mk * oil[k]);
+    face[0].add(g.face[0], g.face_list[0], g.nx + 1, g.ny, sx.face, sy.centre, sz.centre, mk, mk * vk.x);
+    face[1].add(g.face[1], g.face_list[1], g.nx, g.ny + 1, sx.centre, sy.face, sz.centre, mk, mk * vk.y);
+    face[2].add(g.face[2], g.face_list[2], g.nx, g.ny, sx.centre, sy.centre, sz.face, mk, mk * vk.z);
   }
+  cell.flush(g.cell, g.cell_list);
+  for (int c = 0; c < 3 && faces; ++c) face[c].flush(g.face[c], g.face_list[c]);
 }
 
 /// Face velocity from a rasterised face: momentum / weight where the face got mass, else `empty`.
