@@ -41,7 +41,7 @@ TEST_F(AlgorithmsTest, SortByKeyMatchesStableSort) {
 }
 
 TEST_F(AlgorithmsTest, SortFullWidthKeys) {
-  const int64_t n = 5000;
+  const int64_t n = 150001;  // over the CPU's threshold for splitting the passes
   std::mt19937 rng(3);
   std::vector<uint32_t> keys(n), vals(n);
   for (int64_t i = 0; i < n; ++i) keys[i] = rng(), vals[i] = uint32_t(i);
@@ -55,7 +55,7 @@ TEST_F(AlgorithmsTest, SortFullWidthKeys) {
 }
 
 TEST_F(AlgorithmsTest, ExclusiveScanInPlaceAndTotal) {
-  for (int64_t n : {1, 5, 100000}) {
+  for (int64_t n : {1, 5, 100000, 300007}) {
     std::vector<uint32_t> in(n);
     for (int64_t i = 0; i < n; ++i) in[i] = uint32_t(i % 7);
     DeviceBuffer<uint32_t> d(device_, n);

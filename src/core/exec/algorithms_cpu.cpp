@@ -11,26 +11,61 @@
 
 namespace wb::cpu {
 
+namespace {
+// Below this many elements a primitive runs on one thread: a team's start costs more than it saves.
+constexpr int64_t kParallelMin = int64_t(1) << 16;
+// The most threads the sort and the scan split their work over (their per-thread tables).
+constexpr int kMaxSlices = 64;
+
+// Thread t's slice of [0, n) out of nt: contiguous, in thread order.
+void slice_of(int64_t n, int t, int nt, int64_t& lo, int64_t& hi) {
+  lo = n * t / nt;
+  hi = n * (t + 1) / nt;
+}
+int threads_for(int64_t n) { return n >= kParallelMin ? std::min(omp_get_max_threads(), kMaxSlices) : 1; }
+}  // namespace
+
 // LSD radix sort, 8 bits a pass, only as many passes as key_bits needs. A generic
-// comparison sort over OpenMP is an order of magnitude slower on the per-step path.
+// comparison sort over OpenMP is an order of magnitude slower on the per-step path. Each pass
+// counts each thread's slice, and each thread scatters its slice after the slices before it in
+// every digit, so the sort is stable and its result the same for any number of threads.
 void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Workspace& ws) {
   check_sort_args(n, key_bits);
   if (n <= 1) return;
   const int passes = std::max(1, (std::min(key_bits, 32) + 7) / 8);
-  auto* scratch = static_cast<uint32_t*>(ws.get(size_t(n) * 2 * sizeof(uint32_t)));
+  const int threads = threads_for(n);
+  auto* scratch = static_cast<uint32_t*>(ws.get(size_t(n) * 2 * sizeof(uint32_t) + sizeof(size_t) * 256 * kMaxSlices));
+  auto* count = reinterpret_cast<size_t*>(scratch + 2 * n);  // 256 a thread; 2n uint32 keep it aligned
   uint32_t* k_src = keys;
   uint32_t* v_src = values;
   uint32_t* k_dst = scratch;
   uint32_t* v_dst = scratch + n;
   for (int pass = 0; pass < passes; ++pass) {
     const int shift = pass * 8;
-    size_t count[257] = {};
-    for (int64_t i = 0; i < n; ++i) ++count[((k_src[i] >> shift) & 0xFFu) + 1];
-    for (int b = 0; b < 256; ++b) count[b + 1] += count[b];
-    for (int64_t i = 0; i < n; ++i) {
-      const size_t dst = count[(k_src[i] >> shift) & 0xFFu]++;
-      k_dst[dst] = k_src[i];
-      v_dst[dst] = v_src[i];
+#pragma omp parallel num_threads(threads)
+    {
+      const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+      int64_t lo, hi;
+      slice_of(n, t, nt, lo, hi);
+      size_t* c = count + 256 * t;
+      std::fill(c, c + 256, size_t(0));
+      for (int64_t i = lo; i < hi; ++i) ++c[(k_src[i] >> shift) & 0xFFu];
+#pragma omp barrier
+#pragma omp single
+      {
+        size_t at = 0;  // digit by digit, thread by thread: each slice's first slot of each digit
+        for (int b = 0; b < 256; ++b)
+          for (int u = 0; u < nt; ++u) {
+            const size_t m = count[256 * u + b];
+            count[256 * u + b] = at;
+            at += m;
+          }
+      }
+      for (int64_t i = lo; i < hi; ++i) {
+        const size_t dst = c[(k_src[i] >> shift) & 0xFFu]++;
+        k_dst[dst] = k_src[i];
+        v_dst[dst] = v_src[i];
+      }
     }
     std::swap(k_src, k_dst);
     std::swap(v_src, v_dst);
@@ -41,14 +76,32 @@ void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Work
   }
 }
 
+// Two passes over the slices: each thread sums its own, then scans it from the sum of those
+// before it. In place (in == out) too: a slice's elements are read before they are written.
 uint32_t exclusive_scan(const uint32_t* in, uint32_t* out, int64_t n, Workspace&) {
-  uint32_t running = 0;
-  for (int64_t i = 0; i < n; ++i) {
-    const uint32_t v = in[i];
-    out[i] = running;
-    running += v;
+  uint32_t part[kMaxSlices + 1] = {}, total = 0;
+#pragma omp parallel num_threads(threads_for(n))
+  {
+    const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+    int64_t lo, hi;
+    slice_of(n, t, nt, lo, hi);
+    uint32_t sum = 0;
+    for (int64_t i = lo; i < hi; ++i) sum += in[i];
+    part[t + 1] = sum;
+#pragma omp barrier
+#pragma omp single
+    {
+      for (int u = 0; u < nt; ++u) part[u + 1] += part[u];
+      total = part[nt];
+    }
+    uint32_t running = part[t];
+    for (int64_t i = lo; i < hi; ++i) {
+      const uint32_t v = in[i];
+      out[i] = running;
+      running += v;
+    }
   }
-  return running;
+  return total;
 }
 
 void exclusive_scan_into(const uint32_t* in, uint32_t* out, int64_t n, Workspace& ws) { exclusive_scan(in, out, n, ws); }
