@@ -197,24 +197,42 @@ void grid_column_tops(GridDims d, const float* rho, const float* dryness, float 
 void grid_running_columns(GridView g, PaintWindowView pw, float dry_threshold, float speed, float* out) {
   // A column runs where a cell of wet paint has a face across the canvas (u or v) faster than
   // `speed`: paint sinking as it settles (w) does not run. Its x, -x, y, -y (canvas cells, the
-  // column's centre) for the maxima that make the box of such columns.
+  // column's centre) for the maxima that make the box of such columns. Each layer of the run's
+  // columns at once (parallel_for_runs<kColumnLanes>); the faces only of a layer with wet paint.
   const GridDims d = g.d;
-  const int64_t n = int64_t(d.nx) * d.ny;
-  parallel_for(n, [=] WB_HD(int64_t col) {
-    const int i = int(col % d.nx), j = int(col / d.nx);
-    bool running = false;
-    for (int k = 0; k < d.nz && !running; ++k) {
-      const int64_t c = d.cell(i, j, k);
-      if (!(pw.density[c] > 0.f) || pw.dryness[c] >= dry_threshold) continue;
-      const float u = maxf(fabsf(g.vel[0][d.uidx(i, j, k)]), fabsf(g.vel[0][d.uidx(i + 1, j, k)]));
-      const float v = maxf(fabsf(g.vel[1][d.vidx(i, j, k)]), fabsf(g.vel[1][d.vidx(i, j + 1, k)]));
-      running = maxf(u, v) > speed;  // maxf: fmaxf is a library call on the CPU
+  const int64_t n = int64_t(d.nx) * d.ny, u_layer = int64_t(d.ny) * (d.nx + 1), v_layer = int64_t(d.ny + 1) * d.nx;
+  parallel_for_runs<kColumnLanes>(n, [=] WB_HD(int64_t col0, int lanes) {
+    int64_t u0[kColumnLanes], v0[kColumnLanes];  // the lane's u and v faces in layer 0
+    bool running[kColumnLanes];
+    for (int l = 0; l < lanes; ++l) {
+      const int64_t col = col0 + l, i = col % d.nx, j = col / d.nx;
+      u0[l] = j * (d.nx + 1) + i;
+      v0[l] = j * d.nx + i;
+      running[l] = false;
     }
-    const float none = -INFINITY, x = float(i + pw.ox) + 0.5f, y = float(j + pw.oy) + 0.5f;
-    out[col] = running ? x : none;
-    out[n + col] = running ? -x : none;
-    out[2 * n + col] = running ? y : none;
-    out[3 * n + col] = running ? -y : none;
+    for (int k = 0; k < d.nz; ++k) {
+      const int64_t c0 = int64_t(k) * n + col0, uk = int64_t(k) * u_layer, vk = int64_t(k) * v_layer;
+      bool wet[kColumnLanes], any = false;
+      for (int l = 0; l < lanes; ++l) {
+        wet[l] = (pw.density[c0 + l] > 0.f) & !(pw.dryness[c0 + l] >= dry_threshold);
+        any = any | wet[l];
+      }
+      if (!any) continue;  // most layers: the faces are not read
+      for (int l = 0; l < lanes; ++l) {
+        const int64_t ui = uk + u0[l], vi = vk + v0[l];
+        const float u = maxf(fabsf(g.vel[0][ui]), fabsf(g.vel[0][ui + 1]));
+        const float v = maxf(fabsf(g.vel[1][vi]), fabsf(g.vel[1][vi + d.nx]));
+        running[l] = running[l] | (wet[l] & (maxf(u, v) > speed));
+      }
+    }
+    for (int l = 0; l < lanes; ++l) {
+      const int64_t col = col0 + l;
+      const float none = -INFINITY, x = float(col % d.nx + pw.ox) + 0.5f, y = float(col / d.nx + pw.oy) + 0.5f;
+      out[col] = running[l] ? x : none;
+      out[n + col] = running[l] ? -x : none;
+      out[2 * n + col] = running[l] ? y : none;
+      out[3 * n + col] = running[l] ? -y : none;
+    }
   });
 }
 
