@@ -247,6 +247,7 @@ void Transfer::absorb(const SampleView& samples, BristleLoad& load, ParticleStor
   ensure_particles(np);
   for (auto& b : s_f32_) b.fill_zero();
   s_u32_[0].fill_zero();
+  s_u32_[2].fill_zero();
   p_moved_.fill_zero();
   AbsorbScratch a{};
   a.ticket = s_u32_[0].data();
@@ -258,6 +259,7 @@ void Transfer::absorb(const SampleView& samples, BristleLoad& load, ParticleStor
   a.bl_w = s_f32_[7].data();
   for (int c = 0; c < 3; ++c) a.bl_c[c] = s_f32_[8 + c].data();
   a.bl_b = s_f32_[11].data();
+  a.bl_n = s_u32_[2].data();
   a.moved = p_moved_.data();
   a.counters = sums_ptr_->absorb_counts;  // address only: the counts accumulate in the record
   const BristleLoadView lv = load.view();

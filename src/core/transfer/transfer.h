@@ -125,6 +125,7 @@ struct AbsorbScratch {
   float* bl_w;       ///< sum of bleeding weights e
   float* bl_c[3];    ///< sum e c_k
   float* bl_b;       ///< sum e brightness(c_k)
+  uint32_t* bl_n;    ///< particles bleeding into sample j (counted into counters[1] by the apply pass)
   float* moved;      ///< per particle: mass absorbed (0 otherwise)
   int32_t* counters; ///< [0] absorbed, [1] bleeding
 };
@@ -274,7 +275,7 @@ class Transfer {
   Workspace ws_;
   int64_t step_index_ = 0;
   // Per sample.
-  DeviceBuffer<uint32_t> s_u32_[2];
+  DeviceBuffer<uint32_t> s_u32_[3];
   DeviceBuffer<float> s_f32_[12];
   LaunchGraph wick_graph_;  ///< the wick's passes, recorded (CUDA)
   // Per particle.

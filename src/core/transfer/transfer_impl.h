@@ -247,12 +247,13 @@ void transfer_absorb(ParticleView p, SampleView s, BristleLoadView load, AbsorbS
     atomic_add(&a.bl_c[1][j], e * ck.y);
     atomic_add(&a.bl_c[2][j], e * ck.z);
     atomic_add(&a.bl_b[j], e * pigment_brightness(ck));
-    atomic_add(&a.counters[1], int32_t(1));
+    atomic_add(&a.bl_n[j], 1u);  // a sample's count: one address for all would be contended
   });
 }
 
 void transfer_absorb_apply(BristleLoadView load, AbsorbScratch a) {
   parallel_for(load.count, [=] WB_HD(int64_t j) {
+    if (a.bl_n[j] > 0u) atomic_add(&a.counters[1], int32_t(a.bl_n[j]));
     const float am = a.acc_m[j], bw = a.bl_w[j];
     if (!(am > 0.f) && !(bw > 0.f)) return;
     const float mj = load.m[j];
