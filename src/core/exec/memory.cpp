@@ -16,6 +16,8 @@
 #include <new>
 #include <unordered_map>
 
+#include <omp.h>
+
 #include "core/exec/dispatch.h"
 #include "core/exec/fault.h"
 #if defined(WB_WITH_CUDA)
@@ -36,6 +38,24 @@ struct Ledger {
 Ledger& ledger() {
   static Ledger l;
   return l;
+}
+/// fn(lo, hi) over [0, bytes) in one slice a thread where the range is large: one thread's memcpy
+/// or memset reaches about half the memory's bandwidth here (a 14 MB copy, the window's three
+/// velocities: 1.0-1.25 ms on one thread, 0.5-0.66 on two of the 2-core VM), and the others wait.
+template <class F>
+void in_slices(size_t bytes, F fn) {
+  constexpr size_t kMinSlice = size_t(1) << 20;
+  if (bytes < 2 * kMinSlice) {
+    fn(size_t(0), bytes);
+    return;
+  }
+#pragma omp parallel
+  {
+    const size_t n = size_t(omp_get_num_threads()), t = size_t(omp_get_thread_num());
+    const size_t per = ((bytes + n - 1) / n + 63) & ~size_t(63);  // whole cache lines
+    const size_t lo = std::min(bytes, t * per), hi = std::min(bytes, lo + per);
+    if (hi > lo) fn(lo, hi);
+  }
 }
 /// Refuses an allocation the budget has no room for, before the system is asked.
 void check_budget(size_t bytes, bool cuda) {
@@ -266,7 +286,10 @@ void copy_from_host(const Device& device, void* dev_dst, const void* host_src, s
 void copy_on_device(const Device& device, void* dst, const void* src, size_t bytes) {
   count_launch();
   if (device.is_cpu()) {
-    std::memmove(dst, src, bytes);
+    // As cudaMemcpy's, the two ranges do not overlap.
+    in_slices(bytes, [&](size_t lo, size_t hi) {
+      std::memcpy(static_cast<char*>(dst) + lo, static_cast<const char*>(src) + lo, hi - lo);
+    });
     return;
   }
 #if defined(WB_WITH_CUDA)
@@ -279,7 +302,7 @@ void copy_on_device(const Device& device, void* dst, const void* src, size_t byt
 void fill_zero(const Device& device, void* ptr, size_t bytes) {
   count_launch();
   if (device.is_cpu()) {
-    std::memset(ptr, 0, bytes);
+    in_slices(bytes, [&](size_t lo, size_t hi) { std::memset(static_cast<char*>(ptr) + lo, 0, hi - lo); });
     return;
   }
 #if defined(WB_WITH_CUDA)
