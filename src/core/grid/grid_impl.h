@@ -43,10 +43,11 @@ struct FacesIn {
   const GridExtent* e;
   F fn;
   WB_HD void operator()(int64_t t) const {
-    int c;
+    int c, i, j, k;
     int64_t f;
     extent_face(d, *e, t, c, f);
-    fn(c, f);
+    d.decompose_face(c, f, i, j, k);  // a kernel that does not use them drops the division
+    fn(c, f, i, j, k);
   }
 };
 template <class F>
@@ -54,10 +55,11 @@ struct AllFaces {
   GridDims d;
   F fn;
   WB_HD void operator()(int64_t t) const {
-    int c;
+    int c, i, j, k;
     int64_t f;
     split_face_below(d, d.nz, t, c, f);
-    fn(c, f);
+    d.decompose_face(c, f, i, j, k);
+    fn(c, f, i, j, k);
   }
 };
 }  // namespace detail
@@ -91,8 +93,9 @@ void for_cells(const GridDims& d, const GridExtent* e, F fn) {
   else
     parallel_for(d.cells(), fn);
 }
-/// fn(c, f) (component, index) for every face a stage visits: those of the extent's cells, or all.
-/// On the CPU backend a row along x at a time, as for_extent_cells.
+/// fn(c, f, i, j, k) (component, index, and the face's (i, j, k) of face_position) for every face
+/// a stage visits: those of the extent's cells, or all. On the CPU backend a row along x at a time,
+/// as for_extent_cells: the row gives j and k, no division a face.
 template <class F>
 void for_faces(const GridDims& d, const GridExtent* e, F fn) {
   if (!e) {
@@ -114,8 +117,9 @@ void for_faces(const GridDims& d, const GridExtent* e, F fn) {
       [=](int64_t r) {
         const int c = r < ru ? 0 : (r < ru + rv ? 1 : 2);
         const int64_t s = c == 0 ? r : (c == 1 ? r - ru : r - ru - rv), ey = by + (c == 1), ex = bx + (c == 0);
-        const int64_t f0 = ((s / ey) * (d.ny + (c == 1)) + x.y0 + s % ey) * (d.nx + (c == 0)) + x.x0;
-        for (int64_t i = 0; i < ex; ++i) fn(c, f0 + i);
+        const int k = int(s / ey), j = int(x.y0 + s % ey);
+        const int64_t f0 = (int64_t(k) * (d.ny + (c == 1)) + j) * (d.nx + (c == 0)) + x.x0;
+        for (int64_t i = 0; i < ex; ++i) fn(c, f0 + i, int(x.x0 + i), j, k);
       },
       kMinParallelSize / bx + 1);
 #endif
@@ -142,9 +146,7 @@ void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float*
     parallel_for(d.cells(), cell);
   // Open fraction, solid velocity and fluid flag of each face in one pass: the flag reads only
   // the face's own fraction and its two cells' classes.
-  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f) {
-    int i, j, k;
-    d.decompose_face(c, f, i, j, k);
+  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f, int i, int j, int k) {
     float theta, us;
     face_fraction(d, g.cls, br, c, i, j, k, theta, us);
     g.theta[c][f] = theta;
@@ -505,8 +507,7 @@ void grid_advect_paint_axis(GridView g, PaintWindowView paint, PaintWindowView s
 void grid_advect_velocity(GridView g, const float* u, const float* v, const float* w, float dt) {
   WB_REQUIRE(g.extent, "grid advection: the velocity's extent is not set");
   const GridDims d = g.d;
-  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f) {
-    int i, j, k;
+  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f, int i, int j, int k) {
     if (g.theta[c][f] <= 0.f) {
       g.vel[c][f] = g.solid_vel[c][f];
       return;
@@ -514,7 +515,6 @@ void grid_advect_velocity(GridView g, const float* u, const float* v, const floa
     // An air face keeps the velocity the last projection extrapolated to it (docs/GRID.md
     // "Advection and mass": the paint's momentum is carried where the paint is).
     if (!g.fluid[c][f]) return;
-    d.decompose_face(c, f, i, j, k);
     const Vec3 p = backtrace(u, v, w, d, face_position(c, i, j, k), dt);
     g.vel[c][f] = sample_component(c == 0 ? u : (c == 1 ? v : w), d, c, p);
   });
@@ -534,10 +534,8 @@ void grid_gravity(GridView g, float* ph, float g_dt, float g_dt_y) {
       ph[c] = head;
     }
   });
-  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f) {
+  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f, int i, int j, int k) {
     if (g.theta[c][f] <= 0.f) return;
-    int i, j, k;
-    d.decompose_face(c, f, i, j, k);
     int64_t a, b;
     bool ha, hb;
     face_cells(d, c, i, j, k, a, b, ha, hb);
@@ -715,13 +713,14 @@ void grid_viscous_flags(GridView g, uint32_t* flag) {
   // The extent's faces: beyond them every flag is 0 already, as the fluid flags are (the faces
   // a step's liquid held are visited once more by the next step, GridExtent::dirty_box).
   const GridDims d = g.d;
-  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f) { flag[global_face(d, c, f)] = g.fluid[c][f] ? 1u : 0u; });
+  for_faces(d, g.extent,
+            [=] WB_HD(int c, int64_t f, int, int, int) { flag[global_face(d, c, f)] = g.fluid[c][f] ? 1u : 0u; });
 }
 
 void grid_viscous_list(GridView g, const uint32_t* idx, uint32_t* list) {
   const GridDims d = g.d;
   // Fluid faces lie below the extent's layers; the list and idx are of every face.
-  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f) {
+  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f, int, int, int) {
     if (!g.fluid[c][f]) return;
     const int64_t t = global_face(d, c, f);
     list[idx[t]] = uint32_t(t);
@@ -923,9 +922,7 @@ void poisson_apply_all(PoissonView s, const float* x, float* out) {
 
 void grid_apply_pressure(GridView g, const float* p) {
   const GridDims d = g.d;
-  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f) {
-    int i, j, k;
-    d.decompose_face(c, f, i, j, k);
+  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f, int i, int j, int k) {
     g.vel[c][f] = projected_face_velocity(g, p, c, i, j, k);
   });
 }
@@ -933,14 +930,12 @@ void grid_apply_pressure(GridView g, const float* p) {
 void grid_extrapolate(GridView g) {
   const GridDims d = g.d;
   // Writes only faces that touch no liquid, reads only faces that do: safe in place.
-  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f) {
-    int i, j, k;
+  for_faces(d, g.extent, [=] WB_HD(int c, int64_t f, int i, int j, int k) {
     if (g.theta[c][f] <= 0.f) {
       g.vel[c][f] = g.solid_vel[c][f];
       return;
     }
     if (g.fluid[c][f]) return;
-    d.decompose_face(c, f, i, j, k);
     g.vel[c][f] = extrapolated_face_velocity(g, c, i, j, k);
   });
 }
