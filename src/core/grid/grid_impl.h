@@ -35,7 +35,12 @@ struct CellsIn {
   GridDims d;
   const GridExtent* e;
   F fn;
-  WB_HD void operator()(int64_t t) const { fn(extent_cell(d, *e, t)); }
+  WB_HD void operator()(int64_t t) const {
+    const int64_t c = extent_cell(d, *e, t);
+    int i, j, k;
+    d.decompose_cell(c, i, j, k);  // a kernel that does not use them drops the division
+    fn(c, i, j, k);
+  }
 };
 template <class F>
 struct FacesIn {
@@ -64,9 +69,9 @@ struct AllFaces {
 };
 }  // namespace detail
 
-/// fn(c) for the first *count cells of the extent e (x fastest, then y, then z). CUDA launches a
-/// thread a cell that finds its cell by division; the CPU backend, whose device memory is the
-/// host's, reads the extent and walks it a row along x at a time (one division a row).
+/// fn(c, i, j, k) for the first *count cells of the extent e (x fastest, then y, then z). CUDA
+/// launches a thread a cell that finds its cell by division; the CPU backend, whose device memory
+/// is the host's, reads the extent and walks it a row along x at a time (one division a row).
 template <class F>
 void for_extent_cells(const GridDims& d, const GridExtent* e, const int64_t* count, F fn) {
 #if defined(__CUDACC__)
@@ -79,19 +84,25 @@ void for_extent_cells(const GridDims& d, const GridExtent* e, const int64_t* cou
   parallel_for(
       rows,
       [=](int64_t r) {
-        const int64_t c0 = ((r / by) * d.ny + x.y0 + r % by) * d.nx + x.x0;
-        for (int64_t i = 0; i < bx; ++i) fn(c0 + i);
+        const int k = int(r / by), j = int(x.y0 + r % by);
+        const int64_t c0 = (int64_t(k) * d.ny + j) * d.nx + x.x0;
+        for (int64_t i = 0; i < bx; ++i) fn(c0 + i, int(x.x0 + i), j, k);
       },
       kMinParallelSize / bx + 1);
 #endif
 }
-/// fn(c) for every cell a stage visits: the extent's, or all.
+/// fn(c, i, j, k) for every cell a stage visits: the extent's, or all.
 template <class F>
 void for_cells(const GridDims& d, const GridExtent* e, F fn) {
-  if (e)
+  if (e) {
     for_extent_cells(d, e, &e->cells, fn);
-  else
-    parallel_for(d.cells(), fn);
+    return;
+  }
+  parallel_for(d.cells(), [=] WB_HD(int64_t c) {
+    int i, j, k;
+    d.decompose_cell(c, i, j, k);
+    fn(c, i, j, k);
+  });
 }
 /// fn(c, f, i, j, k) (component, index, and the face's (i, j, k) of face_position) for every face
 /// a stage visits: those of the extent's cells, or all. On the CPU backend a row along x at a time,
@@ -129,9 +140,7 @@ void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float*
                    FlowColumns flow, float liquid_threshold, float dry_threshold) {
   const int canvas_w = canvas.width, canvas_h = canvas.height, canvas_d = canvas.depth;
   const GridDims d = g.d;
-  const auto cell = [=] WB_HD(int64_t c) {
-    int i, j, k;
-    d.decompose_cell(c, i, j, k);
+  const auto cell = [=] WB_HD(int64_t c, int i, int j, int k) {
     const int cx = i + pw.ox, cy = j + pw.oy, cz = k + pw.oz;
     const bool on =
         cx >= 0 && cy >= 0 && cz >= 0 && cx < canvas_w && cy < canvas_h && cz < canvas_d && flow.contains(cx, cy);
@@ -143,7 +152,7 @@ void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float*
   if (g.extent)
     for_extent_cells(d, g.extent, &g.extent->classes, cell);
   else
-    parallel_for(d.cells(), cell);
+    for_cells(d, nullptr, cell);
   // Open fraction, solid velocity and fluid flag of each face in one pass: the flag reads only
   // the face's own fraction and its two cells' classes.
   for_faces(d, g.extent, [=] WB_HD(int c, int64_t f, int i, int j, int k) {
@@ -294,14 +303,12 @@ void grid_paint_outflow(GridView g, const float* rho, float* rates) {
   // the same whatever the order). The painted cells lie in the step's first extent, which g's
   // extent is (grid_first_extent).
   const GridDims d = g.d;
-  for_cells(d, g.extent, [=] WB_HD(int64_t c) {
+  for_cells(d, g.extent, [=] WB_HD(int64_t c, int i, int j, int k) {
     // Traces (a millionth of a cell) do not count. The donor limit leaves a part in 10^6 of what
     // a cell held, so a drained cell in the bristles' fast flow keeps 1e-6, then 1e-12, ... of a
     // cell: sized by them, the studio's stroke took 16 sub-steps a step where its paint needed 3.
     // A trace asked for more than it holds gives what it holds (the donor limit).
     if (!(rho[c] > kTraceDensity)) return;
-    int i, j, k;
-    d.decompose_cell(c, i, j, k);
     for (int a = 0; a < 3; ++a) {
       const float r = cell_axis_outflow(g, rho, a, i, j, k);
       if (r > 0.f) atomic_max(&rates[a], r);  // loads first, and writes only a larger value
@@ -698,13 +705,11 @@ void grid_film_write(GridDims d, PaintWindowView pw, const float* col) {
 void grid_effective_viscosity(GridView g, JointOil oil, HerschelBulkley stiff, HerschelBulkley oily, float m,
                               float* mu) {
   const GridDims d = g.d;
-  for_cells(d, g.extent, [=] WB_HD(int64_t c) {
+  for_cells(d, g.extent, [=] WB_HD(int64_t c, int i, int j, int k) {
     if (g.cls[c] != kCellLiquid) {
       mu[c] = 0.f;
       return;
     }
-    int i, j, k;
-    d.decompose_cell(c, i, j, k);
     mu[c] = apparent_viscosity(rheology_at_oil(oil.at(c), stiff, oily), cell_strain_rate(g, i, j, k), m);
   });
 }
@@ -864,43 +869,40 @@ void grid_viscous_write(GridView g, const uint32_t* list, ListCount n, const dou
 
 void grid_rhs(GridView g, const float* rho, float inv_dt, float* b) {
   const GridDims d = g.d;
-  for_cells(d, g.extent, [=] WB_HD(int64_t c) {
+  for_cells(d, g.extent, [=] WB_HD(int64_t c, int i, int j, int k) {
     if (g.cls[c] != kCellLiquid) {
       b[c] = 0.f;
       return;
     }
-    int i, j, k;
-    d.decompose_cell(c, i, j, k);
     b[c] = compression_source(rho ? rho[c] : 0.f, inv_dt) - cell_divergence(g, i, j, k);
   });
 }
 
 void poisson_jacobi(PoissonView s, const float* b, const float* x, float* out, float omega) {
-  for_cells(s.d, s.extent, [=] WB_HD(int64_t c) { out[c] = jacobi_update(s, b, x, c, omega); });
+  for_cells(s.d, s.extent,
+            [=] WB_HD(int64_t c, int i, int j, int k) { out[c] = jacobi_update(s, b, x, c, i, j, k, omega); });
 }
 
 void poisson_residual(PoissonView s, const float* b, const float* x, float* r) {
-  for_cells(s.d, s.extent, [=] WB_HD(int64_t c) {
-    r[c] = s.cls[c] == kCellLiquid ? b[c] - poisson_apply(s, x, c) : 0.f;
+  for_cells(s.d, s.extent, [=] WB_HD(int64_t c, int i, int j, int k) {
+    r[c] = s.cls[c] == kCellLiquid ? b[c] - poisson_apply(s, x, c, i, j, k) : 0.f;
   });
 }
 
 void poisson_chebyshev(PoissonView s, const float* b, const float* x, const float* x_prev, float* out, float omega_k) {
-  for_cells(s.d, s.extent, [=] WB_HD(int64_t c) {
-    const float xj = jacobi_update(s, b, x, c, 1.f);
+  for_cells(s.d, s.extent, [=] WB_HD(int64_t c, int i, int j, int k) {
+    const float xj = jacobi_update(s, b, x, c, i, j, k, 1.f);
     out[c] = s.cls[c] == kCellLiquid ? omega_k * (xj - x_prev[c]) + x_prev[c] : 0.f;
   });
 }
 
 void poisson_fixed_point_first(PoissonView s, const float* r, const float* y, float* out, float alpha) {
   // One Jacobi sweep on the residual r started from alpha * y (Eq. 3, inner term).
-  for_cells(s.d, s.extent, [=] WB_HD(int64_t c) {
+  for_cells(s.d, s.extent, [=] WB_HD(int64_t c, int i, int j, int k) {
     if (s.cls[c] != kCellLiquid) {
       out[c] = 0.f;
       return;
     }
-    int i, j, k;
-    s.d.decompose_cell(c, i, j, k);
     float diag, off;
     poisson_row(s, y, i, j, k, diag, off);
     out[c] = diag > 1e-6f ? (r[c] + alpha * off) / diag : 0.f;
@@ -909,15 +911,16 @@ void poisson_fixed_point_first(PoissonView s, const float* r, const float* y, fl
 
 void poisson_fixed_point_second(PoissonView s, const float* r, const float* z, float* y_out, float* x) {
   // Second Jacobi sweep, then x += y (the pressure applied is the sum of the corrections).
-  for_cells(s.d, s.extent, [=] WB_HD(int64_t c) {
-    const float y = jacobi_update(s, r, z, c, 1.f);
+  for_cells(s.d, s.extent, [=] WB_HD(int64_t c, int i, int j, int k) {
+    const float y = jacobi_update(s, r, z, c, i, j, k, 1.f);
     y_out[c] = y;
     x[c] += y;
   });
 }
 
 void poisson_apply_all(PoissonView s, const float* x, float* out) {
-  for_cells(s.d, s.extent, [=] WB_HD(int64_t c) { out[c] = poisson_apply(s, x, c); });
+  for_cells(s.d, s.extent,
+            [=] WB_HD(int64_t c, int i, int j, int k) { out[c] = poisson_apply(s, x, c, i, j, k); });
 }
 
 void grid_apply_pressure(GridView g, const float* p) {

@@ -116,23 +116,20 @@ WB_HD WB_INLINE void poisson_row(const PoissonView& s, const T* x, int i, int j,
   if (tt > 0.f && k + 1 < d.nz) off += T(tt) * x[d.cell(i, j, k + 1)];
 }
 
-/// (A x)_i = diag_i x_i - sum theta_f x_nb on liquid cells, 0 elsewhere.
+/// (A x)_i = diag_i x_i - sum theta_f x_nb on liquid cells, 0 elsewhere; cell c is (i, j, k).
 template <typename T>
-WB_HD WB_INLINE T poisson_apply(const PoissonView& s, const T* x, int64_t c) {
+WB_HD WB_INLINE T poisson_apply(const PoissonView& s, const T* x, int64_t c, int i, int j, int k) {
   if (s.cls[c] != kCellLiquid) return T(0);
-  int i, j, k;
-  s.d.decompose_cell(c, i, j, k);
   T diag, off;
   poisson_row(s, x, i, j, k, diag, off);
   return diag * x[c] - off;
 }
 
-/// One weighted Jacobi update of cell c: (1-omega) x_c + omega D^-1 (b_c + R x)_c, Eq. 7
-/// (omega = 1: plain Jacobi). Cells outside liquid, or closed on every face, stay 0.
-WB_HD WB_INLINE float jacobi_update(const PoissonView& s, const float* b, const float* x, int64_t c, float omega) {
+/// One weighted Jacobi update of cell c = (i, j, k): (1-omega) x_c + omega D^-1 (b_c + R x)_c,
+/// Eq. 7 (omega = 1: plain Jacobi). Cells outside liquid, or closed on every face, stay 0.
+WB_HD WB_INLINE float jacobi_update(const PoissonView& s, const float* b, const float* x, int64_t c, int i, int j,
+                                    int k, float omega) {
   if (s.cls[c] != kCellLiquid) return 0.f;
-  int i, j, k;
-  s.d.decompose_cell(c, i, j, k);
   float diag, off;
   poisson_row(s, x, i, j, k, diag, off);
   if (diag <= 1e-6f) return 0.f;

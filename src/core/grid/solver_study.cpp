@@ -131,7 +131,11 @@ void apply_host(const HostPoisson& s, const std::vector<double>& x, std::vector<
   const PoissonView v = s.view();
   const int64_t n = s.d.cells();
 #pragma omp parallel for schedule(static)
-  for (int64_t c = 0; c < n; ++c) out[size_t(c)] = poisson_apply(v, x.data(), c);
+  for (int64_t c = 0; c < n; ++c) {
+    int i, j, k;
+    v.d.decompose_cell(c, i, j, k);
+    out[size_t(c)] = poisson_apply(v, x.data(), c, i, j, k);
+  }
 }
 double dot(const std::vector<double>& a, const std::vector<double>& b) {
   double acc = 0;
