@@ -146,15 +146,50 @@ float reduce_min(const float* in, int64_t n, Workspace&) {
   return m;
 }
 
-void count_nonfinite_each_into(const FloatArrays& arrays, int64_t* out, Workspace& ws) {
+namespace {
+// Non-finite floats of in[0, n): an exponent of all ones, tested on the bits so that the loop
+// vectorises.
+uint32_t nonfinite_in(const float* in, int64_t n) {
+  const auto* bits = reinterpret_cast<const uint32_t*>(in);
+  uint32_t c = 0;
+#pragma omp simd reduction(+ : c)
+  for (int64_t i = 0; i < n; ++i) c += (bits[i] & 0x7f800000u) == 0x7f800000u ? 1u : 0u;
+  return c;
+}
+}  // namespace
+
+// Every array's blocks in one parallel loop (a census is some 24 arrays a step: a loop each woke
+// the threads 24 times), each block's count kept apart and an array's blocks summed after.
+void count_nonfinite_each_into(const FloatArrays& arrays, int64_t* out, Workspace&) {
   if (arrays.count == 0) return;
-  for (int k = 0; k < arrays.count; ++k) out[k] = count_nonfinite(arrays.ptr[k], arrays.n[k], ws);
+  constexpr int64_t kMaxBlocks = 4096;
+  int64_t total = 0;
+  for (int k = 0; k < arrays.count; ++k) total += arrays.n[k];
+  // Blocks of at least 64 Ki floats, and few enough for the table here (each under 2^32).
+  const int64_t block = std::max(int64_t(1) << 16, (total + kMaxBlocks / 2 - 1) / (kMaxBlocks / 2));
+  int64_t first[FloatArrays::kMax + 1] = {};
+  for (int k = 0; k < arrays.count; ++k) first[k + 1] = first[k] + (arrays.n[k] + block - 1) / block;
+  const int64_t blocks = first[arrays.count];  // at most kMaxBlocks / 2 + kMax
+  uint32_t per_block[kMaxBlocks];
+#pragma omp parallel for schedule(static) if (blocks > 1)
+  for (int64_t b = 0; b < blocks; ++b) {
+    int k = 0;
+    while (first[k + 1] <= b) ++k;
+    const int64_t lo = (b - first[k]) * block, hi = std::min(arrays.n[k], lo + block);
+    per_block[b] = nonfinite_in(arrays.ptr[k] + lo, hi - lo);
+  }
+  for (int k = 0; k < arrays.count; ++k) {
+    int64_t c = 0;
+    for (int64_t b = first[k]; b < first[k + 1]; ++b) c += per_block[b];
+    out[k] = c;
+  }
 }
 
-int64_t count_nonfinite(const float* in, int64_t n, Workspace&) {
+int64_t count_nonfinite(const float* in, int64_t n, Workspace& ws) {
+  FloatArrays one;
+  one.add(in, n);
   int64_t c = 0;
-#pragma omp parallel for reduction(+ : c) schedule(static) if (n > 65536)
-  for (int64_t i = 0; i < n; ++i) c += std::isfinite(in[i]) ? 0 : 1;
+  count_nonfinite_each_into(one, &c, ws);
   return c;
 }
 
