@@ -297,14 +297,24 @@ void Brush::update_samples(float dt, const BrushFrame& frame, const SolidField& 
   sample_history_ = std::min(sample_history_ + 1, 2);
 }
 
-void Brush::rasterize(Int3 window_origin, Int3 window_dims, float* psi, float* vx, float* vy, float* vz) {
+void Brush::rasterize(Int3 window_origin, Int3 window_dims, float* psi, float* vx, float* vy, float* vz,
+                      TouchListBuffers* cells) {
   WB_PROFILE_SCOPE("brush.rasterize");
   WB_REQUIRE(window_dims.x > 0 && window_dims.y > 0 && window_dims.z > 0, "Brush::rasterize: window dims must be positive");
   WB_REQUIRE(psi && vx && vy && vz, "Brush::rasterize: null output pointer");
-  const int64_t cells = int64_t(window_dims.x) * window_dims.y * window_dims.z;
-  for (float* p : {psi, vx, vy, vz}) mem::fill_zero(device_, p, size_t(cells) * sizeof(float));
-  samples_rasterize(device_, samples(), spec_.bristle_radius, window_origin, window_dims, psi, vx, vy, vz);
-  samples_rasterize_finish(device_, cells, psi, vx, vy, vz);
+  const int64_t n = int64_t(window_dims.x) * window_dims.y * window_dims.z;
+  WB_REQUIRE(!cells || cells->capacity() == n, "Brush::rasterize: the cell list is not the window's");
+  if (cells) {
+    // The fields hold the last raster at the cells it listed and 0 elsewhere: those go back to 0,
+    // so that the raster costs in proportion to the bristles, not to the window.
+    samples_raster_clear(device_, n, psi, vx, vy, vz, cells->view());
+    cells->clear_count();
+  } else {
+    for (float* p : {psi, vx, vy, vz}) mem::fill_zero(device_, p, size_t(n) * sizeof(float));
+  }
+  const TouchList list = cells ? cells->view() : TouchList{};
+  samples_rasterize(device_, samples(), spec_.bristle_radius, window_origin, window_dims, psi, vx, vy, vz, list);
+  samples_rasterize_finish(device_, n, psi, vx, vy, vz, list);
 }
 
 int64_t Brush::mark_contacts(int32_t* trace, int trace_w, int trace_h, int ox, int oy, float contact_height,

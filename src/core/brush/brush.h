@@ -14,6 +14,7 @@
 #include "core/canvas/window.h"
 #include "core/exec/buffer.h"
 #include "core/exec/graph.h"
+#include "core/exec/touch_list.h"
 #include "core/exec/workspace.h"
 
 namespace wb {
@@ -85,7 +86,8 @@ class Brush {
   /// Bristle density psi (occupied volume fraction, clamped to 1) and the psi-weighted
   /// mean bristle velocity (cells/s) on the cell-centred window at `window_origin`, sized
   /// `window_dims`. Device pointers, window_dims.x*y*z floats each; zeroed here.
-  void rasterize(Int3 window_origin, Int3 window_dims, float* psi, float* vx, float* vy, float* vz);
+  void rasterize(Int3 window_origin, Int3 window_dims, float* psi, float* vx, float* vy, float* vz,
+                 TouchListBuffers* cells = nullptr);
 
   /// Sets trace[(y - oy) * trace_w + (x - ox)] = 1 (device pointer) for every canvas cell
   /// (x, y) holding a sample less than contact_height above the canvas or the dried paint

@@ -347,7 +347,7 @@ void samples_z(SampleView sv, float* z) {
 }
 
 void samples_rasterize(SampleView sv, float radius, Int3 origin, Int3 dims, float* psi, float* vx, float* vy,
-                       float* vz) {
+                       float* vz, TouchList cells) {
   const int S = sv.per_bristle;
   parallel_for(sv.count(), [=] WB_HD(int64_t q) {
     const int j = int(q % S);
@@ -372,18 +372,31 @@ void samples_rasterize(SampleView sv, float radius, Int3 origin, Int3 dims, floa
       atomic_add(&vx[at], m * v.x);
       atomic_add(&vy[at], m * v.y);
       atomic_add(&vz[at], m * v.z);
+      if (cells.on()) cells.touch(at);
     }
   });
 }
 
-void samples_rasterize_finish(int64_t cells, float* psi, float* vx, float* vy, float* vz) {
-  parallel_for(cells, [=] WB_HD(int64_t i) {
+void samples_rasterize_finish(int64_t n, float* psi, float* vx, float* vy, float* vz, TouchList cells) {
+  const auto finish = [=] WB_HD(int64_t i) {
     const float p = psi[i];
     if (p <= 0.f) return;
     vx[i] /= p;  // divided: p may be subnormal
     vy[i] /= p;
     vz[i] /= p;
     psi[i] = minf(p, 1.f);
+  };
+  if (cells.on())  // the cells the splat listed: the others hold 0
+    parallel_for_count(cells.count, n, [=] WB_HD(int64_t t) { finish(cells.items[t]); });
+  else
+    parallel_for(n, finish);
+}
+
+void samples_raster_clear(int64_t n, float* psi, float* vx, float* vy, float* vz, TouchList cells) {
+  parallel_for_count(cells.count, n, [=] WB_HD(int64_t t) {
+    const int64_t i = cells.items[t];
+    psi[i] = vx[i] = vy[i] = vz[i] = 0.f;
+    cells.listed[i] = 0;
   });
 }
 

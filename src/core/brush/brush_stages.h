@@ -8,6 +8,7 @@
 #include "core/brush/brush_views.h"
 #include "core/canvas/window.h"
 #include "core/exec/dispatch.h"
+#include "core/exec/touch_list.h"
 
 namespace wb {
 
@@ -60,9 +61,11 @@ struct FrameScan {
   X(void, samples_motion, (SampleView sv, SamplePrev prev, float dt, int history), (sv, prev, dt, history))          \
   X(void, samples_z, (SampleView sv, float* z), (sv, z))                                                             \
   X(void, samples_rasterize, (SampleView sv, float radius, Int3 origin, Int3 dims, float* psi, float* vx, float* vy, \
-      float* vz), (sv, radius, origin, dims, psi, vx, vy, vz))                                                       \
-  X(void, samples_rasterize_finish, (int64_t cells, float* psi, float* vx, float* vy, float* vz),                    \
-      (cells, psi, vx, vy, vz))                                                                                      \
+      float* vz, TouchList cells), (sv, radius, origin, dims, psi, vx, vy, vz, cells))                               \
+  X(void, samples_rasterize_finish, (int64_t n, float* psi, float* vx, float* vy, float* vz, TouchList cells),       \
+      (n, psi, vx, vy, vz, cells))                                                                                   \
+  X(void, samples_raster_clear, (int64_t n, float* psi, float* vx, float* vy, float* vz, TouchList cells),           \
+      (n, psi, vx, vy, vz, cells))                                                                                   \
   X(void, samples_contact_keys, (SampleView sv, SolidField solid, float contact_height, int32_t* trace, int trace_w, \
       int trace_h, int ox, int oy, uint32_t* keys, uint32_t* vals),                                                  \
       (sv, solid, contact_height, trace, trace_w, trace_h, ox, oy, keys, vals))                                      \

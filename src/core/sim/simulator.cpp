@@ -77,6 +77,8 @@ Simulator::Simulator(const SimConfig& config, const BrushPose& initial_pose)
     b.fill_zero();
   };
   cells(psi_);
+  bristle_cells_.set_device(d);
+  bristle_cells_.ensure(g.cells());  // with psi_ and bristle_v_ zero: nothing listed (Brush::rasterize)
   raster_cell_.set_device(d);
   raster_cell_.resize(size_t(g.cells()));
   raster_cell_.fill_zero();  // then kept zero beyond the listed cells (clear_raster)
@@ -649,7 +651,7 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
     grid_->move_window(w.origin);
     grid_->set_flow_columns(w.flow);
     brush_->rasterize(grid_->window().origin(), grid_->window().dims(), psi_.data(), bristle_v_[0].data(),
-                      bristle_v_[1].data(), bristle_v_[2].data());
+                      bristle_v_[1].data(), bristle_v_[2].data(), &bristle_cells_);
     grid_->set_bristles(BristleField{psi_.data(), bristle_v_[0].data(), bristle_v_[1].data(), bristle_v_[2].data()});
   }
 

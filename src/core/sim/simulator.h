@@ -271,6 +271,7 @@ class Simulator {
   DeviceBuffer<FloatPair> raster_cell_, raster_face_[3];  ///< the particles' raster (flip_kernels.h)
   /// The cells and faces the raster reached: zero elsewhere, and cleared through these.
   TouchListBuffers raster_cells_, raster_faces_[3];
+  TouchListBuffers bristle_cells_;  ///< the cells of psi_ and bristle_v_ the bristles' raster reached
   DeviceBuffer<float> raster_density_, raster_oil_;  ///< its mass and oil per cell mass
   DeviceBuffer<float> overlay_mass_;
   /// The step's record on the device: the transfer's sums, the census's, the non-finite
