@@ -377,19 +377,26 @@ void samples_rasterize(SampleView sv, float radius, Int3 origin, Int3 dims, floa
   });
 }
 
+namespace brush_detail {
+/// Cell i of the bristles' raster from its sums: the mean velocity, psi clamped to 1.
+WB_HD WB_INLINE void finish_raster_cell(int64_t i, float* psi, float* vx, float* vy, float* vz) {
+  const float p = psi[i];
+  if (p <= 0.f) return;
+  vx[i] /= p;  // divided: p may be subnormal
+  vy[i] /= p;
+  vz[i] /= p;
+  psi[i] = minf(p, 1.f);
+}
+}  // namespace brush_detail
+
 void samples_rasterize_finish(int64_t n, float* psi, float* vx, float* vy, float* vz, TouchList cells) {
-  const auto finish = [=] WB_HD(int64_t i) {
-    const float p = psi[i];
-    if (p <= 0.f) return;
-    vx[i] /= p;  // divided: p may be subnormal
-    vy[i] /= p;
-    vz[i] /= p;
-    psi[i] = minf(p, 1.f);
-  };
-  if (cells.on())  // the cells the splat listed: the others hold 0
-    parallel_for_count(cells.count, n, [=] WB_HD(int64_t t) { finish(cells.items[t]); });
-  else
-    parallel_for(n, finish);
+  if (cells.on()) {  // the cells the splat listed: the others hold 0
+    parallel_for_count(cells.count, n, [=] WB_HD(int64_t t) {
+      brush_detail::finish_raster_cell(cells.items[t], psi, vx, vy, vz);
+    });
+  } else {
+    parallel_for(n, [=] WB_HD(int64_t i) { brush_detail::finish_raster_cell(i, psi, vx, vy, vz); });
+  }
 }
 
 void samples_raster_clear(int64_t n, float* psi, float* vx, float* vy, float* vz, TouchList cells) {

@@ -43,6 +43,16 @@ struct CellsIn {
   }
 };
 template <class F>
+struct AllCells {
+  GridDims d;
+  F fn;
+  WB_HD void operator()(int64_t c) const {
+    int i, j, k;
+    d.decompose_cell(c, i, j, k);
+    fn(c, i, j, k);
+  }
+};
+template <class F>
 struct FacesIn {
   GridDims d;
   const GridExtent* e;
@@ -98,11 +108,7 @@ void for_cells(const GridDims& d, const GridExtent* e, F fn) {
     for_extent_cells(d, e, &e->cells, fn);
     return;
   }
-  parallel_for(d.cells(), [=] WB_HD(int64_t c) {
-    int i, j, k;
-    d.decompose_cell(c, i, j, k);
-    fn(c, i, j, k);
-  });
+  parallel_for(d.cells(), detail::AllCells<F>{d, fn});
 }
 /// fn(c, f, i, j, k) (component, index, and the face's (i, j, k) of face_position) for every face
 /// a stage visits: those of the extent's cells, or all. On the CPU backend a row along x at a time,
