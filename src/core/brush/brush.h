@@ -85,7 +85,8 @@ class Brush {
 
   /// Bristle density psi (occupied volume fraction, clamped to 1) and the psi-weighted
   /// mean bristle velocity (cells/s) on the cell-centred window at `window_origin`, sized
-  /// `window_dims`. Device pointers, window_dims.x*y*z floats each; zeroed here.
+  /// `window_dims`. Device pointers, window_dims.x*y*z floats each; zeroed here, or, given the
+  /// list of the cells the last raster into them reached, zeroed there and the list kept anew.
   void rasterize(Int3 window_origin, Int3 window_dims, float* psi, float* vx, float* vy, float* vz,
                  TouchListBuffers* cells = nullptr);
 

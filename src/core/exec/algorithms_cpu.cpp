@@ -8,21 +8,15 @@
 #include <vector>
 
 #include "core/exec/algorithms.h"
+#include "core/exec/parallel_for.h"
 
 namespace wb::cpu {
 
 namespace {
-// Below this many elements a primitive runs on one thread: a team's start costs more than it saves.
-constexpr int64_t kParallelMin = int64_t(1) << 16;
 // The most threads the sort and the scan split their work over (their per-thread tables).
 constexpr int kMaxSlices = 64;
-
-// Thread t's slice of [0, n) out of nt: contiguous, in thread order.
-void slice_of(int64_t n, int t, int nt, int64_t& lo, int64_t& hi) {
-  lo = n * t / nt;
-  hi = n * (t + 1) / nt;
-}
-int threads_for(int64_t n) { return n >= kParallelMin ? std::min(omp_get_max_threads(), kMaxSlices) : 1; }
+// Up to a sum's serial size a primitive runs on one thread: a team's start costs more than it saves.
+int threads_for(int64_t n) { return n > kMinParallelSum ? std::min(omp_get_max_threads(), kMaxSlices) : 1; }
 }  // namespace
 
 // LSD radix sort, 8 bits a pass, only as many passes as key_bits needs. A generic
@@ -46,7 +40,7 @@ void sort_by_key(uint32_t* keys, uint32_t* values, int64_t n, int key_bits, Work
     {
       const int t = omp_get_thread_num(), nt = omp_get_num_threads();
       int64_t lo, hi;
-      slice_of(n, t, nt, lo, hi);
+      thread_slice(n, t, nt, lo, hi);
       size_t* c = count + 256 * t;
       std::fill(c, c + 256, size_t(0));
       for (int64_t i = lo; i < hi; ++i) ++c[(k_src[i] >> shift) & 0xFFu];
@@ -84,7 +78,7 @@ uint32_t exclusive_scan(const uint32_t* in, uint32_t* out, int64_t n, Workspace&
   {
     const int t = omp_get_thread_num(), nt = omp_get_num_threads();
     int64_t lo, hi;
-    slice_of(n, t, nt, lo, hi);
+    thread_slice(n, t, nt, lo, hi);
     uint32_t sum = 0;
     for (int64_t i = lo; i < hi; ++i) sum += in[i];
     part[t + 1] = sum;

@@ -20,6 +20,7 @@
 
 #include "core/exec/dispatch.h"
 #include "core/exec/fault.h"
+#include "core/exec/parallel_for.h"
 #if defined(WB_WITH_CUDA)
 #include "core/exec/cuda_check.h"
 #include "core/exec/stream.h"
@@ -49,12 +50,13 @@ void in_slices(size_t bytes, F fn) {
     fn(size_t(0), bytes);
     return;
   }
+  const int64_t lines = int64_t((bytes + 63) / 64);  // whole cache lines a thread
 #pragma omp parallel
   {
-    const size_t n = size_t(omp_get_num_threads()), t = size_t(omp_get_thread_num());
-    const size_t per = ((bytes + n - 1) / n + 63) & ~size_t(63);  // whole cache lines
-    const size_t lo = std::min(bytes, t * per), hi = std::min(bytes, lo + per);
-    if (hi > lo) fn(lo, hi);
+    int64_t lo, hi;
+    thread_slice(lines, omp_get_thread_num(), omp_get_num_threads(), lo, hi);
+    const size_t a = size_t(lo) * 64, b = std::min(bytes, size_t(hi) * 64);
+    if (b > a) fn(a, b);
   }
 }
 /// Refuses an allocation the budget has no room for, before the system is asked.

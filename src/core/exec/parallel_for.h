@@ -25,6 +25,13 @@ inline constexpr int64_t kMinParallelHeavy = 4;
 /// parallel_sum_count: the CPU sums serially up to this many elements (as reduce_sum does).
 inline constexpr int64_t kMinParallelSum = 65536;
 
+/// Thread t's part of [0, n) of nt threads: contiguous, in thread order (the CPU's loops that
+/// split their work by hand: the sort's and the scan's passes, large copies and fills).
+inline void thread_slice(int64_t n, int t, int nt, int64_t& lo, int64_t& hi) {
+  lo = n * t / nt;
+  hi = n * (t + 1) / nt;
+}
+
 #if defined(__CUDACC__)
 namespace detail {
 template <typename F>

@@ -115,7 +115,7 @@ void sample_grid_query(SampleGridView g, ParticleView p, float max_range) {
   parallel_for_runs<kQueryLanes>(p.count, [=] WB_HD(int64_t k0, int lanes) {
     // Neighbours on a lattice of at most 2-cell cells (the default grid's): on a coarser grid
     // two of its cells would hold points too far apart to share much of their walk.
-    const float inv_h = 1.f / fminf(g.h, 2.f);
+    const float inv_h = 1.f / minf(g.h, 2.f);
     NearestSample found[kQueryLanes];
     int start = 0, b0[3] = {0, 0, 0}, b1[3] = {0, 0, 0};
     for (int j = 0; j <= lanes; ++j) {
