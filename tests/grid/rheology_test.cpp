@@ -265,14 +265,14 @@ TEST_F(RheologyTest, OilyPaintRunsDownAnUprightCanvasStiffPaintStays) {
 }
 
 namespace {
-/// A layer about a cell thick (0.2 mm) with grooves across x two cells apart (columns of 0.7 and
-/// 1.3 cells), left alone `seconds`. Returns the grooves' depth after over before (the mean
+/// A layer about a cell thick (0.2 mm) with grooves across x two cells apart (columns of 1 - a and
+/// 1 + a cells), left alone `seconds`. Returns the grooves' depth after over before (the mean
 /// difference between neighbouring columns) and the relative change of the paint's mass.
-std::pair<double, double> grooves_at_rest(const Device& device, float oil, float seconds) {
+std::pair<double, double> grooves_at_rest(const Device& device, float oil, float seconds, float a = 0.3f) {
   TileStore canvas(device, CanvasDims{64, 32, 16});
   GridParams p;
   Grid g(canvas, p, Int3{48, 16, 8}, Int3{0, 0, 0});
-  const auto column = [](int i) { return i % 2 ? 1.3f : 0.7f; };
+  const auto column = [a](int i) { return i % 2 ? 1.f + a : 1.f - a; };
   paint_cells(g, [&](int i, int, int k) { return k == 0 ? std::min(1.f, column(i)) : (k == 1 ? std::max(0.f, column(i) - 1.f) : 0.f); },
               oil);
   const GridDims d = g.dims();
@@ -292,20 +292,39 @@ std::pair<double, double> grooves_at_rest(const Device& device, float oil, float
   const auto [before, m0] = depth();
   for (int s = 0; s < int(std::lround(seconds / p.dt)); ++s) g.step(p.dt);
   const auto [after, m1] = depth();
-  std::printf("[ film ] oil %.2f: grooves 2 cells apart in a layer a cell thick keep %.1f %% of their depth after "
-              "%.0f s; mass %+.2g\n", oil, 100 * after / before, seconds, (m1 - m0) / m0);
+  std::printf("[ film ] oil %.2f: grooves 2 cells apart and %.2f cells deep in a layer a cell thick keep %.1f %% of "
+              "their depth after %.0f s; mass %+.2g\n", oil, 2 * a, 100 * after / before, seconds, (m1 - m0) / m0);
   return {after / before, (m1 - m0) / m0};
 }
 }  // namespace
 
 TEST_F(RheologyTest, ThinOilyPaintLevelsStiffPaintKeepsItsGrooves) {
   // Paint thinner than a cell has no pressure across a groove in the grid; as a film it levels
-  // where gravity's stress at its base passes the yield stress (oil 0.95: 0.15 Pa).
+  // where the stress at its base, from gravity and surface tension, passes the yield stress
+  // (oil 0.95: 0.15 Pa; oil 0.1: 135 Pa).
   const auto [oily, oily_mass] = grooves_at_rest(device_, 0.95f, 2.f);
   EXPECT_LE(oily, 0.5) << "oil-rich paint levels";
   EXPECT_LE(std::fabs(oily_mass), 1e-5);
+  // Grooves 0.4 cells deep (columns 0.8 and 1.2): the capillary stress at the film's depth the
+  // grid's shortest groove sees (kFilmCapillaryDepth), sigma 8 a / dx^2 x 0.45 dx = 119 Pa at
+  // 0.033 N/m, is below stiff paint's yield stress.
+  const auto [stiff, stiff_mass] = grooves_at_rest(device_, 0.1f, 10.f, 0.2f);
+  EXPECT_GE(stiff, 0.99) << "stiff paint keeps its grooves";
+  EXPECT_LE(std::fabs(stiff_mass), 1e-5);
+}
+
+TEST_F(RheologyTest, SurfaceTensionLevelsStiffPaintOnlyToItsYieldStress) {
+  // Grooves 0.6 cells deep (columns 0.7 and 1.3) pull the base with 178 Pa, more than stiff
+  // paint's 135 Pa: a Bingham film levels them until the capillary stress, in proportion to the
+  // depth, falls to the yield stress (Liu & Mei's plug), to 135 / 178 = 76 % of their depth, and
+  // holds them there.
   const auto [stiff, stiff_mass] = grooves_at_rest(device_, 0.1f, 10.f);
-  EXPECT_GE(stiff, 0.9) << "stiff paint keeps its grooves";
+  const GridParams p;
+  const HerschelBulkley hb =
+      rheology_at_oil(0.1f, HerschelBulkley{p.yield_stress_stiff, p.consistency_stiff, p.flow_index_stiff},
+                      HerschelBulkley{p.yield_stress_oily, p.consistency_oily, p.flow_index_oily});
+  const double a = 0.3, stress = double(p.surface_tension) * 8.0 * a / double(p.cell_size) * kFilmCapillaryDepth;
+  EXPECT_NEAR(stiff, hb.tau_y / stress, 0.03) << "levelled to the yield stress";
   EXPECT_LE(std::fabs(stiff_mass), 1e-5);
 }
 

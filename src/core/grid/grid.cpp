@@ -50,6 +50,7 @@ void check_params(const GridParams& p) {
   WB_REQUIRE(p.gravity >= 0.f && p.gravity <= 1e6f, "grid: gravity must be in [0, 1e6] cells/s^2");
   WB_REQUIRE(p.tilt >= 0.f && p.tilt <= 90.f, "grid: the canvas tilt must be in [0, 90] degrees");
   WB_REQUIRE(p.film_max >= 0.f && p.film_max <= 4.f, "grid: film_max must be in [0, 4] cells");
+  WB_REQUIRE(p.surface_tension >= 0.f && p.surface_tension <= 0.1f, "grid: surface_tension must be in [0, 0.1] N/m");
   WB_REQUIRE(p.liquid_threshold > 0.f && p.liquid_threshold <= 1.f, "grid: liquid_threshold must be in (0, 1]");
   WB_REQUIRE(p.dry_rate >= 0.f && p.dry_rate <= 1000.f, "grid: dry_rate must be in [0, 1000] /s");
   WB_REQUIRE(p.dry_threshold > 0.f && p.dry_threshold <= 1.f, "grid: dry_threshold must be in (0, 1]");
@@ -186,6 +187,17 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   for (auto& b : film_) {
     b.set_device(d);
     b.resize(size_t(kFilmFields) * size_t(g.nx) * size_t(g.ny));
+  }
+  {
+    FilmSolve& fs = film_solve_;
+    const size_t columns = size_t(g.nx) * size_t(g.ny);
+    for (auto* b : {&fs.flag, &fs.idx, &fs.list, &fs.go}) b->set_device(d);
+    for (auto* b : {&fs.cinv, &fs.diag, &fs.x, &fs.r, &fs.p, &fs.q, &fs.sums}) b->set_device(d);
+    fs.count.set_device(d), fs.lap.set_device(d);
+    for (auto* b : {&fs.flag, &fs.idx, &fs.list}) b->resize(2 * columns);
+    for (auto* b : {&fs.cinv, &fs.diag, &fs.x, &fs.r, &fs.p, &fs.q}) b->resize(2 * columns);
+    fs.lap.resize(columns);
+    fs.sums.resize(6), fs.go.resize(1), fs.count.resize(1);
   }
   for (auto* b : {&visc_flag_, &visc_idx_, &visc_list_}) {
     b->set_device(d);
@@ -537,14 +549,52 @@ void Grid::flow_film(float dt) {
   const float D = rho0 * g_si * h * h * h / (3.f * std::min(oily.K, stiff.K));
   const int substeps = std::max(1, int(std::ceil(dt * 4.f * D / (cell * cell))));
   const Vec3 gv = params_.gravity_vector();
-  FilmFlow f{stiff, oily, rho0 * -gv.z * cell, rho0 * gv.y * cell, cell, dt / float(substeps)};
+  const FilmFlow f{stiff, oily, rho0 * -gv.z * cell, rho0 * gv.y * cell, cell, dt / float(substeps),
+                   params_.surface_tension};
   // The columns are read from the cells once, flow in their own planes, and are written back once.
   grid_film_columns(device(), g, extent_.data(), window_.paint().view(), bristles_, particle_density_, flow_,
                     params_.dry_threshold, params_.film_max, f, film_[0].data());
   int cur = 0;
   for (int s = 0; s < substeps; ++s, cur = 1 - cur)
     grid_film_update(device(), g, film_[cur].data(), f, film_[1 - cur].data());
+  if (params_.surface_tension > 0.f) film_capillarity(dt, f, cur), cur = 1 - cur;
   grid_film_write(device(), g, window_.paint().view(), film_[cur].data());
+}
+
+void Grid::film_capillarity(float dt, const FilmFlow& f, int cur) {
+  const Device& d = device();
+  const GridDims g = dims();
+  FilmSolve& s = film_solve_;
+  const float* col = film_[cur].data();
+  const int64_t faces = 2 * int64_t(g.nx) * g.ny;
+  // The flowing faces, compacted as the viscous solve's: their count stays on the device.
+  grid_film_curvature(d, g, col, s.lap.data());
+  grid_film_capillary_flags(d, g, col, s.lap.data(), f, dt, s.flag.data());
+  exclusive_scan_into(d, s.flag.data(), s.idx.data(), faces, ws_);
+  grid_film_capillary_list(d, faces, s.flag.data(), s.idx.data(), s.list.data(), s.count.data());
+  const ListCount n{s.count.data(), faces};
+  grid_film_capillary_setup(d, g, col, s.lap.data(), s.list.data(), n, f, dt, s.cinv.data(), s.diag.data(),
+                            s.r.data(), s.x.data(), s.q.data());
+  // Jacobi CG to the viscous solve's tolerance and iteration bound, its loop on the device
+  // (apply_viscosity: the same passes, sums and test).
+  const double tol2 = double(params_.viscosity_tolerance) * double(params_.viscosity_tolerance);
+  const int max_it = std::max(1, params_.viscosity_max_iterations);
+  double* sums = s.sums.data();
+  const SumScratch sum{cg_partial_.data(), cg_ticket_.data()};
+  s.sums.fill_zero();
+  grid_pcg_start(d, n, s.r.data(), s.q.data(), s.diag.data(), s.p.data(), sums + 0, sums + 3, sum);
+  const CgGuard guard{sums + 0, sums + 3, tol2};
+  const uint64_t key = launch_key({launch_key_of(col), launch_key_of(s.x.data()), launch_key_of(sums),
+                                   uint64_t(faces), uint64_t(max_it), std::bit_cast<uint64_t>(tol2)});
+  s.loop.run(d, key, s.go.data(), [&] {
+    grid_film_capillary_apply(d, g, col, s.list.data(), n, s.flag.data(), s.idx.data(), s.cinv.data(), s.p.data(),
+                              s.q.data(), sums + 2, guard, sum);
+    grid_pcg_update(d, n, guard, sums + 2, s.p.data(), s.q.data(), s.diag.data(), s.x.data(), s.r.data(), sums + 1,
+                    sums + 4, sum);
+    grid_pcg_direction(d, n, guard, sums + 1, s.r.data(), s.diag.data(), s.p.data());
+    grid_pcg_continue(d, sums + 0, sums + 1, sums + 3, tol2, sums + 4, max_it, s.go.data());
+  });
+  grid_film_capillary_move(d, g, col, s.flag.data(), s.idx.data(), s.x.data(), f, film_[1 - cur].data());
 }
 
 void Grid::step(float dt, const std::function<void()>& after_advection) {

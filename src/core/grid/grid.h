@@ -229,6 +229,18 @@ class Grid {
   void advect_paint(float dt);
   PaintWindow paint_tmp_;
   DeviceBuffer<float> film_[2];  ///< flow_film's columns (FilmField planes), this sub-step's and the next
+  /// The film's surface tension solve (flow_film), over its 2 nx ny faces (the x faces, then the
+  /// y faces): each face's flag (it flows) and index, the flowing faces' list and count, L0 s of
+  /// the columns, and the CG's 1 / c, diagonal, vectors and sums (the viscous solve's layout).
+  struct FilmSolve {
+    DeviceBuffer<uint32_t> flag, idx, list, go;
+    DeviceBuffer<int64_t> count;
+    DeviceBuffer<float> lap;
+    DeviceBuffer<double> cinv, diag, x, r, p, q, sums;
+    LaunchLoop loop;
+  } film_solve_;
+  /// Surface tension's step of the film in film_[cur] into film_[1 - cur] (flow_film).
+  void film_capillarity(float dt, const FilmFlow& f, int cur);
   SolverScratch scratch_;
   Workspace ws_;
   GridStats stats_;
@@ -275,6 +287,25 @@ class Grid {
     (d, e, pw, br, particle_density, flow, dry_threshold, film_max, f, col))                                           \
   X(void, grid_film_update, (GridDims d, const float* col, FilmFlow f, float* next), (d, col, f, next))                \
   X(void, grid_film_write, (GridDims d, PaintWindowView pw, const float* col), (d, pw, col))                           \
+  X(void, grid_film_curvature, (GridDims d, const float* col, float* lap), (d, col, lap))                              \
+  X(void, grid_film_capillary_flags,                                                                                   \
+    (GridDims d, const float* col, const float* lap, FilmFlow f, float dt, uint32_t* flag),                           \
+    (d, col, lap, f, dt, flag))                                                                                        \
+  X(void, grid_film_capillary_list,                                                                                    \
+    (int64_t faces, const uint32_t* flag, const uint32_t* idx, uint32_t* list, int64_t* count),                       \
+    (faces, flag, idx, list, count))                                                                                   \
+  X(void, grid_film_capillary_setup,                                                                                   \
+    (GridDims d, const float* col, const float* lap, const uint32_t* list, ListCount cnt, FilmFlow f, float dt,       \
+     double* cinv, double* diag, double* r, double* x, double* q),                                                     \
+    (d, col, lap, list, cnt, f, dt, cinv, diag, r, x, q))                                                              \
+  X(void, grid_film_capillary_apply,                                                                                   \
+    (GridDims d, const float* col, const uint32_t* list, ListCount cnt, const uint32_t* flag, const uint32_t* idx,   \
+     const double* cinv, const double* p, double* q, double* pq, CgGuard guard, SumScratch s),                         \
+    (d, col, list, cnt, flag, idx, cinv, p, q, pq, guard, s))                                                          \
+  X(void, grid_film_capillary_move,                                                                                    \
+    (GridDims d, const float* col, const uint32_t* flag, const uint32_t* idx, const double* x, FilmFlow f,            \
+     float* next),                                                                                                     \
+    (d, col, flag, idx, x, f, next))                                                                                   \
   X(void, grid_gravity, (GridView g, float* ph, float g_dt, float g_dt_y), (g, ph, g_dt, g_dt_y))                      \
   X(void, grid_effective_viscosity,                                                                                    \
     (GridView g, JointOil oil, HerschelBulkley stiff, HerschelBulkley oily, float m, float* mu),                       \

@@ -104,14 +104,23 @@ struct HerschelBulkley {
 };
 
 /// What a thin film's flow needs (Grid::flow_film): the paint's end members, gravity across the
-/// canvas and down it (Pa per m of slope, Pa/m), the cell (m) and the sub-step (s).
+/// canvas and down it (Pa per m of slope, Pa/m), the cell (m), the sub-step (s) and the paint's
+/// surface tension (N/m).
 struct FilmFlow {
   HerschelBulkley stiff, oily;  ///< the paint's end members (Grid::paint_end_members)
   float rho_g_cos;  ///< rho0 g cos(tilt): the pressure gradient per unit slope of the surface, Pa/m
   float rho_g_sin;  ///< rho0 g sin(tilt): the pull down the canvas (+y), Pa/m
   float cell;       ///< m
   float dt;         ///< s
+  float sigma;      ///< N/m
 };
+
+/// The depth (cells) of a film that a groove the grid holds sees: a capillary wave of wavenumber k
+/// on a film deeper than 1/k shears only the top 1/k or so (creeping flow over a floor: the
+/// levelling rate tends to sigma k / (2 mu) for kh >> 1, where lubrication's sigma k^4 h^3 / (3 mu)
+/// keeps growing), and the lubrication film matches that rate and the stress at its base with
+/// the depth 1.14 / k. The bristles' streaks are 2-3 cells apart (k = 2 pi / 2.5 cells): 0.45 cells.
+inline constexpr float kFilmCapillaryDepth = 0.45f;
 
 /// Per film column in Grid::flow_film's scratch: the film's thickness (cells; negative where the
 /// column is no film), the top of what it lies on (cells), the first layer above that, its

@@ -648,43 +648,249 @@ WB_HD WB_INLINE float film_face(const float* col, int64_t n, int64_t a, int64_t 
   return G > 0.f ? -t : t;
 }
 
+namespace detail {
+/// Column c of the film after the signed inflows in[s] through its four faces (from[s] the column
+/// across each): what stays, then each inflow with its column's paint (Algorithm 2 by mass; oil
+/// and dryness by mass). A column that is no film keeps only what its neighbours and the write
+/// read of it. Both columns of a face compute its transfer from the same values, bit for bit, so
+/// what one gains the other loses.
+WB_HD WB_INLINE void film_column_after(const float* col, int64_t n, int64_t c, const float (&in)[4],
+                                       const int64_t (&from)[4], const FilmFlow& f, float* next) {
+  const float h = col[kFilmH * n + c];
+  next[kFilmH * n + c] = h, next[kFilmMoved * n + c] = col[kFilmMoved * n + c];
+  if (h < 0.f) return;
+  for (int p = 0; p < kFilmFields; ++p)
+    if (p != kFilmH && p != kFilmMoved) next[p * n + c] = col[p * n + c];
+  float out = 0.f, gain = 0.f;
+  for (int s = 0; s < 4; ++s) out += in[s] < 0.f ? -in[s] : 0.f, gain += in[s] > 0.f ? in[s] : 0.f;
+  if (out == 0.f && gain == 0.f) return;
+  float m = h - out;
+  Vec3 p(col[kFilmR * n + c], col[kFilmY * n + c], col[kFilmB * n + c]);
+  float oil = m * col[kFilmOil * n + c], dry = m * col[kFilmDry * n + c];
+  for (int s = 0; s < 4; ++s) {
+    if (!(in[s] > 0.f)) continue;
+    const int64_t o = from[s];
+    p = color_mix(p, Vec3(col[kFilmR * n + o], col[kFilmY * n + o], col[kFilmB * n + o]), m, in[s]);
+    oil += in[s] * col[kFilmOil * n + o], dry += in[s] * col[kFilmDry * n + o];
+    m += in[s];
+  }
+  next[kFilmH * n + c] = m;
+  next[kFilmR * n + c] = p.x, next[kFilmY * n + c] = p.y, next[kFilmB * n + c] = p.z;
+  next[kFilmOil * n + c] = m > 0.f ? oil / m : 0.f, next[kFilmDry * n + c] = m > 0.f ? dry / m : 0.f;
+  film_rheology(next, n, c, f);
+  next[kFilmMoved * n + c] = col[kFilmMoved * n + c] + out + gain;
+}
+}  // namespace detail
+
 void grid_film_update(GridDims d, const float* col, FilmFlow f, float* next) {
   const int64_t n = int64_t(d.nx) * d.ny;
   parallel_for(n, [=] WB_HD(int64_t c) {
-    // A column that is no film keeps only what its neighbours and the write read of it.
-    const float h = col[kFilmH * n + c];
-    next[kFilmH * n + c] = h, next[kFilmMoved * n + c] = col[kFilmMoved * n + c];
-    if (h < 0.f) return;
-    for (int p = 0; p < kFilmFields; ++p)
-      if (p != kFilmH && p != kFilmMoved) next[p * n + c] = col[p * n + c];
     const int i = int(c % d.nx), j = int(c / d.nx);
-    // Signed inflow through each face and the column it comes from. Both columns of a face
-    // compute its transfer from the same values, bit for bit, so what one gains the other loses;
-    // the window's own edges carry nothing.
+    // Signed inflow through each face and the column it comes from; the window's own edges
+    // carry nothing.
     const int64_t from[4] = {c - 1, c + 1, c - d.nx, c + d.nx};
-    const float in[4] = {i > 0 ? film_face(col, n, from[0], c, 0.f, f) : 0.f,
-                         i + 1 < d.nx ? -film_face(col, n, c, from[1], 0.f, f) : 0.f,
-                         j > 0 ? film_face(col, n, from[2], c, f.rho_g_sin, f) : 0.f,
-                         j + 1 < d.ny ? -film_face(col, n, c, from[3], f.rho_g_sin, f) : 0.f};
-    float out = 0.f, gain = 0.f;
-    for (int s = 0; s < 4; ++s) out += in[s] < 0.f ? -in[s] : 0.f, gain += in[s] > 0.f ? in[s] : 0.f;
-    if (out == 0.f && gain == 0.f) return;
-    // What stays, then each inflow with its column's paint (Algorithm 2 by mass; oil and dryness by mass).
-    float m = h - out;
-    Vec3 p(col[kFilmR * n + c], col[kFilmY * n + c], col[kFilmB * n + c]);
-    float oil = m * col[kFilmOil * n + c], dry = m * col[kFilmDry * n + c];
-    for (int s = 0; s < 4; ++s) {
-      if (!(in[s] > 0.f)) continue;
-      const int64_t o = from[s];
-      p = color_mix(p, Vec3(col[kFilmR * n + o], col[kFilmY * n + o], col[kFilmB * n + o]), m, in[s]);
-      oil += in[s] * col[kFilmOil * n + o], dry += in[s] * col[kFilmDry * n + o];
-      m += in[s];
+    float in[4] = {0.f, 0.f, 0.f, 0.f};
+    if (col[kFilmH * n + c] >= 0.f) {
+      in[0] = i > 0 ? film_face(col, n, from[0], c, 0.f, f) : 0.f;
+      in[1] = i + 1 < d.nx ? -film_face(col, n, c, from[1], 0.f, f) : 0.f;
+      in[2] = j > 0 ? film_face(col, n, from[2], c, f.rho_g_sin, f) : 0.f;
+      in[3] = j + 1 < d.ny ? -film_face(col, n, c, from[3], f.rho_g_sin, f) : 0.f;
     }
-    next[kFilmH * n + c] = m;
-    next[kFilmR * n + c] = p.x, next[kFilmY * n + c] = p.y, next[kFilmB * n + c] = p.z;
-    next[kFilmOil * n + c] = m > 0.f ? oil / m : 0.f, next[kFilmDry * n + c] = m > 0.f ? dry / m : 0.f;
-    film_rheology(next, n, c, f);
-    next[kFilmMoved * n + c] = col[kFilmMoved * n + c] + out + gain;
+    detail::film_column_after(col, n, c, in, from, f, next);
+  });
+}
+
+namespace detail {
+/// On the CPU backend the device's sums are the host's memory: an iteration launched past
+/// convergence returns before its pass (on CUDA its threads return at once).
+inline bool cpu_past_convergence(const CgGuard& guard) {
+#if defined(__CUDACC__)
+  (void)guard;
+  return false;
+#else
+  return !guard.active();
+#endif
+}
+}  // namespace detail
+
+// --- surface tension of thin films (docs/GRID.md "Surface tension") --------------------------
+// The film's faces are numbered f < n for the x face between columns c = f and c + 1, and
+// n + c for the y face between c and c + nx. The capillary pressure under the surface s = base +
+// h is sigma kappa, kappa = -lap(s) (small slopes); the flux across a face is q = -M dp/ds, M
+// the Bingham film's mobility. Explicitly the step would need sub-steps of dx^4 / (16 sigma M):
+// thousands a frame for oily paint. So the faces' fluxes F (cells of thickness over the step)
+// are solved implicitly: F = -c G L0 (s + G^T F), c = dt sigma M / dx^4, G the faces' difference
+// of two columns, L0 the film's graph Laplacian; that is
+//   (1/c + G L0 G^T) F = -G L0 s,
+// symmetric positive definite in the flowing faces' fluxes, by the viscous solve's Jacobi CG.
+
+namespace detail {
+/// A film column that holds paint. A paint's edge on the bare ground stays where it was laid (a
+/// pinned contact line, as in drying coatings): surface tension acts on the paint's surface only,
+/// across faces between two such columns.
+WB_HD WB_INLINE bool film_wet(const float* col, int64_t n, int64_t c) { return col[kFilmH * n + c] > 0.f; }
+WB_HD WB_INLINE float film_surface(const float* col, int64_t n, int64_t c) {
+  return col[kFilmBase * n + c] + col[kFilmH * n + c];
+}
+
+/// The columns a and b of film face f; false where the face is the window's edge.
+WB_HD WB_INLINE bool film_face_columns(const GridDims& d, int64_t n, int64_t f, int64_t& a, int64_t& b) {
+  const bool y = f >= n;
+  a = y ? f - n : f;
+  if (y) {
+    b = a + d.nx;
+    return a / d.nx + 1 < d.ny;
+  }
+  b = a + 1;
+  return a % d.nx + 1 < d.nx;
+}
+
+/// L0 v at wet film column c: the sum over its wet film neighbours of v(c) - v(neighbour) (none
+/// across the paint's edge or out of the window: the surface's curvature stops there).
+template <class V>
+WB_HD WB_INLINE auto film_laplacian(const GridDims& d, const float* col, int64_t n, int64_t c, V v) {
+  const int i = int(c % d.nx), j = int(c / d.nx);
+  const auto vc = v(c);
+  auto sum = vc - vc;
+  if (i > 0 && film_wet(col, n, c - 1)) sum += vc - v(c - 1);
+  if (i + 1 < d.nx && film_wet(col, n, c + 1)) sum += vc - v(c + 1);
+  if (j > 0 && film_wet(col, n, c - d.nx)) sum += vc - v(c - d.nx);
+  if (j + 1 < d.ny && film_wet(col, n, c + d.nx)) sum += vc - v(c + d.nx);
+  return sum;
+}
+
+/// 1 / c of film face f between a and b, c = dt sigma M / dx^4, or 0 where the face does not flow:
+/// the total driving gradient G (gravity's as film_face, and the capillary dp/ds from lap = L0 s)
+/// against the upwind column's yield stress at the depth the groove sees (Bingham, Liu & Mei), M
+/// the plug's mobility Y^2 (3h - Y) / (6 K), taken from the step's start.
+WB_HD WB_INLINE double film_capillary_inverse(const float* col, int64_t n, const float* lap, int64_t a, int64_t b,
+                                             float pull, const FilmFlow& f, float dt) {
+  const float slope = film_surface(col, n, b) - film_surface(col, n, a);
+  const float G = f.rho_g_cos * slope - pull + f.sigma * (lap[b] - lap[a]) / (f.cell * f.cell);
+  const int64_t u = G > 0.f ? b : a;
+  const float Gm = fabsf(G), h = minf(col[kFilmH * n + u], kFilmCapillaryDepth) * f.cell;
+  const float tau_y = col[kFilmTau * n + u];
+  if (!(Gm * h > tau_y)) return 0.0;
+  const double Y = double(h) - double(tau_y) / double(Gm);
+  const double M = Y * Y * (3.0 * double(h) - Y) / (6.0 * double(col[kFilmK * n + u]));
+  const double cell2 = double(f.cell) * double(f.cell);
+  const double c = double(dt) * double(f.sigma) * M / (cell2 * cell2);
+  return c > 0.0 ? 1.0 / c : 0.0;
+}
+
+/// The flux of film face f in the CG's vector v (0 where the face does not flow).
+WB_HD WB_INLINE double film_face_value(const uint32_t* flag, const uint32_t* idx, const double* v, int64_t f) {
+  return flag[f] ? v[idx[f]] : 0.0;
+}
+
+/// (G^T v) at column c: what the flowing faces' fluxes v bring into it.
+WB_HD WB_INLINE double film_inflow(const GridDims& d, int64_t n, const uint32_t* flag, const uint32_t* idx,
+                                   const double* v, int64_t c) {
+  const int i = int(c % d.nx), j = int(c / d.nx);
+  double in = -film_face_value(flag, idx, v, c) - film_face_value(flag, idx, v, n + c);
+  if (i > 0) in += film_face_value(flag, idx, v, c - 1);
+  if (j > 0) in += film_face_value(flag, idx, v, n + c - d.nx);
+  return in;
+}
+}  // namespace detail
+
+/// lap = L0 s at the film's wet columns (cells), 0 elsewhere.
+void grid_film_curvature(GridDims d, const float* col, float* lap) {
+  const int64_t n = int64_t(d.nx) * d.ny;
+  parallel_for(n, [=] WB_HD(int64_t c) {
+    lap[c] = detail::film_wet(col, n, c)
+                 ? detail::film_laplacian(d, col, n, c, [=](int64_t o) { return detail::film_surface(col, n, o); })
+                 : 0.f;
+  });
+}
+
+/// 1 at each film face that flows this step (film_capillary_inverse), 0 elsewhere.
+void grid_film_capillary_flags(GridDims d, const float* col, const float* lap, FilmFlow f, float dt, uint32_t* flag) {
+  const int64_t n = int64_t(d.nx) * d.ny;
+  parallel_for(2 * n, [=] WB_HD(int64_t e) {
+    int64_t a, b;
+    flag[e] = detail::film_face_columns(d, n, e, a, b) && detail::film_wet(col, n, a) &&
+                      detail::film_wet(col, n, b) &&
+                      detail::film_capillary_inverse(col, n, lap, a, b, e >= n ? f.rho_g_sin : 0.f, f, dt) > 0.0
+                  ? 1u
+                  : 0u;
+  });
+}
+
+/// The flowing faces' list (list[idx[f]] = f) and their count (the scan's last entry plus its flag).
+void grid_film_capillary_list(int64_t faces, const uint32_t* flag, const uint32_t* idx, uint32_t* list,
+                              int64_t* count) {
+  parallel_for(faces, [=] WB_HD(int64_t e) {
+    if (flag[e]) list[idx[e]] = uint32_t(e);
+  });
+  parallel_for(1, [=] WB_HD(int64_t) { *count = int64_t(idx[faces - 1]) + (flag[faces - 1] ? 1 : 0); });
+}
+
+/// Each flowing face's 1 / c, the Jacobi diagonal 1 / c + (G L0 G^T)_ff, the right-hand side
+/// b = -G L0 s in r, the first guess x = 0 and A x = 0 in q.
+void grid_film_capillary_setup(GridDims d, const float* col, const float* lap, const uint32_t* list, ListCount cnt,
+                               FilmFlow f, float dt, double* cinv, double* diag, double* r, double* x, double* q) {
+  const int64_t n = int64_t(d.nx) * d.ny;
+  parallel_for_count(cnt.n, cnt.capacity, [=] WB_HD(int64_t e) {
+    const int64_t face = list[e];
+    int64_t a, b;
+    detail::film_face_columns(d, n, face, a, b);
+    // (G^T e_f)^T L0 (G^T e_f) = deg a + deg b + 2: a and b are film neighbours.
+    const auto degree = [=](int64_t c) {
+      return detail::film_laplacian(d, col, n, c, [=](int64_t o) { return o == c ? 1.f : 0.f; });
+    };
+    cinv[e] = detail::film_capillary_inverse(col, n, lap, a, b, face >= n ? f.rho_g_sin : 0.f, f, dt);
+    diag[e] = cinv[e] + double(degree(a)) + double(degree(b)) + 2.0;
+    r[e] = double(lap[a]) - double(lap[b]);
+    x[e] = 0.0, q[e] = 0.0;
+  });
+}
+
+/// q = A p = p / c + G L0 G^T p over the flowing faces, and p.q.
+void grid_film_capillary_apply(GridDims d, const float* col, const uint32_t* list, ListCount cnt,
+                               const uint32_t* flag, const uint32_t* idx, const double* cinv, const double* p,
+                               double* q, double* pq, CgGuard guard, SumScratch s) {
+  if (detail::cpu_past_convergence(guard)) return;  // p.Ap is not read past convergence
+  const int64_t n = int64_t(d.nx) * d.ny;
+  parallel_sum_count(
+      cnt.n, cnt.capacity,
+      [=] WB_HD(int64_t e) {
+        if (!guard.active()) return 0.0;
+        const int64_t face = list[e];
+        int64_t a, b;
+        detail::film_face_columns(d, n, face, a, b);
+        const auto inflow = [=](int64_t c) { return detail::film_inflow(d, n, flag, idx, p, c); };
+        const double w_a = detail::film_laplacian(d, col, n, a, inflow);
+        const double w_b = detail::film_laplacian(d, col, n, b, inflow);
+        q[e] = cinv[e] * p[e] + (w_b - w_a);
+        return p[e] * q[e];
+      },
+      pq, s);
+}
+
+/// The film after the solved fluxes x: each face carries its flux from the upwind column, at most
+/// a quarter of that column's film (it has four faces), as the gravity's sub-steps do.
+void grid_film_capillary_move(GridDims d, const float* col, const uint32_t* flag, const uint32_t* idx,
+                              const double* x, FilmFlow f, float* next) {
+  const int64_t n = int64_t(d.nx) * d.ny;
+  parallel_for(n, [=] WB_HD(int64_t c) {
+    const int i = int(c % d.nx), j = int(c / d.nx);
+    const int64_t from[4] = {c - 1, c + 1, c - d.nx, c + d.nx};
+    // The face's flux, a -> b where positive, bounded by the upwind film.
+    const auto carried = [=](int64_t face, int64_t a, int64_t b) {
+      if (!flag[face]) return 0.f;  // a face that does not flow, or one beside no film
+      const double F = x[idx[face]];
+      const float t = float(F > 0.0 ? F : -F), m = minf(t, 0.25f * col[kFilmH * n + (F > 0.0 ? a : b)]);
+      return F > 0.0 ? m : -m;
+    };
+    float in[4] = {0.f, 0.f, 0.f, 0.f};
+    if (detail::film_wet(col, n, c)) {
+      in[0] = i > 0 ? carried(c - 1, c - 1, c) : 0.f;
+      in[1] = i + 1 < d.nx ? -carried(c, c, c + 1) : 0.f;
+      in[2] = j > 0 ? carried(n + c - d.nx, c - d.nx, c) : 0.f;
+      in[3] = j + 1 < d.ny ? -carried(n + c, c, c + d.nx) : 0.f;
+    }
+    detail::film_column_after(col, n, c, in, from, f, next);
   });
 }
 
@@ -780,18 +986,6 @@ void grid_viscous_setup(GridView g, const uint32_t* list, ListCount n, const uin
   });
 }
 
-namespace detail {
-/// On the CPU backend the device's sums are the host's memory: an iteration launched past
-/// convergence returns before its pass (on CUDA its threads return at once).
-inline bool cpu_past_convergence(const CgGuard& guard) {
-#if defined(__CUDACC__)
-  (void)guard;
-  return false;
-#else
-  return !guard.active();
-#endif
-}
-}  // namespace detail
 
 void grid_viscous_apply(ListCount n, const float* nu, const int32_t* nb, const double* diag, const double* p,
                         double* q, double* pq, CgGuard guard, SumScratch s) {

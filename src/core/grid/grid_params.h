@@ -87,6 +87,11 @@ struct GridParams {
   /// it has no pressure across it. Default 2 (0.4 mm), range [0, 4] (its explicit sub-steps grow as
   /// the cube: 7 a 1/60 s step at 2 cells, 56 at 4); 0 turns the film off.
   float film_max = 2.f;
+  /// Surface tension of the paint's surface, N/m: it levels a thin film's grooves where its
+  /// capillary stress passes the paint's yield stress (docs/GRID.md "Surface tension"). Default
+  /// 0.033 (linseed oil and other vegetable oils, 0.031-0.035 N/m at 20-25 C; the binder forms
+  /// the paint's surface), range [0, 0.1]; 0 turns it off.
+  float surface_tension = 0.033f;
   /// Gravity in the canvas frame, cells/s^2: (0, g sin(tilt), -g cos(tilt)).
   Vec3 gravity_vector() const {
     const float a = tilt * (3.14159265f / 180.f);

@@ -83,6 +83,8 @@ std::vector<ParamInfo> build_table() {
       WB_PARAM(grid.gravity, "Gravity", "cells/s^2", "Eq. 2", 0, 1e6, "Gravity on the grid paint (down)"),
       WB_PARAM(grid.film_max, "Thin film", "cells", "", 0, 4,
                "Wet paint at most this thick, away from the bristles, flows as a film under gravity (0: off)"),
+      WB_PARAM(grid.surface_tension, "Surface tension", "N/m", "", 0, 0.1,
+               "Levels a thin film's grooves where its stress passes the yield stress (linseed oil: 0.033; 0: off)"),
       WB_PARAM(grid.tilt, "Canvas tilt", "degrees", "", 0, 90,
                "0: flat on a table; 90: upright on an easel (gravity pulls the paint down the canvas, +y)"),
       WB_PARAM(grid.liquid_threshold, "Liquid threshold", "", "§4.2", 0.01, 1,
