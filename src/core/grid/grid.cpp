@@ -554,6 +554,11 @@ void Grid::flow_film(float dt) {
   // The columns are read from the cells once, flow in their own planes, and are written back once.
   grid_film_columns(device(), g, extent_.data(), window_.paint().view(), bristles_, particle_density_, flow_,
                     params_.dry_threshold, params_.film_max, f, film_[0].data());
+  // What the film lies on is the same in both planes: the sub-steps do not copy it.
+  const size_t columns = size_t(g.nx) * size_t(g.ny);
+  static_assert(kFilmAbove == kFilmBase + 1, "the base and the first layer over it are adjacent planes");
+  mem::copy_on_device(device(), film_[1].data() + kFilmBase * columns, film_[0].data() + kFilmBase * columns,
+                      2 * columns * sizeof(float));
   int cur = 0;
   for (int s = 0; s < substeps; ++s, cur = 1 - cur)
     grid_film_update(device(), g, film_[cur].data(), f, film_[1 - cur].data());

@@ -651,26 +651,32 @@ WB_HD WB_INLINE float film_face(const float* col, int64_t n, int64_t a, int64_t 
 namespace detail {
 /// Column c of the film after the signed inflows in[s] through its four faces (from[s] the column
 /// across each): what stays, then each inflow with its column's paint (Algorithm 2 by mass; oil
-/// and dryness by mass). A column that is no film keeps only what its neighbours and the write
-/// read of it. Both columns of a face compute its transfer from the same values, bit for bit, so
-/// what one gains the other loses.
+/// and dryness by mass). Both columns of a face compute its transfer from the same values, bit for
+/// bit, so what one gains the other loses. The base and the first layer over it are the same in
+/// both sub-steps' planes (Grid::flow_film) and are not copied; a column that is no film, or a
+/// bare one that nothing reached, passes on only its thickness and what crossed it (its paint's
+/// fields are read only where it holds paint).
 WB_HD WB_INLINE void film_column_after(const float* col, int64_t n, int64_t c, const float (&in)[4],
                                        const int64_t (&from)[4], const FilmFlow& f, float* next) {
   const float h = col[kFilmH * n + c];
   next[kFilmH * n + c] = h, next[kFilmMoved * n + c] = col[kFilmMoved * n + c];
   if (h < 0.f) return;
-  for (int p = 0; p < kFilmFields; ++p)
-    if (p != kFilmH && p != kFilmMoved) next[p * n + c] = col[p * n + c];
   float out = 0.f, gain = 0.f;
   for (int s = 0; s < 4; ++s) out += in[s] < 0.f ? -in[s] : 0.f, gain += in[s] > 0.f ? in[s] : 0.f;
-  if (out == 0.f && gain == 0.f) return;
+  if (out == 0.f && gain == 0.f) {
+    if (h > 0.f)
+      for (const int p : {kFilmOil, kFilmR, kFilmY, kFilmB, kFilmDry, kFilmTau, kFilmK}) next[p * n + c] = col[p * n + c];
+    return;
+  }
+  // What stays (none of a bare column's fields), then each inflow.
   float m = h - out;
-  Vec3 p(col[kFilmR * n + c], col[kFilmY * n + c], col[kFilmB * n + c]);
-  float oil = m * col[kFilmOil * n + c], dry = m * col[kFilmDry * n + c];
+  const bool kept = m > 0.f;
+  Vec3 p = kept ? Vec3(col[kFilmR * n + c], col[kFilmY * n + c], col[kFilmB * n + c]) : Vec3(0.f, 0.f, 0.f);
+  float oil = kept ? m * col[kFilmOil * n + c] : 0.f, dry = kept ? m * col[kFilmDry * n + c] : 0.f;
   for (int s = 0; s < 4; ++s) {
     if (!(in[s] > 0.f)) continue;
     const int64_t o = from[s];
-    p = color_mix(p, Vec3(col[kFilmR * n + o], col[kFilmY * n + o], col[kFilmB * n + o]), m, in[s]);
+    p = color_mix(p, Vec3(col[kFilmR * n + o], col[kFilmY * n + o], col[kFilmB * n + o]), maxf(m, 0.f), in[s]);
     oil += in[s] * col[kFilmOil * n + o], dry += in[s] * col[kFilmDry * n + o];
     m += in[s];
   }
