@@ -191,7 +191,8 @@ Grid::Grid(TileStore& canvas, const GridParams& params, Int3 dims, Int3 origin)
   {
     FilmSolve& fs = film_solve_;
     const size_t columns = size_t(g.nx) * size_t(g.ny);
-    for (auto* b : {&fs.flag, &fs.idx, &fs.list, &fs.go}) b->set_device(d);
+    for (auto* b : {&fs.flag, &fs.idx, &fs.list, &fs.go, &fs.flowed, &fs.pairs_done, &fs.steps_go}) b->set_device(d);
+    for (auto* b : {&fs.flowed, &fs.pairs_done, &fs.steps_go}) b->resize(1);
     for (auto* b : {&fs.cinv, &fs.diag, &fs.x, &fs.r, &fs.p, &fs.q, &fs.sums}) b->set_device(d);
     fs.count.set_device(d), fs.lap.set_device(d);
     for (auto* b : {&fs.flag, &fs.idx, &fs.list}) b->resize(2 * columns);
@@ -547,9 +548,10 @@ void Grid::flow_film(float dt) {
   const float h = params_.film_max * cell;
   const auto [stiff, oily] = paint_end_members(params_);
   const float D = rho0 * g_si * h * h * h / (3.f * std::min(oily.K, stiff.K));
-  const int substeps = std::max(1, int(std::ceil(dt * 4.f * D / (cell * cell))));
+  // In pairs, so that each pair ends in the plane it began in (the device's loop, below).
+  const int pairs = std::max(1, int(std::ceil(dt * 2.f * D / (cell * cell))));
   const Vec3 gv = params_.gravity_vector();
-  const FilmFlow f{stiff, oily, rho0 * -gv.z * cell, rho0 * gv.y * cell, cell, dt / float(substeps),
+  const FilmFlow f{stiff, oily, rho0 * -gv.z * cell, rho0 * gv.y * cell, cell, dt / float(2 * pairs),
                    params_.surface_tension};
   // The columns are read from the cells once, flow in their own planes, and are written back once.
   grid_film_columns(device(), g, extent_.data(), window_.paint().view(), bristles_, particle_density_, flow_,
@@ -559,9 +561,22 @@ void Grid::flow_film(float dt) {
   static_assert(kFilmAbove == kFilmBase + 1, "the base and the first layer over it are adjacent planes");
   mem::copy_on_device(device(), film_[1].data() + kFilmBase * columns, film_[0].data() + kFilmBase * columns,
                       2 * columns * sizeof(float));
+  // The sub-steps' pairs run until one moves nothing (the film then stays as it is: stiff paint,
+  // or runny paint come to rest) or all are made; the device decides, the host does not wait.
+  FilmSolve& fs = film_solve_;
+  fs.flowed.fill_zero();
+  fs.pairs_done.fill_zero();
+  const uint64_t key = launch_key(
+      {launch_key_of(film_[0].data()), launch_key_of(film_[1].data()), launch_key_of(fs.flowed.data()),
+       uint64_t(pairs), uint64_t(columns), launch_key_of(f.stiff.tau_y), launch_key_of(f.stiff.K),
+       launch_key_of(f.stiff.n), launch_key_of(f.oily.tau_y), launch_key_of(f.oily.K), launch_key_of(f.oily.n),
+       launch_key_of(f.rho_g_cos), launch_key_of(f.rho_g_sin), launch_key_of(f.cell), launch_key_of(f.dt)});
+  fs.steps.run(device(), key, fs.steps_go.data(), [&] {
+    grid_film_update(device(), g, film_[0].data(), f, film_[1].data(), fs.flowed.data());
+    grid_film_update(device(), g, film_[1].data(), f, film_[0].data(), fs.flowed.data());
+    grid_film_continue(device(), fs.flowed.data(), fs.pairs_done.data(), pairs, fs.steps_go.data());
+  });
   int cur = 0;
-  for (int s = 0; s < substeps; ++s, cur = 1 - cur)
-    grid_film_update(device(), g, film_[cur].data(), f, film_[1 - cur].data());
   if (params_.surface_tension > 0.f) film_capillarity(dt, f, cur), cur = 1 - cur;
   grid_film_write(device(), g, window_.paint().view(), film_[cur].data());
 }

@@ -220,7 +220,8 @@ class Grid {
   }
   /// The layers holding paint or particles now, or liquid before the advection: extent_.
   void find_extent();
-  /// Thin films (GridParams::film_max): their lubrication flow over dt, in explicit sub-steps.
+  /// Thin films (GridParams::film_max): their lubrication flow over dt, in explicit sub-steps
+  /// (pairs of them, run by the device until a pair moves nothing), then surface tension's step.
   void flow_film(float dt);
   /// The maxima of grid_column_tops (wet paint and particles above `trace`) into advect_max_'s six
   /// slots from `slot`: the paint's top, the joint top, then x, -x, y, -y of the joint columns.
@@ -233,6 +234,9 @@ class Grid {
   /// y faces): each face's flag (it flows) and index, the flowing faces' list and count, L0 s of
   /// the columns, and the CG's 1 / c, diagonal, vectors and sums (the viscous solve's layout).
   struct FilmSolve {
+    /// The gravity sub-steps' loop: paint crossed a face in this pair, the pairs made, another pair.
+    DeviceBuffer<uint32_t> flowed, pairs_done, steps_go;
+    LaunchLoop steps;
     DeviceBuffer<uint32_t> flag, idx, list, go;
     DeviceBuffer<int64_t> count;
     DeviceBuffer<float> lap;
@@ -285,7 +289,10 @@ class Grid {
     (GridDims d, const GridExtent* e, PaintWindowView pw, BristleField br, const float* particle_density,              \
      FlowColumns flow, float dry_threshold, float film_max, FilmFlow f, float* col),                                   \
     (d, e, pw, br, particle_density, flow, dry_threshold, film_max, f, col))                                           \
-  X(void, grid_film_update, (GridDims d, const float* col, FilmFlow f, float* next), (d, col, f, next))                \
+  X(void, grid_film_update, (GridDims d, const float* col, FilmFlow f, float* next, uint32_t* flowed),                 \
+    (d, col, f, next, flowed))                                                                                         \
+  X(void, grid_film_continue, (uint32_t * flowed, uint32_t* pairs_done, int pairs, uint32_t* go),                      \
+    (flowed, pairs_done, pairs, go))                                                                                   \
   X(void, grid_film_write, (GridDims d, PaintWindowView pw, const float* col), (d, pw, col))                           \
   X(void, grid_film_curvature, (GridDims d, const float* col, float* lap), (d, col, lap))                              \
   X(void, grid_film_capillary_flags,                                                                                   \

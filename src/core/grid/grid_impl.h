@@ -688,7 +688,7 @@ WB_HD WB_INLINE void film_column_after(const float* col, int64_t n, int64_t c, c
 }
 }  // namespace detail
 
-void grid_film_update(GridDims d, const float* col, FilmFlow f, float* next) {
+void grid_film_update(GridDims d, const float* col, FilmFlow f, float* next, uint32_t* flowed) {
   const int64_t n = int64_t(d.nx) * d.ny;
   parallel_for(n, [=] WB_HD(int64_t c) {
     const int i = int(c % d.nx), j = int(c / d.nx);
@@ -701,8 +701,20 @@ void grid_film_update(GridDims d, const float* col, FilmFlow f, float* next) {
       in[1] = i + 1 < d.nx ? -film_face(col, n, c, from[1], 0.f, f) : 0.f;
       in[2] = j > 0 ? film_face(col, n, from[2], c, f.rho_g_sin, f) : 0.f;
       in[3] = j + 1 < d.ny ? -film_face(col, n, c, from[3], f.rho_g_sin, f) : 0.f;
+      if (in[0] != 0.f || in[1] != 0.f || in[2] != 0.f || in[3] != 0.f) *flowed = 1u;  // all write 1
     }
     detail::film_column_after(col, n, c, in, from, f, next);
+  });
+}
+
+/// After a pair of the film's sub-steps: another pair while paint crossed a face in this one and
+/// pairs are left (a pair in which nothing moved leaves the film as it was, and so would every
+/// later one); the flag is cleared for the next.
+void grid_film_continue(uint32_t* flowed, uint32_t* pairs_done, int pairs, uint32_t* go) {
+  parallel_for(1, [=] WB_HD(int64_t) {
+    *pairs_done += 1u;
+    *go = *flowed != 0u && *pairs_done < uint32_t(pairs) ? 1u : 0u;
+    *flowed = 0u;
   });
 }
 
