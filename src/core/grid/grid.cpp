@@ -454,23 +454,34 @@ void Grid::apply_viscosity(float dt) {
   // iteration writes again), then b.D^-1 b, r = b - A x, p = D^-1 r and r.z.
   grid_viscous_apply(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_x_.data(), cg_q_.data(), sums + 2, {},
                      sum);
-  grid_pcg_start(d, n, cg_r_.data(), cg_q_.data(), cg_diag_.data(), cg_p_.data(), sums + 0, sums + 3, sum);
-  // An iteration: p.Ap, the update (r.z into slot 1), the direction, and the test, which moves
-  // r.z to slot 0 and sets the loop's flag. Every pass also tests (CgGuard), so that a solve that
-  // starts converged moves nothing in its one pass.
-  const CgGuard guard{sums + 0, sums + 3, tol2};
   const uint64_t key = launch_key({launch_key_of(cg_x_.data()), launch_key_of(cg_nb_.data()),
                                    launch_key_of(cg_nu_.data()), launch_key_of(sums), uint64_t(all), uint64_t(max_it),
                                    std::bit_cast<uint64_t>(tol2)});
-  cg_loop_.run(d, key, cg_go_.data(), [&] {
-    grid_viscous_apply(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_p_.data(), cg_q_.data(), sums + 2,
-                       guard, sum);
-    grid_pcg_update(d, n, guard, sums + 2, cg_p_.data(), cg_q_.data(), cg_diag_.data(), cg_x_.data(), cg_r_.data(),
-                    sums + 1, sums + 4, sum);
-    grid_pcg_direction(d, n, guard, sums + 1, cg_r_.data(), cg_diag_.data(), cg_p_.data());
-    grid_pcg_continue(d, sums + 0, sums + 1, sums + 3, tol2, sums + 4, max_it, cg_go_.data());
-  });
+  run_pcg(cg_loop_, key, n, PcgVectors{cg_x_.data(), cg_r_.data(), cg_p_.data(), cg_q_.data(), cg_diag_.data(), sums,
+                                       cg_go_.data()},
+          tol2, max_it, [&](const CgGuard& guard) {
+            grid_viscous_apply(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_p_.data(), cg_q_.data(),
+                               sums + 2, guard, sum);
+          });
   grid_viscous_write(d, v, list, n, cg_x_.data());
+}
+
+template <class Apply>
+void Grid::run_pcg(LaunchLoop& loop, uint64_t key, ListCount n, PcgVectors v, double tol2, int max_it, Apply apply) {
+  const Device& d = device();
+  const SumScratch sum{cg_partial_.data(), cg_ticket_.data()};
+  double* sums = v.sums;
+  grid_pcg_start(d, n, v.r, v.q, v.diag, v.p, sums + 0, sums + 3, sum);
+  // An iteration: p.Ap (apply, into slot 2), the update (r.z into slot 1), the direction, and the
+  // test, which moves r.z to slot 0 and sets the loop's flag. Every pass also tests (CgGuard), so
+  // that a solve that starts converged moves nothing in its one pass.
+  const CgGuard guard{sums + 0, sums + 3, tol2};
+  loop.run(d, key, v.go, [&] {
+    apply(guard);
+    grid_pcg_update(d, n, guard, sums + 2, v.p, v.q, v.diag, v.x, v.r, sums + 1, sums + 4, sum);
+    grid_pcg_direction(d, n, guard, sums + 1, v.r, v.diag, v.p);
+    grid_pcg_continue(d, sums + 0, sums + 1, sums + 3, tol2, sums + 4, max_it, v.go);
+  });
 }
 
 void Grid::record_into(GridRecord* out) const {
@@ -576,16 +587,17 @@ void Grid::flow_film(float dt) {
     grid_film_update(device(), g, film_[1].data(), f, film_[0].data(), fs.flowed.data());
     grid_film_continue(device(), fs.flowed.data(), fs.pairs_done.data(), pairs, fs.steps_go.data());
   });
-  int cur = 0;
-  if (params_.surface_tension > 0.f) film_capillarity(dt, f, cur), cur = 1 - cur;
-  grid_film_write(device(), g, window_.paint().view(), film_[cur].data());
+  // The pairs end in the first plane; surface tension's step moves it into the second.
+  const bool capillary = params_.surface_tension > 0.f;
+  if (capillary) film_capillarity(dt, f);
+  grid_film_write(device(), g, window_.paint().view(), film_[capillary ? 1 : 0].data());
 }
 
-void Grid::film_capillarity(float dt, const FilmFlow& f, int cur) {
+void Grid::film_capillarity(float dt, const FilmFlow& f) {
   const Device& d = device();
   const GridDims g = dims();
   FilmSolve& s = film_solve_;
-  const float* col = film_[cur].data();
+  const float* col = film_[0].data();
   const int64_t faces = 2 * int64_t(g.nx) * g.ny;
   // The flowing faces, compacted as the viscous solve's: their count stays on the device.
   grid_film_curvature(d, g, col, s.lap.data());
@@ -595,26 +607,20 @@ void Grid::film_capillarity(float dt, const FilmFlow& f, int cur) {
   const ListCount n{s.count.data(), faces};
   grid_film_capillary_setup(d, g, col, s.lap.data(), s.list.data(), n, f, dt, s.cinv.data(), s.diag.data(),
                             s.r.data(), s.x.data(), s.q.data());
-  // Jacobi CG to the viscous solve's tolerance and iteration bound, its loop on the device
-  // (apply_viscosity: the same passes, sums and test).
+  // The viscous solve's Jacobi CG, tolerance and iteration bound.
   const double tol2 = double(params_.viscosity_tolerance) * double(params_.viscosity_tolerance);
   const int max_it = std::max(1, params_.viscosity_max_iterations);
-  double* sums = s.sums.data();
   const SumScratch sum{cg_partial_.data(), cg_ticket_.data()};
   s.sums.fill_zero();
-  grid_pcg_start(d, n, s.r.data(), s.q.data(), s.diag.data(), s.p.data(), sums + 0, sums + 3, sum);
-  const CgGuard guard{sums + 0, sums + 3, tol2};
-  const uint64_t key = launch_key({launch_key_of(col), launch_key_of(s.x.data()), launch_key_of(sums),
+  const uint64_t key = launch_key({launch_key_of(col), launch_key_of(s.x.data()), launch_key_of(s.sums.data()),
                                    uint64_t(faces), uint64_t(max_it), std::bit_cast<uint64_t>(tol2)});
-  s.loop.run(d, key, s.go.data(), [&] {
-    grid_film_capillary_apply(d, g, col, s.list.data(), n, s.flag.data(), s.idx.data(), s.cinv.data(), s.p.data(),
-                              s.q.data(), sums + 2, guard, sum);
-    grid_pcg_update(d, n, guard, sums + 2, s.p.data(), s.q.data(), s.diag.data(), s.x.data(), s.r.data(), sums + 1,
-                    sums + 4, sum);
-    grid_pcg_direction(d, n, guard, sums + 1, s.r.data(), s.diag.data(), s.p.data());
-    grid_pcg_continue(d, sums + 0, sums + 1, sums + 3, tol2, sums + 4, max_it, s.go.data());
-  });
-  grid_film_capillary_move(d, g, col, s.flag.data(), s.idx.data(), s.x.data(), f, film_[1 - cur].data());
+  run_pcg(s.loop, key, n, PcgVectors{s.x.data(), s.r.data(), s.p.data(), s.q.data(), s.diag.data(), s.sums.data(),
+                                     s.go.data()},
+          tol2, max_it, [&](const CgGuard& guard) {
+            grid_film_capillary_apply(d, g, col, s.list.data(), n, s.flag.data(), s.idx.data(), s.cinv.data(),
+                                      s.p.data(), s.q.data(), s.sums.data() + 2, guard, sum);
+          });
+  grid_film_capillary_move(d, g, col, s.flag.data(), s.idx.data(), s.x.data(), f, film_[1].data());
 }
 
 void Grid::step(float dt, const std::function<void()>& after_advection) {

@@ -187,6 +187,16 @@ class Grid {
   DeviceBuffer<double> cg_partial_;
   DeviceBuffer<uint32_t> cg_ticket_;
   LaunchLoop cg_loop_;  ///< the CG's iterations, run by the device until converged
+  /// A Jacobi CG's vectors and its device scalars (cg_sums_'s layout) and loop flag.
+  struct PcgVectors {
+    double *x, *r, *p, *q, *diag, *sums;
+    uint32_t* go;
+  };
+  /// Jacobi-preconditioned CG (Saad 2003, Alg. 9.1) over the n entries of v from x, with b in r
+  /// and A x in q on entry, run by `loop` (keyed by `key`) until the test or max_it stops it;
+  /// apply(guard) writes q = A p and p.Ap into sums[2]. The viscous and the film's solves.
+  template <class Apply>
+  void run_pcg(LaunchLoop& loop, uint64_t key, ListCount n, PcgVectors v, double tol2, int max_it, Apply apply);
   DeviceBuffer<GridRecord> record_;  ///< read_record's copy of the step's device figures
   /// The advection's maxima: the outflow rate along each axis (slots 0-2), then column_maxima's
   /// six (the top layers holding paint and paint or particles, the latter's box), which make the
@@ -243,8 +253,8 @@ class Grid {
     DeviceBuffer<double> cinv, diag, x, r, p, q, sums;
     LaunchLoop loop;
   } film_solve_;
-  /// Surface tension's step of the film in film_[cur] into film_[1 - cur] (flow_film).
-  void film_capillarity(float dt, const FilmFlow& f, int cur);
+  /// Surface tension's step of the film in film_[0] into film_[1] (flow_film).
+  void film_capillarity(float dt, const FilmFlow& f);
   SolverScratch scratch_;
   Workspace ws_;
   GridStats stats_;
