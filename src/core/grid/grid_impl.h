@@ -853,7 +853,8 @@ void grid_film_capillary_setup(GridDims d, const float* col, const float* lap, c
     const int64_t face = list[e];
     int64_t a, b;
     detail::film_face_columns(d, n, face, a, b);
-    // (G^T e_f)^T L0 (G^T e_f) = deg a + deg b + 2: a and b are film neighbours.
+    // (G^T e_f)^T L0 (G^T e_f) = deg a + deg b + 2: a and b are film neighbours. A column's
+    // degree (its wet neighbours) is L0 of its own indicator there.
     const auto degree = [=](int64_t c) {
       return detail::film_laplacian(d, col, n, c, [=](int64_t o) { return o == c ? 1.f : 0.f; });
     };
