@@ -475,9 +475,9 @@ TEST_F(StrokePropertiesTest, SlowAndEasedStrokesLeaveNoRibs) {
   // cells, a slope of 0.13. The brush lifts past the body by its length: its trailing bristles,
   // pressed and raised at the lift, put a step into the body's last cells with the lift 16 cells
   // past it. The flat broadside at 15 mm/s lays a line the others do not: its cells alternate
-  // along the track by 0.02 cells (a 2-cell period, slope 0.06, 2.7-4.3x over 14 runs), from the
-  // touching samples' pick-up of the film's particles (docs/TRANSFER.md "Ribs on slow strokes");
-  // its bound is 6x until that is found.
+  // along the track by 0.015-0.02 cells (the 2-cell period exactly, slope 0.05-0.06, 1.9-5.3x over
+  // 21 runs), growing with the touching samples' pick-up of the film's particles
+  // (docs/TRANSFER.md "Ribs on slow strokes"); its bound is 6x until its cause is found.
   constexpr double kVisibleSlope = 0.03;
   struct Case {
     const char* name;

@@ -59,10 +59,10 @@ TEST(TransferSweep, DepositScalesWithDistanceSlidNotSteps) {
   EXPECT_EQ(swept_deposit(0.01f * m, 0.5f, 4.f, split, cm), 0.f) << "dry brush: the paint does not reach";
   EXPECT_GT(swept_deposit(m, 0.5f, 4.f, split, cm), 0.f);
   // The film under a full, pressed sample (R_m = R) balances where what it lays per cell slid
-  // equals what it takes back of a film f: film_pickup per cell slid of the film in its reach,
-  // pi R^2 f. split A(R, 0) = (1 - split) 2 R f at f = 0.59 cells.
+  // equals what it takes back of a film f: a pass takes film_pickup of a whole chord of each
+  // particle in the band of 2 R it sweeps. split A(R, 0) = (1 - split) 2 R f at f = 0.59 cells.
   const float R = load_radius(m, cm), travel = 0.25f;
-  const auto taken = [&](float f) { return film_pickup(split, R, travel) * 3.14159265f * R * R * f * cm; };
+  const auto taken = [&](float f) { return film_pickup(split, 1.f) * 2.f * R * travel * f * cm; };
   const float balance = split * segment_area(R, 0.f) / ((1.f - split) * 2.f * R);
   EXPECT_NEAR(balance, 0.59f, 0.01f) << "a full, pressed sample lays 0.59 cells";
   const float laid = swept_deposit(m, 0.f, travel, split, cm);
@@ -404,24 +404,43 @@ TEST_F(BristleParticleTest, AbsorptionStopsAtCapacityAndLimit) {
   EXPECT_NEAR(load3.total_mass(ws_), 3.0 * mk, 1e-6 * mk);
 }
 
-TEST(TransferSweep, FilmPickupGrowsWithTheDistanceSlidUpToOnePass) {
+TEST(TransferSweep, FilmPickupTakesOnePassWhateverTheSteps) {
   const float split = 0.5f, R = 0.75f;
-  EXPECT_EQ(film_pickup(split, R, 0.f), 0.f) << "a sample resting on the film sweeps none of it";
-  EXPECT_NEAR(film_pickup(split, R, 0.1f), 2.f * film_pickup(split, R, 0.05f), 1e-7f) << "linear in the slide";
-  EXPECT_FLOAT_EQ(film_pickup(split, R, 10.f), 1.f - split) << "a whole pass in one step";
-  EXPECT_EQ(film_pickup(1.f, R, 10.f), 0.f) << "split 1: the film stays on the surface";
-  // A particle in the sample's reach lies under its path for a mean chord of pi R / 2: the steps
-  // of one pass take (1 - split) of it in all, in few steps or many.
-  for (int steps : {2, 8, 64}) {
-    const float travel = 3.14159265f * R / 2.f / float(steps);
-    EXPECT_NEAR(float(steps) * film_pickup(split, R, travel), 1.f - split, 1e-5f) << steps << " steps";
+  EXPECT_EQ(film_pickup(split, 0.f), 0.f) << "a sample resting on the film sweeps none of it";
+  EXPECT_FLOAT_EQ(film_pickup(split, 1.f), 1.f - split) << "a whole pass in one step";
+  EXPECT_EQ(film_pickup(1.f, 1.f), 0.f) << "split 1: the film stays on the surface";
+  // The share of the chord: a path ending over the particle swept half of it; one passing beside
+  // the particle beyond the disc, or stopping short of it, none.
+  EXPECT_NEAR(swept_chord_share(0.f, 0.f, 0.f, 3.f, 0.f, R), 0.5f, 1e-6f);
+  EXPECT_NEAR(swept_chord_share(0.f, 0.f, 0.f, 0.f, 3.f, R), 0.5f, 1e-6f) << "any direction";
+  EXPECT_EQ(swept_chord_share(0.f, 0.8f, 0.f, 3.f, 0.f, R), 0.f) << "beside the path";
+  EXPECT_EQ(swept_chord_share(0.f, 0.f, 0.8f, 3.f, 0.f, R), 0.f) << "above the reach";
+  EXPECT_EQ(swept_chord_share(1.f, 0.f, 0.f, 3.f, 0.f, R), 0.f) << "ahead of the path";
+  EXPECT_EQ(swept_chord_share(-4.f, 0.f, 0.f, 3.f, 0.f, R), 0.f) << "behind the path";
+  EXPECT_EQ(swept_chord_share(0.f, 0.f, 0.f, 0.f, 0.f, R), 0.f) << "resting";
+  // A pass over a particle cut into steps of any length takes 1 - split of it in all, wherever
+  // the particle lies across the band and whatever the phase of the steps' ends against it: the
+  // pick-up does not beat with the travel a step.
+  for (float travel : {0.3f, 0.625f, 1.25f, 1.6f, 3.f}) {
+    for (float e : {0.f, 0.3f, 0.7f}) {
+      for (float dz : {0.f, 0.25f}) {
+        for (float phase : {0.f, 0.37f, 0.81f}) {
+          double survive = 1.0;
+          for (int k = 0; k < 40; ++k) {
+            const float end = -6.f + (float(k) + phase) * travel;  // the sample's end, x
+            survive *= 1.0 - film_pickup(split, swept_chord_share(0.f - end, e, dz, travel, 0.f, R));
+          }
+          EXPECT_NEAR(survive, split, 1e-5) << "travel " << travel << ", offset " << e << ", dz " << dz;
+        }
+      }
+    }
   }
 }
 
 TEST_F(BristleParticleTest, TouchingSampleTakesTheFilmItSweepsWholeParticlesOnly) {
   // One empty sample 0.4 cells over the canvas (its reach R = 0.75: it touches) above a film of
-  // 600 light particles within its reach. Resting, or sliding with the film, it takes none;
-  // sliding over it, a share film_pickup of them, each whole: no particle is split.
+  // 600 light particles. Resting, or sliding with the film, it takes none; sliding over it, a
+  // share of them, each whole: no particle is split.
   TransferParams prm;
   prm.absorb_limit = 1024;  // the per-step limit is not what is measured here
   const float dt = 1.f / 60.f, mk = 1e-14f;
@@ -431,10 +450,10 @@ TEST_F(BristleParticleTest, TouchingSampleTakesTheFilmItSweepsWholeParticlesOnly
     xs.push_back(Vec3(8.f + r * std::cos(a), 8.f + r * std::sin(a), 0.1f + 0.2f * float(i % 3) / 2.f));
   }
   PaintWindow w = make_window({16, 16, 8}, {0, 0, 0}, [](int, int, int) { return 0.f; }, Vec3());
-  const auto taken = [&](Vec3 v_sample, Vec3 v_film) {
+  const auto taken = [&](Vec3 v_sample, Vec3 v_film, Vec3 end = Vec3(8.f, 8.f, 0.4f)) {
     HostSamples h;
     h.resize(1, 1);
-    h.x[0] = Vec3(8.f, 8.f, 0.4f);
+    h.x[0] = end;
     h.v[0] = v_sample;
     DeviceSamples s(device_);
     s.upload(h);
@@ -466,11 +485,21 @@ TEST_F(BristleParticleTest, TouchingSampleTakesTheFilmItSweepsWholeParticlesOnly
   const float R = load_radius(prm.M_max, prm.cell_mass());
   EXPECT_EQ(taken(Vec3(), Vec3()), 0.0) << "resting on the film";
   EXPECT_EQ(taken(Vec3(30.f, 0.f, 0.f), Vec3(30.f, 0.f, 0.f)), 0.0) << "carrying the film along";
-  for (float travel : {0.25f * R, 0.5f * R, 4.f * R}) {
-    const double expect = film_pickup(prm.split, R, travel), got = taken(Vec3(travel / dt, 0.f, 0.f), Vec3());
+  // Sliding over it, each particle with the chance of the share of its chord swept; the last
+  // case ends 2 cells past the film, beyond its reach: the film along the path is taken too.
+  struct Slide {
+    float travel, past;
+  };
+  for (Slide sl : {Slide{0.25f * R, 0.f}, Slide{0.5f * R, 0.f}, Slide{4.f * R, 0.f}, Slide{3.f, 2.f}}) {
+    const Vec3 end(8.f + sl.past, 8.f, 0.4f);
+    double expect = 0.0;
+    for (const Vec3& x : xs)
+      expect += film_pickup(prm.split, swept_chord_share(x.x - end.x, x.y - end.y, x.z - end.z, sl.travel, 0.f, R));
+    expect /= double(xs.size());
+    const double got = taken(Vec3(sl.travel / dt, 0.f, 0.f), Vec3(), end);
     // Binomial spread of 600 draws: sqrt(p (1 - p) / 600) <= 0.021; 4 of it.
-    EXPECT_NEAR(got, expect, 0.085) << "slid " << travel << " cells";
-    EXPECT_GT(got, 0.0);
+    EXPECT_NEAR(got, expect, 0.085) << "slid " << sl.travel << " cells";
+    EXPECT_GT(got, sl.past > 0.f ? 0.4 : 0.0) << "slid " << sl.travel << " cells";
   }
 }
 

@@ -627,6 +627,7 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
   brush_stage(poses, substeps, dt);
   bool resting = false;
   float zone_room = 1e30f;  // this part's room for the particle zone (WindowPlace::zone_room)
+  float pen_slid = 0.f;     // the tips' travel over the part in the canvas plane, cells
 
   // --- 3. Window: follow the brush; rasterise the bristles into it (boundary of §4.2) -----
   {
@@ -637,6 +638,7 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
     // them, a drag bends them back), the box over the step must stay out of the window's rim;
     // where it would not, the box is read instead (docs/TRANSFER.md "The particle zone").
     const Vec3 moved = footprint_centre(brush_->pose(), config_.brush.length) - tips_before;
+    pen_slid = std::hypot(moved.x, moved.y);
     guess_ = {box_before[0] + moved.x, box_before[1] + moved.x, box_before[2] + moved.y, box_before[3] + moved.y};
     box_ = guess_;
     WindowPlace w = place_window(box_before, box_);
@@ -684,8 +686,12 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
     WB_PROFILE_SCOPE("transfer");
     if (config_.particles) {
       // The absorption candidates are found against this step's samples, as far as the
-      // largest load sphere reaches (Eq. 14 takes a particle only inside R_j).
-      const float range = transfer_->params().absorb_range();
+      // largest load sphere reaches (Eq. 14 takes a particle only inside R_j) and, for the
+      // touching samples' pick-up of the film, back along the path the brush slid this part
+      // (docs/TRANSFER.md "Swept contact"), as far as the adhesion's query reaches (D1): the
+      // query's work is then bounded by that one's, not by the pen's speed.
+      const float slid = std::isfinite(pen_slid) ? std::clamp(pen_slid, 0.f, config_.params.particles.D1) : 0.f;
+      const float range = transfer_->params().absorb_range() + slid;
       WB_PROFILE_SCOPE("transfer.nearest");
       build_sample_grid(range, 0.f);
       sample_grid_.query_nearest(particles_.view(), range);

@@ -145,16 +145,39 @@ WB_HD WB_INLINE float swept_deposit(float m, float r, float travel, float split,
   return split * segment_area(load_radius(m, cell_mass), r) * cell_mass * travel;
 }
 
-/// Share of a particle of the surface's film that a touching sample takes in a step (the pick-up
-/// side of swept_deposit; docs/TRANSFER.md "Swept contact"). Sliding `travel` cells relative to
-/// the particle, the sample's reach, a disc of radius R on the surface, sweeps a band of 2R travel:
-/// 2 travel / (pi R) of the film in the disc, and (1 - split) of what it sweeps goes with the
-/// bristle. A particle stays in the disc over a mean chord of pi R / 2, so one pass of the sample
-/// takes (1 - split) of it in all, however many steps the pass lasts; a sample resting on the
-/// film takes nothing more.
-WB_HD WB_INLINE float film_pickup(float split, float R, float travel) {
-  if (!(R > 0.f)) return 0.f;
-  return (1.f - split) * minf(2.f * maxf(travel, 0.f) / (3.14159265f * R), 1.f);
+/// Share of a film particle's chord that a touching sample's reach swept over this step
+/// (docs/TRANSFER.md "Swept contact"). The sample's reach, a sphere of radius R, cuts the
+/// particle's plane (dz below or above the sample) in a disc of radius Rp; in the canvas plane
+/// the sample slid along the path from x - d to x relative to the particle (d its velocity less
+/// the particle's, times dt). The particle is under the disc over a chord of 2c of that line,
+/// c^2 = Rp^2 - e^2 at a distance e from it; the share is the part of the chord the step's path
+/// covers, in [0, 1]: the steps of one pass over the particle add to 1 however they cut the pass,
+/// and a sample resting on the film, or carrying it along, sweeps none of it.
+/// `q` is the particle less the sample's end point, in the canvas plane, and dz their height difference.
+WB_HD WB_INLINE float swept_chord_share(float qx, float qy, float dz, float dx, float dy, float R) {
+  const float Rp2 = R * R - dz * dz;
+  const float len = sqrtf(dx * dx + dy * dy);
+  if (!(Rp2 > 0.f) || !(len > 1e-6f)) return 0.f;
+  // Along the path from its start (x - d): the particle at t, its distance e from the line.
+  const float ux = dx / len, uy = dy / len;
+  const float sx = qx + dx, sy = qy + dy;
+  const float t = sx * ux + sy * uy;
+  const float e2 = maxf(sx * sx + sy * sy - t * t, 0.f);
+  if (!(e2 < Rp2)) return 0.f;
+  const float c = sqrtf(Rp2 - e2);
+  const float covered = minf(t + c, len) - maxf(t - c, 0.f);
+  return clampf(covered / (2.f * c), 0.f, 1.f);
+}
+
+/// Chance that a touching sample takes a particle of the surface's film whole this step, having
+/// swept `share` of the particle's chord (swept_chord_share): the pick-up side of swept_deposit.
+/// The film a bristle slides over splits, and (1 - split) of it goes with the bristle: the
+/// chance of surviving the whole pass is split, and one of the step's part of the pass
+/// split^share, so the steps of a pass take 1 - split in all whatever the pen's speed and the step.
+WB_HD WB_INLINE float film_pickup(float split, float share) {
+  if (!(share > 0.f) || !(split < 1.f)) return 0.f;
+  if (!(split > 0.f)) return 1.f;
+  return 1.f - powf(split, minf(share, 1.f));
 }
 
 /// Share of its single-pass deposit a sample leaves when k samples sweep the same canvas column

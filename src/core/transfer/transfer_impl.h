@@ -199,22 +199,32 @@ void transfer_absorb(ParticleView p, SampleView s, BristleLoadView load, AbsorbS
     const float mk = p.m[k];
     if (!(mk > 0.f)) return;
     const float R = load.radius[j];
-    if (!(length2(p.x[k] - s.x[j]) < R * R)) return;
+    const Vec3 q = p.x[k] - s.x[j];
+    const bool within = length2(q) < R * R;
+    // A sample touching a surface takes the share of the film there that its reach swept over
+    // this step (film splitting, as when it deposits), along the whole path it slid, not only
+    // where the step ended: a pass takes 1 - split of a particle however many steps it lasts,
+    // so the pick-up does not beat with the travel a step. A particle is taken whole with that
+    // chance, so the film is not split into ever lighter particles. Away from surfaces a sample
+    // takes the particles within R_j (Eq. 14).
+    const bool touching = load.gap[j] < R;
+    float chance = 0.f;
+    if (touching) {
+      const Vec3 d = (s.v[j] - p.v[k]) * dt;
+      chance = film_pickup(prm.split, swept_chord_share(q.x, q.y, q.z, d.x, d.y, R));
+      if (!within && !(chance > 0.f)) return;
+    } else if (!within) {
+      return;
+    }
     const float mj = load.m[j], Mj = load.capacity[j];
     const Vec3 ck(p.pigment_r[k], p.pigment_y[k], p.pigment_b[k]);
     if (mj < Mj && limit > 0) {
-      // Tickets enforce the per-step limit on the particles a sample meets (§5.1); the claimed
+      if (touching && !(step_uniform(k, step_index) < chance)) return;  // left on the surface
+      // Tickets enforce the per-step limit on the particles a sample takes (§5.1); the claimed
       // mass reproduces the sequential test "m_j < M_j before this particle" (a rejected claim
       // only makes later ones stricter).
       const uint32_t t = atomic_add(&a.ticket[j], 1u);
       if (t < limit) {
-        // A sample touching a surface takes the share of the film there that its footprint swept
-        // past this step (film_pickup: film splitting, as when it deposits), a particle whole
-        // with that chance, so the film is not split into ever lighter particles; a sample
-        // resting on the film sweeps none of it. Away from surfaces it takes the particle (Eq. 14).
-        if (load.gap[j] < R &&
-            !(step_uniform(k, step_index) < film_pickup(prm.split, R, slid_distance(s.v[j] - p.v[k], dt))))
-          return;
         const float before = atomic_add(&a.claimed[j], mk);
         if (mj + before < Mj) {
           // Dead and weightless: the census, taken before the step's compaction, counts its
@@ -233,6 +243,7 @@ void transfer_absorb(ParticleView p, SampleView s, BristleLoadView load, AbsorbS
         }
       }
     }
+    if (!within) return;
     // Colour bleeding: the sample's colour as it was at the start of the pass (the sample is
     // updated in the next launch), the particle's mass unchanged.
     const float e = bleed_weight(bleed, mk, mj);
