@@ -208,8 +208,9 @@ class Transfer {
   /// of bristles.
   void share_contact(const SampleView& samples, BristleLoad& load, const TransferEnv& env);
   /// Eq. 14: particles within R_j of their nearest sample j join it while m_j < M_j (at most
-  /// absorb_limit met per sample), else bleed colour; a sample touching a surface takes a particle
-  /// of its film with the chance its slide over dt sweeps it (film_pickup). Absorbed particles are
+  /// absorb_limit taken per sample), else bleed colour; a sample touching a surface takes a
+  /// particle of its film under the path it slid over dt with the chance of the share of the
+  /// particle's chord that path swept (swept_chord_share, film_pickup). Absorbed particles are
   /// flagged dead. The stages that take a record fill its host-known fields; their sums wait for
   /// collect().
   void absorb(const SampleView& samples, BristleLoad& load, ParticleStore& particles, float dt);
