@@ -6,8 +6,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <vector>
 
 #include "backend_fixture.h"
+#include "core/grid/grid_fields.h"
 #include "core/grid/rheology.h"
 #include "core/io/document.h"
 #include "core/render/renderer.h"
@@ -77,6 +79,30 @@ float column(const GridDims& d, const std::vector<float>& rho, int i, int j) {
   return h;
 }
 }  // namespace
+
+TEST(Rheology, AFilmFaceCarriesNothingFromAnEmptyColumnWhateverItsFields) {
+  // Two film columns: a bare one (h = 0) on a dried ridge 2 cells high beside a film 0.5 cells
+  // thick in the valley. Gravity drives from the ridge to the valley, so the bare column is
+  // upwind. Its paint's fields are never written in a sub-step that nothing reaches it, so they
+  // hold whatever the buffer held: no value of them may make it carry paint (a negative yield
+  // stress let an empty column pass the yield test and carry an infinite flux).
+  const int64_t n = 2;
+  std::vector<float> col(size_t(kFilmFields) * n, 0.f);
+  col[kFilmH * n + 0] = 0.f, col[kFilmBase * n + 0] = 2.f;
+  col[kFilmH * n + 1] = 0.5f, col[kFilmBase * n + 1] = 0.f;
+  col[kFilmTau * n + 1] = 0.5f, col[kFilmK * n + 1] = 1.f;
+  const FilmFlow f{HerschelBulkley{100.f, 10.f, 1.f}, HerschelBulkley{0.1f, 0.05f, 1.f}, 8000.f, 0.f, 2e-4f, 1e-3f,
+                   0.033f};
+  for (const float tau : {-1e30f, -1.f, 0.f, NAN, 1e30f})
+    for (const float K : {-1e-30f, 0.f, 1e-30f, NAN, 1.f}) {
+      col[kFilmTau * n + 0] = tau, col[kFilmK * n + 0] = K;
+      EXPECT_EQ(film_face(col.data(), n, 0, 1, 0.f, f), 0.f) << "tau_y " << tau << ", K " << K;
+      EXPECT_EQ(film_face(col.data(), n, 1, 0, 0.f, f), 0.f) << "tau_y " << tau << ", K " << K;
+    }
+  // The valley's film, upwind of an empty column lower still, does flow into it.
+  col[kFilmBase * n + 0] = 0.f, col[kFilmBase * n + 1] = 2.f;
+  EXPECT_LT(film_face(col.data(), n, 0, 1, 0.f, f), 0.f) << "from column 1 into column 0";
+}
 
 TEST_F(RheologyTest, ShearedPaintThinsByTheModelsRatio) {
   const GridParams p;

@@ -627,27 +627,6 @@ void grid_film_columns(GridDims d, const GridExtent* e, PaintWindowView pw, Bris
   });
 }
 
-/// Thickness (cells) a film face carries in a sub-step from column a to b (negative: b to a).
-/// A gravity-driven Bingham film (Liu & Mei, J. Fluid Mech. 207, 505, 1989): with the driving
-/// gradient G (Pa/m) the base's shear stress is G h; below the yield stress nothing flows; above it
-/// the paint shears below the plug's height Y = h - tau_y / G and the flux is G Y^2 (3h - Y) / (6 K),
-/// the upwind column's h, tau_y and K (n taken as 1: the oily paint that flows is nearly Newtonian).
-/// At most a quarter of the upwind film leaves through one face a sub-step (it has four).
-WB_HD WB_INLINE float film_face(const float* col, int64_t n, int64_t a, int64_t b, float pull, const FilmFlow& f) {
-  const float ha = col[kFilmH * n + a], hb = col[kFilmH * n + b];
-  if (ha < 0.f || hb < 0.f) return 0.f;
-  const float slope = (col[kFilmBase * n + b] + hb) - (col[kFilmBase * n + a] + ha);  // cells per cell
-  const float G = f.rho_g_cos * slope - pull;  // dp/ds along a -> b, Pa/m: the paint flows down it
-  const int64_t u = G > 0.f ? b : a;
-  const float hu = col[kFilmH * n + u];
-  const float Gm = fabsf(G), h = hu * f.cell, tau_y = col[kFilmTau * n + u];
-  if (!(Gm * h > tau_y)) return 0.f;
-  const float Y = h - tau_y / Gm;
-  const float q = Gm * Y * Y * (3.f * h - Y) / (6.f * col[kFilmK * n + u]);  // m^2/s
-  const float t = minf(q * f.dt / (f.cell * f.cell), 0.25f * hu);
-  return G > 0.f ? -t : t;
-}
-
 namespace detail {
 /// Column c of the film after the signed inflows in[s] through its four faces (from[s] the column
 /// across each): what stays, then each inflow with its column's paint (Algorithm 2 by mass; oil
