@@ -126,8 +126,7 @@ void BM_ColumnScans(benchmark::State& state) {
   const int which = int(state.range(0));
   for (auto _ : state) {
     if (which == 0 || which == 1)
-      wb::grid_column_tops(d, gd, paint.density.data(), paint.dryness.data(), liquid, dry, particles.data(), 0.f,
-                           out.data());
+      wb::grid_column_tops(d, gd, paint.density.data(), paint.dryness.data(), dry, particles.data(), 0.f, out.data());
     if (which == 0 || which == 2)
       wb::particles_solid_height(d, paint.view(), particles.data(), dry, liquid, 0.f, out.data(), out.data() + columns);
     if (which == 0 || which == 3)

@@ -62,8 +62,7 @@ TEST_F(ColumnScansTest, RunsOfColumnsGiveWhatAColumnAtATimeGives) {
       DeviceBuffer<float> tops(device_, size_t(6 * layer)), height(device_, size_t(layer)),
           wet_top(device_, size_t(layer)), ground(device_, size_t(layer));
       const GridDims d{n.x, n.y, n.z};
-      grid_column_tops(device_, d, w.density.data(), w.dryness.data(), kLiquid, kDry, particles, kTraceDensity,
-                       tops.data());
+      grid_column_tops(device_, d, w.density.data(), w.dryness.data(), kDry, particles, kTraceDensity, tops.data());
       particles_solid_height(device_, w.view(), particles, kDry, kLiquid, kFloor, height.data(), wet_top.data());
       particles_ground_surface(device_, w.view(), particles, kDry, kLiquid, kFloor, ground.data());
       const std::vector<float> th = tops.to_host(), hh = height.to_host(), wh = wet_top.to_host(),
@@ -74,7 +73,7 @@ TEST_F(ColumnScansTest, RunsOfColumnsGiveWhatAColumnAtATimeGives) {
         float top = 0.f, joint = 0.f;
         for (int k = n.z - 1; k >= 0; --k) {
           const float r = h.density(k * layer + c), dr = h.dryness(k * layer + c);
-          const bool wet = r > kTraceDensity && (!(dr >= kDry) || classify_cell(r, dr, true, kLiquid, kDry) == kCellLiquid);
+          const bool wet = r > kTraceDensity && (!(dr >= kDry) || !dried_solid(r, dr, kDry));
           if (wet && top == 0.f) top = float(k + 1);
           if ((wet || pdens(k) > kTraceDensity) && joint == 0.f) joint = float(k + 1);
         }

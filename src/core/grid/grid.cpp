@@ -373,8 +373,8 @@ void Grid::column_maxima(float trace, int slot) {
   const GridDims g = dims();
   const int64_t columns = int64_t(g.nx) * g.ny;
   const PaintWindow& paint = window_.paint();
-  grid_column_tops(device(), g, paint.density.data(), paint.dryness.data(), params_.liquid_threshold,
-                   params_.dry_threshold, particle_density_, trace, cell_tmp_.data());
+  grid_column_tops(device(), g, paint.density.data(), paint.dryness.data(), params_.dry_threshold, particle_density_,
+                   trace, cell_tmp_.data());
   for (int s = 0; s < 6; ++s)
     reduce_max_into(device(), cell_tmp_.data() + s * columns, columns, advect_max_.data() + slot + s, ws_);
 }

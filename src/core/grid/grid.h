@@ -267,9 +267,9 @@ class Grid {
      FlowColumns flow, float liquid_threshold, float dry_threshold),                                                   \
     (g, pw, br, particle_density, canvas, flow, liquid_threshold, dry_threshold))                                      \
   X(void, grid_column_tops,                                                                                            \
-    (GridDims d, const float* rho, const float* dryness, float liquid_threshold, float dry_threshold,                  \
-     const float* particle_density, float trace, float* out),                                                          \
-    (d, rho, dryness, liquid_threshold, dry_threshold, particle_density, trace, out))                                  \
+    (GridDims d, const float* rho, const float* dryness, float dry_threshold, const float* particle_density,           \
+     float trace, float* out),                                                                                         \
+    (d, rho, dryness, dry_threshold, particle_density, trace, out))                                                    \
   X(void, grid_first_extent, (GridDims d, const float* maxima, GridExtent* e, float* rates), (d, maxima, e, rates))    \
   X(void, grid_running_columns, (GridView g, PaintWindowView pw, float dry_threshold, float speed, float* out),        \
     (g, pw, dry_threshold, speed, out))                                                                                \

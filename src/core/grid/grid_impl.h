@@ -170,16 +170,17 @@ void grid_classify(GridView g, PaintWindowView pw, BristleField br, const float*
   });
 }
 
-void grid_column_tops(GridDims d, const float* rho, const float* dryness, float liquid_threshold, float dry_threshold,
+void grid_column_tops(GridDims d, const float* rho, const float* dryness, float dry_threshold,
                       const float* particle_density, float trace, float* out) {
   const int64_t n = int64_t(d.nx) * d.ny;
   parallel_for_runs<kColumnLanes>(n, [=] WB_HD(int64_t col0, int lanes) {
     // The column's top layer (k + 1) holding paint above `trace`, and holding paint or particles;
     // where it holds either, its x, -x, y and -y, whose maxima are the box of such columns. Dried
-    // paint counts only where the classification makes it liquid (liquid_on_canvas): a canvas's
-    // ground or a dried layer is solid or air, never moves, and the cells of it that wet paint
-    // can reach lie within the box's margins. Each layer of the run's columns at once, down the
-    // whole column (parallel_for_runs<kColumnLanes>).
+    // paint counts unless it is solid (dried_solid): a canvas's ground or a dried layer is solid,
+    // never moves, and the cells of it that wet paint can reach lie within the box's margins; a
+    // dried trace thinner than half a cell is no solid (wet paint that reaches it mixes with it)
+    // and the passes bounded by the extent must see it. Each layer of the run's columns at once,
+    // down the whole column (parallel_for_runs<kColumnLanes>).
     // Without particles the paint's density stands in for theirs against a bound none passes, so
     // that every lane does the same loads and compares (no branch: the run vectorises).
     const float* pd = particle_density ? particle_density : rho;
@@ -192,7 +193,7 @@ void grid_column_tops(GridDims d, const float* rho, const float* dryness, float 
       for (int l = 0; l < lanes; ++l) {
         const int64_t c = c0 + l;
         const float r = rho[c], dr = dryness[c];
-        const bool wet = (r > trace) & (!(dr >= dry_threshold) | liquid_on_canvas(r, dr, liquid_threshold, dry_threshold));
+        const bool wet = (r > trace) & (!(dr >= dry_threshold) | !dried_solid(r, dr, dry_threshold));
         const bool held = wet | (pd[c] > pd_trace);
         top[l] = (top[l] == 0.f) & wet ? level : top[l];
         joint[l] = (joint[l] == 0.f) & held ? level : joint[l];

@@ -23,12 +23,6 @@ WB_HD WB_INLINE uint8_t classify_cell(float density, float dryness, bool on_canv
   return density >= liquid_threshold ? kCellLiquid : kCellAir;
 }
 
-/// classify_cell(density, dryness, true, ...) == kCellLiquid as one expression, without a branch
-/// (a column scan's lanes vectorise over it: parallel_for_runs<kColumnLanes>).
-WB_HD WB_INLINE bool liquid_on_canvas(float density, float dryness, float liquid_threshold, float dry_threshold) {
-  return !dried_solid(density, dryness, dry_threshold) & (density >= liquid_threshold);
-}
-
 /// The two cells a face of component c separates: a = (i,j,k) - e_c, b = (i,j,k).
 /// Sets has_a / has_b to whether they lie in the window.
 WB_HD WB_INLINE void face_cells(const GridDims& d, int c, int i, int j, int k, int64_t& a, int64_t& b, bool& has_a,
