@@ -391,7 +391,8 @@ TEST_F(StrokePropertiesTest, ConstantSpeedLeavesNoStepPattern) {
 /// The strongest peak of the spectrum of the thickness along the track over [x0, x0 + n), periods
 /// 2 to 20 cells, over the continuum at its period: each of the track's 11 central rows of each
 /// body detrended and transformed, their powers averaged (ribs run across the rows and recur in
-/// every body painted by the same stroke, texture does not; Bartlett's average), then each
+/// every body painted by the same stroke; texture recurs less, the second body lying half a cell
+/// across; Bartlett's average), then each
 /// bin's power over the median of the 8 bins nearest it (itself left out). A rib is a line above
 /// its neighbours; the body's texture is a continuum, red where the paint is smooth (surface
 /// tension levels the shortest periods first), and a peak over the median of all the bins

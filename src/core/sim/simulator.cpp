@@ -690,8 +690,7 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
       // touching samples' pick-up of the film, back along the path the brush slid this part
       // (docs/TRANSFER.md "Swept contact"), as far as the adhesion's query reaches (D1): the
       // query's work is then bounded by that one's, not by the pen's speed.
-      const float slid = std::isfinite(pen_slid) ? std::clamp(pen_slid, 0.f, config_.params.particles.D1) : 0.f;
-      const float range = transfer_->params().absorb_range() + slid;
+      const float range = transfer_->params().absorb_range() + std::min(pen_slid, config_.params.particles.D1);
       WB_PROFILE_SCOPE("transfer.nearest");
       build_sample_grid(range, 0.f);
       sample_grid_.query_nearest(particles_.view(), range);

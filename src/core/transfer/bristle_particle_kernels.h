@@ -165,8 +165,9 @@ WB_HD WB_INLINE float swept_chord_share(float qx, float qy, float dz, float dx, 
   const float e2 = maxf(sx * sx + sy * sy - t * t, 0.f);
   if (!(e2 < Rp2)) return 0.f;
   const float c = sqrtf(Rp2 - e2);
+  // The chord [t - c, t + c] against the path [0, len]: their overlap, at most the chord.
   const float covered = minf(t + c, len) - maxf(t - c, 0.f);
-  return clampf(covered / (2.f * c), 0.f, 1.f);
+  return maxf(covered, 0.f) / (2.f * c);
 }
 
 /// Chance that a touching sample takes a particle of the surface's film whole this step, having
