@@ -120,6 +120,14 @@ int main(int argc, char** argv) {
                  qPrintable(cli.value(autosave_opt)));
     return 2;
   }
+  // The demo's other options mean nothing without it: say so instead of opening an idle studio.
+  for (const QCommandLineOption* o : {&stats_opt, &rec_opt, &short_opt}) {
+    if (cli.isSet(*o) && !cli.isSet(demo_opt)) {
+      std::fprintf(stderr, "wetbrush-studio: --%s needs --demo-screenshot FILE (it measures the scripted painting)\n",
+                   qPrintable(o->names().first()));
+      return 2;
+    }
+  }
   opt.data_dir = cli.value(data_opt);
   opt.offer_recovery = !cli.isSet(norecover_opt) && !cli.isSet(demo_opt) && !cli.isSet(loop_opt);
   if (!cli.positionalArguments().isEmpty()) opt.open_path = cli.positionalArguments().first();

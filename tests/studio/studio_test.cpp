@@ -455,6 +455,16 @@ class StudioTest : public QObject {
     QCOMPARE(gl.exitStatus(), QProcess::NormalExit);
     QCOMPARE(gl.exitCode(), 2);
     QVERIFY2(gl.readAllStandardError().contains("--view gl: no OpenGL view on the 'offscreen' platform"), "it says why");
+
+    // The demo's measurements without the demo: an error that says so, not an idle studio.
+    QProcess stats_only;
+    stats_only.setProcessEnvironment(env);
+    stats_only.start(WB_STUDIO_PATH, {"--device", "cpu", "--preset", "tiny", "--data-dir", data, "--demo-stats",
+                                      data + "/alone.json"});
+    QVERIFY2(stats_only.waitForFinished(30000), "answered within 30 s");
+    QCOMPARE(stats_only.exitCode(), 2);
+    QVERIFY2(stats_only.readAllStandardError().contains("--demo-stats needs --demo-screenshot"), "it says why");
+    QVERIFY(!QFile::exists(data + "/alone.json"));
   }
 
   /// The status bar's advice when the simulation falls behind: the lighter preset of the most
