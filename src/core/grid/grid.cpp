@@ -436,7 +436,9 @@ void Grid::apply_viscosity(float dt) {
     cg_nu_.resize(size_t(all));
     for (auto* b : {&cg_x_, &cg_r_, &cg_p_, &cg_q_, &cg_diag_}) b->resize(size_t(all));
   }
-  // Jacobi-preconditioned conjugate gradients (Saad 2003, Alg. 9.1) from the current velocity.
+  // Jacobi-preconditioned conjugate gradients (Saad 2003, Alg. 9.1) from the velocity before the
+  // forces: gravity's uniform dt g is the smoothest error there is (the mode the no-slip floor
+  // holds, the slowest for Jacobi-CG), and resting paint keeps almost none of it.
   // alpha, beta and the test of convergence are formed on the device from sums kept there
   // (cg_sums_: r.z of the current and the next iteration, p.Ap, b.D^-1 b, the iterations made,
   // the fluid faces), and the device runs the iterations until the test or the iteration limit
@@ -449,7 +451,7 @@ void Grid::apply_viscosity(float dt) {
   const ListCount n{cg_count_.data(), all};
   grid_viscous_count(d, v, idx, cg_count_.data(), sums + 5);
   grid_viscous_setup(d, v, list, n, idx, mu_.data(), nu_scale, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(),
-                     cg_r_.data(), cg_x_.data());
+                     cg_r_.data(), cg_x_.data(), FaceFields{{vel_pre_[0].data(), vel_pre_[1].data(), vel_pre_[2].data()}});
   // The right-hand side b goes into r; A x into q (its p.Ap lands in slot 2, which the first
   // iteration writes again), then b.D^-1 b, r = b - A x, p = D^-1 r and r.z.
   grid_viscous_apply(d, n, cg_nu_.data(), cg_nb_.data(), cg_diag_.data(), cg_x_.data(), cg_q_.data(), sums + 2, {},

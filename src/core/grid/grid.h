@@ -107,7 +107,8 @@ class Grid {
   /// hydrostatic part split off (docs/GRID.md).
   void add_external_forces(float dt);
   /// Implicit viscosity with the apparent viscosity of each liquid cell at its strain rate, solved
-  /// by PCG to viscosity_tolerance.
+  /// by PCG to viscosity_tolerance, from the velocity add_external_forces found (the guess only:
+  /// the answer is the same within the tolerance whatever it is).
   void apply_viscosity(float dt);
   /// Projects with params().solver: the velocity loses its divergence, except where paint is
   /// packed above density 1, which it expands back over dt (compression_source).
@@ -332,8 +333,8 @@ class Grid {
   X(void, grid_viscous_count, (GridView g, const uint32_t* idx, int64_t* run, double* total), (g, idx, run, total))    \
   X(void, grid_viscous_setup,                                                                                          \
     (GridView g, const uint32_t* list, ListCount n, const uint32_t* idx, const float* mu, float nu_scale, float* nu,   \
-     int32_t* nb, double* diag, double* b, double* x),                                                                 \
-    (g, list, n, idx, mu, nu_scale, nu, nb, diag, b, x))                                                               \
+     int32_t* nb, double* diag, double* b, double* x, FaceFields guess),                                               \
+    (g, list, n, idx, mu, nu_scale, nu, nb, diag, b, x, guess))                                                               \
   X(void, grid_viscous_apply,                                                                                          \
     (ListCount n, const float* nu, const int32_t* nb, const double* diag, const double* p, double* q, double* pq,      \
      CgGuard guard, SumScratch s),                                                                                     \

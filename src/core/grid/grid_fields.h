@@ -192,6 +192,11 @@ struct ListCount {
   int64_t capacity = 0;
 };
 
+/// A MAC field's three components, read only (the viscous solve's first guess).
+struct FaceFields {
+  const float* c[3] = {nullptr, nullptr, nullptr};
+};
+
 /// The viscous CG's test of convergence, made on the device by every kernel of an iteration:
 /// the iteration runs while r.z > tol2 b.D^-1 b (and r.z > 0), so that iterations launched past
 /// convergence do nothing and the host need not read r.z to stop them. rz null: always run.

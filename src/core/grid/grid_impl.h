@@ -970,7 +970,7 @@ void grid_viscous_count(GridView g, const uint32_t* idx, int64_t* run, double* t
 }
 
 void grid_viscous_setup(GridView g, const uint32_t* list, ListCount n, const uint32_t* idx, const float* mu,
-                        float nu_scale, float* nu, int32_t* nb, double* diag, double* b, double* x) {
+                        float nu_scale, float* nu, int32_t* nb, double* diag, double* b, double* x, FaceFields guess) {
   const GridDims d = g.d;
   parallel_for_count(n.n, n.capacity, [=] WB_HD(int64_t e) {
     int c, i, j, k;
@@ -981,7 +981,7 @@ void grid_viscous_setup(GridView g, const uint32_t* list, ListCount n, const uin
     int c, i, j, k;
     const int64_t f = detail::list_face(d, list, e, c, i, j, k);
     viscous_row(g, nu, idx, e, c, i, j, k, g.vel[c][f], nb + 6 * e, diag[e], b[e]);
-    x[e] = g.vel[c][f];  // the advected, forced velocity is the first guess
+    x[e] = guess.c[c][f];
   });
 }
 
