@@ -334,7 +334,7 @@ class Grid {
   X(void, grid_viscous_setup,                                                                                          \
     (GridView g, const uint32_t* list, ListCount n, const uint32_t* idx, const float* mu, float nu_scale, float* nu,   \
      int32_t* nb, double* diag, double* b, double* x, FaceFields guess),                                               \
-    (g, list, n, idx, mu, nu_scale, nu, nb, diag, b, x, guess))                                                               \
+    (g, list, n, idx, mu, nu_scale, nu, nb, diag, b, x, guess))                                                        \
   X(void, grid_viscous_apply,                                                                                          \
     (ListCount n, const float* nu, const int32_t* nb, const double* diag, const double* p, double* q, double* pq,      \
      CgGuard guard, SumScratch s),                                                                                     \

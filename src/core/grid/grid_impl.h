@@ -981,7 +981,7 @@ void grid_viscous_setup(GridView g, const uint32_t* list, ListCount n, const uin
     int c, i, j, k;
     const int64_t f = detail::list_face(d, list, e, c, i, j, k);
     viscous_row(g, nu, idx, e, c, i, j, k, g.vel[c][f], nb + 6 * e, diag[e], b[e]);
-    x[e] = guess.c[c][f];
+    x[e] = guess.c[c][f];  // the first guess: the advected velocity before the forces (Grid::apply_viscosity)
   });
 }
 
