@@ -263,13 +263,23 @@ WB_HD WB_INLINE Vec3 emission_pattern_point(int s, int P) {
   return Vec3(rho * cosf(phi), rho * sinf(phi), z) * radius;
 }
 
-/// Position of the i-th particle emitted by sample j this step: pattern slot (j + step_index *
-/// n + i) mod P so that successive steps fill different slots, scaled by R_j, kept at or above
-/// the canvas (but never above the sample).
-WB_HD WB_INLINE Vec3 emission_position(Vec3 x_j, float R_j, int64_t j, int64_t step_index, int n, int i, int P,
+/// Slot of the emission pattern for the i-th particle sample j lays at step `step`: the step's
+/// particles take consecutive slots (spread over the pattern) from a start drawn for the sample
+/// and the step. A start that cycled with the step (j + step n) laid the pattern's offsets along
+/// the track in a cycle of P steps, so the film's stretches laid step by step overlapped and
+/// parted in a pattern of the step's travel: lines across a slow stroke at 1/travel less
+/// multiples of 1/(P travel) cycles a cell (the flat broadside's 2-cell line at 15 mm/s,
+/// docs/TRANSFER.md "Ribs on slow strokes").
+WB_HD WB_INLINE int pattern_slot(int64_t j, int64_t step, int i, int P) {
+  const uint32_t h = transfer_hash(uint32_t(j) * 747796405u ^ uint32_t(step) * 2891336453u ^ 0x85ebca6bu);
+  return int((uint64_t(h) + uint64_t(i)) % uint64_t(P));
+}
+
+/// Position of the i-th particle emitted by sample j this step: its pattern slot (pattern_slot),
+/// scaled by R_j, kept at or above the canvas (but never above the sample).
+WB_HD WB_INLINE Vec3 emission_position(Vec3 x_j, float R_j, int64_t j, int64_t step_index, int i, int P,
                                        float floor_z) {
-  const int64_t slot = (j + step_index * int64_t(n) + int64_t(i)) % int64_t(P);
-  Vec3 p = x_j + emission_pattern_point(int(slot), P) * R_j;
+  Vec3 p = x_j + emission_pattern_point(pattern_slot(j, step_index, i, P), P) * R_j;
   const float lo = minf(floor_z + 0.01f, x_j.z);
   if (p.z < lo) p.z = lo;
   return p;

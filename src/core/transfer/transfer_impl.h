@@ -457,15 +457,14 @@ void transfer_emit_fill(SampleView s, BristleLoadView load, ParticleView p, NewB
     for (int i = 0; i < n_eff; ++i) {
       const int64_t k = batch.first + off + i;
       if (i < n_static) {
-        p.x[k] = emission_position(xj, R, j, step_index, n_static, i, P, floor_z);
+        p.x[k] = emission_position(xj, R, j, step_index, i, P, floor_z);
         p.v[k] = vj;  // "the new particles share the same attributes as the sample, including the velocity"
         p.m[k] = mass_each[j];
       } else {
         // Left on the surface along the path slid this step, at rest with it.
         const int q = i - n_static;
-        const int64_t slot = (j + step_index * int64_t(n_swept) + int64_t(q)) % int64_t(P);
         const float jitter = step_uniform(j, step_index);
-        const Vec3 pattern = emission_pattern_point(int(slot), P);
+        const Vec3 pattern = emission_pattern_point(pattern_slot(j, step_index, n_static + q, P), P);
         // Laid where the path touches the surface: a point over a hollow the bristle bridged
         // (its surface more than half a cell lower than at the contact) moves to the next point
         // of the path that touches, else to the end of the path, where the contact is.
