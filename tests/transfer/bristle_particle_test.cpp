@@ -673,6 +673,29 @@ TEST_F(BristleParticleTest, EmissionPatternIsInTheLowerHalfBall) {
   EXPECT_LT(mean.z, -0.2f);
 }
 
+// The pattern's slots a sample starts a step from (docs/TRANSFER.md "Pattern"): every slot in
+// its share over many steps, a step's particles on consecutive slots, and no cycle with the step.
+// A start that cycled with the step, (j + step n) mod P, laid the pattern's offsets along a slow
+// stroke in a P-step cycle: lines across it (the flat broadside's 2-cell line at 15 mm/s).
+TEST_F(BristleParticleTest, PatternSlotsAreDrawnAStepNotCycled) {
+  const int P = 16, steps = 1600;
+  for (int64_t j : {int64_t(0), int64_t(7), int64_t(12345)}) {
+    std::vector<int> start(steps), count(P, 0);
+    for (int t = 0; t < steps; ++t) {
+      start[size_t(t)] = pattern_slot(j, t, 0, P);
+      ++count[size_t(start[size_t(t)])];
+      for (int i = 1; i < 4; ++i) EXPECT_EQ(pattern_slot(j, t, i, P), (start[size_t(t)] + i) % P);
+    }
+    for (int c : count) EXPECT_NEAR(c, steps / P, 0.3 * steps / P) << "sample " << j;
+    // Steps d apart share their start about 1 / P of the time for every lag d: no lag repeats it.
+    for (int d = 1; d <= 2 * P; ++d) {
+      int same = 0;
+      for (int t = 0; t + d < steps; ++t) same += start[size_t(t)] == start[size_t(t + d)];
+      EXPECT_LT(double(same) / double(steps - d), 3.0 / P) << "sample " << j << ", lag " << d;
+    }
+  }
+}
+
 TEST_F(BristleParticleTest, BrushWithoutPaintLeavesNone) {
   HostSamples h = vertical_brush(4, 16, 0.8f, 16.f, 16.f, 0.f, 2.f, Vec3(50.f, 0.f, 0.f));
   DeviceSamples s(device_);

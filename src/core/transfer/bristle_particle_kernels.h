@@ -265,11 +265,8 @@ WB_HD WB_INLINE Vec3 emission_pattern_point(int s, int P) {
 
 /// Slot of the emission pattern for the i-th particle sample j lays at step `step`: the step's
 /// particles take consecutive slots (spread over the pattern) from a start drawn for the sample
-/// and the step. A start that cycled with the step (j + step n) laid the pattern's offsets along
-/// the track in a cycle of P steps, so the film's stretches laid step by step overlapped and
-/// parted in a pattern of the step's travel: lines across a slow stroke at 1/travel less
-/// multiples of 1/(P travel) cycles a cell (the flat broadside's 2-cell line at 15 mm/s,
-/// docs/TRANSFER.md "Ribs on slow strokes").
+/// and the step. Not a cycle with the step: that would shift the film's stretches laid step by
+/// step in a P-step cycle, lines across a slow stroke (docs/TRANSFER.md "Ribs on slow strokes").
 WB_HD WB_INLINE int pattern_slot(int64_t j, int64_t step, int i, int P) {
   const uint32_t h = transfer_hash(uint32_t(j) * 747796405u ^ uint32_t(step) * 2891336453u ^ 0x85ebca6bu);
   return int((uint64_t(h) + uint64_t(i)) % uint64_t(P));
