@@ -193,7 +193,7 @@ void grid_column_tops(GridDims d, const float* rho, const float* dryness, float 
       for (int l = 0; l < lanes; ++l) {
         const int64_t c = c0 + l;
         const float r = rho[c], dr = dryness[c];
-        const bool wet = (r > trace) & (!(dr >= dry_threshold) | !dried_solid(r, dr, dry_threshold));
+        const bool wet = (r > trace) & !dried_solid(r, dr, dry_threshold);
         const bool held = wet | (pd[c] > pd_trace);
         top[l] = (top[l] == 0.f) & wet ? level : top[l];
         joint[l] = (joint[l] == 0.f) & held ? level : joint[l];
