@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "core/session/session.h"
 #include "sim/sim_fixture.h"
 
 namespace wb::test {
@@ -99,6 +100,65 @@ TEST_F(WindowFlowTest, ABeadBesideARestingBrushRunsAsInAWindowHoldingTheCanvas) 
   const Run stiff = bead_run(Int3{128, 128, 16}, 0.6f, 0.1f);
   EXPECT_LE(stiff.front, 55.f);
   EXPECT_EQ(stiff.window_y, -32);
+}
+
+TEST_F(WindowFlowTest, ABrushLiftedClearLeavesTheWindowToTheRunningPaint) {
+  // The brush held up (pen up: its tips 20 cells above the canvas, over the window's top) has
+  // nothing in the window to hold it there: a window too small to hold both the brush and the
+  // running bead at once follows the bead. Measured: 128 x 96 and 96 x 64 windows both run the
+  // bead as the window holding the canvas does (front y 120, centre 107.4); a window held by the
+  // brush stopped them on its walls (front y 96 and 64).
+  const Run whole = bead_run(Int3{128, 256, 16}, 0.6f);
+  for (const Int3 window : {Int3{128, 96, 16}, Int3{96, 64, 16}}) {
+    const Run r = bead_run(window, 0.6f);
+    EXPECT_NEAR(r.front, whole.front, 2.f) << window.y;
+    EXPECT_NEAR(r.centre, whole.centre, 1.f) << window.y;
+    EXPECT_GT(r.window_y, 32 + 8 - window.y / 2) << "the window left the brush (y 32)";
+    EXPECT_LT(std::abs(r.drift), 1e-4);
+  }
+}
+
+TEST_F(WindowFlowTest, TheWindowComesBackToTheBrushThatComesDown) {
+  // The bead has taken the window away from the lifted brush; the pen then comes down where the
+  // brush is, over 0.1 s as the player lowers it: the window is back on the brush before a
+  // bristle reaches its top, the stroke paints and the books close.
+  SimConfig c = small_config(CanvasDims{128, 256, 16});
+  c.window = Int3{96, 64, 16};
+  c.params.grid.tilt = 90.f;
+  const float bx = 64.f, by = 32.f;
+  Simulator sim(c, pose_at(c.brush, bx, by, 0.f, false));
+  PaintLoad oily = red();
+  oily.oil = 0.9f;
+  sim.replace_canvas([&](TileStore& canvas) { put_paint_dab(canvas, 64.f, 50.f, 6.f, 8.f, oily); });
+  for (int s = 0; s < 36; ++s) sim.step(pose_at(c.brush, bx, by, 0.f, false), 1.f / 60.f);
+  const ActiveWindow& win = SimulatorTestAccess::grid(sim).window();
+  ASSERT_GT(win.origin().y, 0) << "the scene: the running paint took the window down the canvas";
+  sim.load_paint(red());
+  for (int s = 1; s <= 12; ++s) {
+    // The elevation from -1 (lifted) to a pressure of 0.5 over 6 steps, then held down.
+    const float e = std::min(-1.f + float(s) / 4.f, 0.5f);
+    PenSample p;
+    p.x = bx, p.y = by, p.pressure = std::max(e, 0.f), p.down = e >= 0.f;
+    sim.step(pose_from_pen(p, e, c.brush), 1.f / 60.f);
+    const Int3 o = win.origin(), n = win.dims();
+    EXPECT_TRUE(by >= float(o.y + 8) && by <= float(o.y + n.y - 8)) << "step " << s << ": the window at y " << o.y;
+  }
+  // The stroke paints: paint under the brush, where the bead had run away from.
+  const TileStore canvas = sim.settled_canvas_copy(device_);
+  double under = 0.0;
+  for (int id : canvas.allocated_tile_ids()) {
+    const TileData t = canvas.read_tile(id);
+    for (int z = 0; z < canvas.dims().depth; ++z)
+      for (int ly = 0; ly < kTileSize; ++ly)
+        for (int lx = 0; lx < kTileSize; ++lx) {
+          const int x = t.tile_x * kTileSize + lx, y = t.tile_y * kTileSize + ly;
+          if (std::abs(float(x) + 0.5f - bx) < 8.f && std::abs(float(y) + 0.5f - by) < 8.f)
+            under += t.density[size_t((z * kTileSize + ly) * kTileSize + lx)];
+        }
+  }
+  std::printf("[ come down ] paint under the brush %.1f cells, books %.1e\n", under, sim.books().max_drift());
+  EXPECT_GT(under, 5.0);
+  EXPECT_LT(std::abs(sim.books().max_drift()), 1e-4);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/exec/algorithms.h"
 #include "core/exec/memory.h"
@@ -403,11 +404,13 @@ void Simulator::queue_samples_box(float* out) {
 std::array<float, 4> Simulator::box_from(const float m[kExtentValues]) {
   ground_ = std::isfinite(m[4]) ? std::max(m[4], 0.f) : 0.f;
   const Vec3 tip = footprint_centre(brush_->pose(), config_.brush.length);
-  if (!(m[0] >= -m[1] && m[2] >= -m[3])) return {tip.x, tip.x, tip.y, tip.y};  // none below the top: the tips' point
+  box_clear_ = !(m[0] >= -m[1] && m[2] >= -m[3]);
+  if (box_clear_) return {tip.x, tip.x, tip.y, tip.y};  // none below the top: the tips' point
   return {-m[1], m[0], -m[3], m[2]};
 }
 
-Simulator::WindowPlace Simulator::place_window(const std::array<float, 4>& before, const std::array<float, 4>& after) {
+Simulator::WindowPlace Simulator::place_window(const std::array<float, 4>& before, const std::array<float, 4>& after,
+                                               bool clear) {
   // The window holds the samples' box over the step (the swept contact lays paint from where
   // each sample was to where it is), centred on it. The particle zone must end inside the kept
   // box: a zone cut by it returns its particles in a strip at every move of the window, a band
@@ -434,6 +437,7 @@ Simulator::WindowPlace Simulator::place_window(const std::array<float, 4>& befor
   const float moved = std::max(std::abs(after[0] + after[1] - before[0] - before[1]),
                                std::abs(after[2] + after[3] - before[2] - before[3]));
   w.resting = 0.5f * moved <= kRestingBox;
+  w.free = w.resting && clear;
   if (!w.resting) slid_ = {0.f, 0.f};
   if (w.resting) {
     // Paint flows only inside the window. A brush at rest leaves the window free to slide off its
@@ -445,7 +449,11 @@ Simulator::WindowPlace Simulator::place_window(const std::array<float, 4>& befor
     // and free the paint at its walls by turns). A wall that slid back over a stroke's body would
     // set its frozen part flowing again, a step where the freeze resumed: paint settling runs
     // slower than kRunningPaint, and paint away from the walls moves no wall.
-    const float slack = std::max(0.f, std::min(w.zone_room, w.rim_room - 2.f * box_miss_ - 1.f));
+    // A brush lifted clear of the window (the easel's painter holding it up beside the work) has
+    // nothing there to hold: the window goes as far as the running paint asks, and comes back to
+    // the brush the step it starts down.
+    const float slack = w.free ? std::numeric_limits<float>::infinity()
+                               : std::max(0.f, std::min(w.zone_room, w.rim_room - 2.f * box_miss_ - 1.f));
     if (running_) {
       const std::array<float, 4>& m = *running_;
       const Int3 o = grid_->window().origin_for(Vec3(cx, cy, 0.f), snap);
@@ -461,7 +469,7 @@ Simulator::WindowPlace Simulator::place_window(const std::array<float, 4>& befor
     const float dx = std::clamp(slid_[0], -slack, slack), dy = std::clamp(slid_[1], -slack, slack);
     const float off = std::max(std::abs(dx), std::abs(dy));
     cx += dx, cy += dy;
-    w.rim_room -= off, w.zone_room -= off;
+    if (!w.free) w.rim_room -= off, w.zone_room -= off;  // a free window holds neither the box nor its zone
     zone_D0_ = std::clamp(room - off, floor_D0, D0);
   }
   w.origin = grid_->window().origin_for(Vec3(cx, cy, 0.f), snap);
@@ -641,8 +649,12 @@ void Simulator::step_part(const BrushPose* pen_poses, int substeps, float dt) {
     pen_slid = std::hypot(moved.x, moved.y);
     guess_ = {box_before[0] + moved.x, box_before[1] + moved.x, box_before[2] + moved.y, box_before[3] + moved.y};
     box_ = guess_;
-    WindowPlace w = place_window(box_before, box_);
-    if (w.rim_room < 2.f * box_miss_ + 1.f) {
+    // A brush is clear of the window when no sample was below its top at the last step's end and
+    // its tips are not coming down: only then may the window leave it (no particle clings to
+    // bristles above the window, and those elsewhere go to the grid at the move as at any).
+    const bool clear = box_clear_ && footprint_centre(brush_->pose(), config_.brush.length).z >= tips_before.z;
+    WindowPlace w = place_window(box_before, box_, clear);
+    if (!w.free && w.rim_room < 2.f * box_miss_ + 1.f) {
       box_ = samples_box();
       w = place_window(box_before, box_);
       ++counters_.box_reads;

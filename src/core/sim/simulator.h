@@ -244,10 +244,12 @@ class Simulator {
     float zone_room;  ///< for the particle zone at D0's floor (negative: the window cuts it)
     FlowColumns flow;  ///< the columns where paint flows: centred on the box, whatever the snap
     bool resting = false;  ///< the box stood still over the step: no wall moves, the window may slide
+    bool free = false;     ///< the brush rests clear of the window: it goes where the paint runs
   };
   /// The window for the samples' box over the step (the union of `before` and `after`), and the
-  /// D0 that keeps the particle zone inside its kept box (zone_D0_).
-  WindowPlace place_window(const std::array<float, 4>& before, const std::array<float, 4>& after);
+  /// D0 that keeps the particle zone inside its kept box (zone_D0_). `clear`: no sample below the
+  /// window's top and the brush not coming down (a lifted brush need not be in it).
+  WindowPlace place_window(const std::array<float, 4>& before, const std::array<float, 4>& after, bool clear = false);
   /// How many parts of a step keep each part's sweep of the brush inside the window (step()).
   int parts_of_step(const BrushPose* poses, int substeps) const;
   /// One part of a step: step() in full for the poses' sub-steps.
@@ -300,6 +302,7 @@ class Simulator {
   Int3 raster_origin_{};              ///< and the window origin it was made at
   DeviceBuffer<float> extent_scratch_, extent_;  ///< the samples' box and the ground (samples_box)
   std::array<float, 4> box_{};                   ///< the samples' box at the end of the last step
+  bool box_clear_ = false;  ///< no sample was below the window's top then (box_ is the tips' point)
   /// The box (x_lo, x_hi, y_lo, y_hi) of the paint that ran at the end of the last step, measured
   /// where the brush rested (place_window slides the window away from a wall it nears).
   std::optional<std::array<float, 4>> running_;
