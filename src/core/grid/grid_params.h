@@ -55,8 +55,8 @@ struct GridParams {
   /// Flow index n at oil 1. Default 1 (the oil is Newtonian), range (0, 1].
   float flow_index_oily = 1.f;
   /// Papanastasiou regularisation m, s: below the critical strain rate 1/m the paint is a
-  /// liquid of viscosity tau_y m + K m^(1-n) (unyielded: it creeps at stress / that). Default 100,
-  /// range [1, 1e5].
+  /// liquid of viscosity tau_y m + K m^(1-n) (unyielded: it creeps at stress / that). Default 1e4
+  /// (a 3 mm ridge of stiff paint creeps about a micrometre in 2 s, docs/GRID.md), range [1, 1e5].
   float regularisation = 1e4f;
   /// Paint density rho0, kg/m^3 (mu / rho0 is the kinematic viscosity). Default 1000 (§5.1).
   float rho0 = 1000.f;
