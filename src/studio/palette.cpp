@@ -63,11 +63,7 @@ void PalettePanel::send_event(const StrokeEvent& e) {
 void PalettePanel::put_paint(QPointF c, const PaintLoad& paint) {
   const float cx = float(c.x()), cy = float(c.y());
   sim_->post([cx, cy, paint](SimThread& s) {
-    // About a fifth of the palette's height across, a third as high as wide (a squeezed-out
-    // dab of stiff paint), within half the paint depth.
-    const CanvasDims d = s.session().dims();
-    const float radius = std::max(4.f, 0.1f * float(std::min(d.width, d.height)));
-    const float height = std::min(0.6f * radius, 0.5f * float(d.depth));
+    const auto [radius, height] = palette_dab_size(s.session().config());
     s.session().put_paint(cx, cy, radius, height, paint);
     s.invalidate_rect(int(cx - radius) - 1, int(cy - radius) - 1, int(cx + radius) + 2, int(cy + radius) + 2);
   });

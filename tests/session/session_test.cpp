@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -214,6 +215,40 @@ TEST_F(SessionTest, AStrokeOfAnotherCanvasOrNonsenseIsRefusedWithItsReason) {
   }
   EXPECT_THROW(s.put_paint(10.f, 10.f, std::nanf(""), 1.f, red()), Error);
   EXPECT_THROW(s.advance(), Error) << "no replay begun";
+}
+
+TEST_F(SessionTest, APaletteDabLeavesTheBrushRoomUnderTheWindowsLid) {
+  // The window's top is a lid nothing rises through. A palette's dab, scrubbed by the brush, has
+  // its ridges ploughed up over it: it is put out no higher than half the window's depth, and the
+  // scrubbed paint stays under the lid. A 200-cell palette and an 8-cell window: a dab a third as
+  // high as wide would be 12 cells high, above the lid from the start.
+  SimConfig c = small_config(CanvasDims{200, 120, 32});
+  c.window = Int3{48, 48, 8};
+  const DabSize dab = palette_dab_size(c);
+  EXPECT_FLOAT_EQ(dab.radius, 12.f);
+  EXPECT_LE(dab.height, 0.5f * float(c.window.z));
+  Session s(c);
+  s.put_paint(100.f, 60.f, dab.radius, dab.height, red());
+  const auto highest = [&] {
+    const FloatImage h = s.height_map();
+    return *std::max_element(h.data.begin(), h.data.end());
+  };
+  const float before = highest();
+  const BrushSpec& b = s.config().brush;
+  PaintLoad none = red();
+  none.load = 0.f;
+  none.reload_on_pen_down = false;
+  s.begin_stroke(pose_at(b, 70.f, 60.f, 0.f, false), none);
+  for (int i = 0; i <= 40; ++i) {
+    const BrushPose p = pose_at(b, 70.f + 1.5f * float(i), 60.f, 0.6f);
+    s.step(&p, 1, 1.f / 60.f);
+  }
+  s.end_stroke();
+  const float after = highest();
+  std::printf("palette dab: %.1f cells high put out, %.2f high scrubbed; the window's lid at %d\n", before, after,
+              c.window.z);
+  EXPECT_NEAR(before, dab.height, 0.5f);
+  EXPECT_LT(after, float(c.window.z) - 1.f) << "the scrubbed paint stays under the lid";
 }
 
 }  // namespace

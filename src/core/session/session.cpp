@@ -356,6 +356,16 @@ std::optional<Vec3> Session::pick(int x, int y) {
   return renderer_.pigment_at(sim_->tiles(), x, y, sim_->live_window());
 }
 
+DabSize palette_dab_size(const SimConfig& config) {
+  // The window's top is a lid nothing rises through, and a brush scrubbing the dab ploughs ridges
+  // of about 4 cells over it: a dab to the lid has no room for them. The viscous solve's
+  // iterations also grow with the depth of paint over the no-slip glass: 6-cell dabs in a
+  // 12-cell window take 13 a step on average, 12-cell dabs 32 (docs/STUDIO.md "Palette").
+  const CanvasDims& d = config.canvas;
+  const float radius = std::max(4.f, 0.1f * float(std::min(d.width, d.height)));
+  return {radius, std::min(0.6f * radius, 0.5f * float(std::min(config.window.z, d.depth)))};
+}
+
 void Session::put_paint(float cx, float cy, float radius, float height, const PaintLoad& paint) {
   WB_REQUIRE(std::isfinite(cx) && std::isfinite(cy) && std::isfinite(radius) && std::isfinite(height) &&
                  radius > 0.f && height > 0.f,

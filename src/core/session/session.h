@@ -39,6 +39,13 @@ BrushPose start_pose(const Stroke& stroke);
 /// a cell). Touches only the tiles under the dab.
 void put_paint_dab(TileStore& canvas, float cx, float cy, float radius, float height, const PaintLoad& paint);
 
+/// A dab put out on a palette (the studio's wells): about a fifth of the canvas's smaller side
+/// across, a third as high as wide (squeezed-out stiff paint), within half the window's depth.
+struct DabSize {
+  float radius = 0.f, height = 0.f;  ///< cells
+};
+DabSize palette_dab_size(const SimConfig& config);
+
 /// A copy of the painting at rest, taken between two steps: what a save writes (any thread may
 /// write it while the session paints on).
 struct PaintingSnapshot {
