@@ -150,7 +150,10 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
   });
   hold_timer_.setInterval(8);
   connect(&hold_timer_, &QTimer::timeout, this, [this] {
-    if (clock_.down()) push_clock(clock_.hold(wall_now()));
+    if (clock_.down())
+      push_clock(clock_.hold(wall_now()));
+    else if (sim_->paint_running() && sim_->is_idle())
+      push_clock(clock_.air(wall_now()));  // the paint runs on while the pen is away (an easel)
   });
   hold_timer_.start();
 

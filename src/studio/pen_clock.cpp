@@ -96,6 +96,24 @@ ClockOutput PenClock::release(const PenInput& p, double t) {
   return out;
 }
 
+ClockOutput PenClock::air(double now) {
+  ClockOutput out;
+  // After a stroke the time line ends on a lifted sample on a step boundary (release, event): the
+  // paint runs a step further with the brush held there, so time between strokes is the gap
+  // plus as long as the paint ran.
+  // The steps of session time the wall clock has run since the last sample, a few at most (the
+  // caller waits for the simulation to catch up before asking again).
+  const int n = std::min(4, int((now - last_arrival_) / kStepDt));
+  if (down_ || !any_ || n < 1) return out;
+  last_arrival_ = now;
+  for (int k = 0; k < n; ++k) {
+    PenSample s = last_;
+    s.t = last_t_ + kStepDt;
+    push(out, s);
+  }
+  return out;
+}
+
 ClockOutput PenClock::event(StrokeEvent e) {
   ClockOutput out;
   if (down_) return out;  // the caller queues palette actions until the pen is up

@@ -56,6 +56,10 @@ class PenClock {
   /// from a timer).
   ClockOutput hold(double now);
   ClockOutput release(const PenInput& p, double t);
+  /// While the pen is away and the paint still runs (an easel's drips): the lifted brush held where
+  /// it is for the steps of session time the wall clock has run since the last sample, at most 4
+  /// (call from a timer while the simulation has caught up).
+  ClockOutput air(double now);
   /// A palette event (dip, wipe, clean, dry) while the pen is up: fires in the next step.
   ClockOutput event(StrokeEvent e);
 

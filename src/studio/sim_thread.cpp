@@ -313,6 +313,7 @@ void SimThread::step_once(const SessionStep& s) {
   const Int3 o = doc.sim().grid().window().origin(), n = doc.sim().grid().window().dims();
   invalidate_rect(std::min(o.x, o0.x), std::min(o.y, o0.y), std::max(o.x, o0.x) + n.x, std::max(o.y, o0.y) + n.y);
   session_.step_done(s);
+  paint_running_.store(doc.sim().paint_running(), std::memory_order_relaxed);
   // The pen events up to the step's end are in the paint now: they go with its next frame.
   const double consumed = wall_now();
   while (!pending_inputs_.empty() && pending_inputs_.front().session_t <= s.step.t) {

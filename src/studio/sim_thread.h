@@ -100,6 +100,9 @@ class SimThread : public QObject {
   void wait_idle();
   /// Every input pushed so far has been simulated (what wait_idle waits for).
   bool is_idle() const;
+  /// Wet paint still ran at the end of the last step simulated (Simulator::paint_running): the
+  /// time line goes on while the pen is away (PenClock::air).
+  bool paint_running() const { return paint_running_.load(std::memory_order_relaxed); }
 
   // --- on the simulation thread (inside post()) -----------------------------------------
   Session& session() { return *doc_; }
@@ -189,6 +192,7 @@ class SimThread : public QObject {
   std::deque<PenEventTime> pending_inputs_;
   bool quit_ = false;
   bool busy_ = false;
+  std::atomic<bool> paint_running_{false};
 
   SessionTimeline session_;  ///< the time line and its recording
 

@@ -942,6 +942,74 @@ class StudioTest : public QObject {
     QCOMPARE(on_sim(*w_, [](SimThread& s) { return s.sim().config().params.grid.tilt; }), 0.f);
   }
 
+  void easelPaintRunsOnWhileThePenIsAway() {
+    // On an easel oily paint keeps running after the pen lifts: the time line goes on a step at a
+    // time while the simulation has caught up and its paint still runs (PenClock::air,
+    // Simulator::paint_running: faster than 2 mm/s), and stops when it runs no more, whatever the tilt.
+    const auto centre_y = [&] {
+      return on_sim(*w_, [](SimThread& s) {
+        TileStore c = s.sim().settled_canvas_copy(Device{});
+        const CanvasDims d = c.dims();
+        double m = 0.0, my = 0.0;
+        for (int id : c.allocated_tile_ids()) {
+          const TileData t = c.read_tile(id);
+          for (int z = 0; z < d.depth; ++z)
+            for (int ly = 0; ly < kTileSize; ++ly)
+              for (int lx = 0; lx < kTileSize; ++lx) {
+                const float r = t.density[size_t((z * kTileSize + ly) * kTileSize + lx)];
+                m += r, my += r * (t.tile_y * kTileSize + ly + 0.5);
+              }
+        }
+        return m > 0.0 ? my / m : 0.0;
+      });
+    };
+    const auto away = [&](int ms, bool until_at_rest) {
+      QElapsedTimer t;
+      t.start();
+      while (t.elapsed() < ms && !(until_at_rest && !w_->sim()->paint_running() && w_->sim()->is_idle())) {
+        QCoreApplication::processEvents(QEventLoop::AllEvents, 5);
+        QThread::usleep(500);
+      }
+      w_->settle();
+    };
+    const auto oily_stroke = [&](float tilt) {
+      grid_only_canvas(false);
+      w_->set_tilt(tilt);
+      w_->paint_panel()->set_reload_each_stroke(false);
+      w_->clean_brush();
+      PaintLoad oily = w_->paint_panel()->current_paint();
+      oily.oil = 0.9f, oily.load = 1.f;
+      w_->dip(oily);
+      stroke(40.f, 1.f, 70.f, 90.f);  // slow and pressed: a thick bead of oily paint
+    };
+    // Upright: the bead runs on down the canvas while the pen is away.
+    oily_stroke(90.f);
+    const double y0 = centre_y();
+    const int64_t s0 = w_->sim()->status().steps;
+    away(1500, false);
+    const double y1 = centre_y();
+    const int64_t s1 = w_->sim()->status().steps;
+    qInfo("upright: the paint's centre at y %.2f after the stroke, %.2f after 1.5 s away (%lld steps)", y0, y1,
+          (long long)(s1 - s0));
+    QVERIFY2(s1 - s0 >= 20, "the running paint is simulated while the pen is away");
+    QVERIFY2(y1 - y0 > 0.5, "and runs down the easel");
+    // Flat: the oily bead spreads for a while, then runs no more, and nothing more is simulated.
+    oily_stroke(0.f);
+    const int64_t s_flat = w_->sim()->status().steps;
+    away(20000, true);
+    QVERIFY2(!w_->sim()->paint_running(), "the spreading bead stops running");
+    const double y2 = centre_y();
+    const int64_t s2 = w_->sim()->status().steps;
+    away(500, false);
+    qInfo("flat: running no more after %lld steps away; %lld steps in the next 0.5 s", (long long)(s2 - s_flat),
+          (long long)(w_->sim()->status().steps - s2));
+    QCOMPARE(w_->sim()->status().steps, s2);
+    QVERIFY(std::fabs(centre_y() - y2) < 1e-6);
+    w_->set_tilt(0.f);
+    w_->paint_panel()->set_reload_each_stroke(true);
+    w_->settle();
+  }
+
   void reloadEachStrokeLoadsTheSelectedWell() {
     // On (the default): every stroke paints the selected well's colour, whatever the brush held;
     // off: the brush keeps its paint from stroke to stroke. The choice is kept in studio.ini.

@@ -117,6 +117,10 @@ class Simulator {
   /// True when the last step left the paint at rest: no face of a painted cell carried paint
   /// faster than grid.rest_speed (the flow the step's advection started from).
   bool paint_at_rest() const;
+  /// True when, at the end of the last step, the brush rested and wet paint ran across the canvas
+  /// faster than kRunningPaint (10 cells/s, 2 mm/s: drips down an easel, an oily pool spreading),
+  /// the box the resting brush's window slides after (docs/GRID.md "The window's walls").
+  bool paint_running() const { return running_.has_value(); }
   /// A pause of `seconds` in which nothing moves, in one call instead of its steps: the particles
   /// go back into the grid (settle), every painted cell dries by the pause (Grid::dry) and the
   /// brush waits at rest at `pose`, where the pause ends.
