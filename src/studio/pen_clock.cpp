@@ -98,11 +98,10 @@ ClockOutput PenClock::release(const PenInput& p, double t) {
 
 ClockOutput PenClock::air(double now) {
   ClockOutput out;
-  // After a stroke the time line ends on a lifted sample on a step boundary (release, event): the
-  // paint runs a step further with the brush held there, so time between strokes is the gap
-  // plus as long as the paint ran.
-  // The steps of session time the wall clock has run since the last sample, a few at most (the
-  // caller waits for the simulation to catch up before asking again).
+  // The time line ends on a lifted sample on a step boundary (release, event): it goes on by the
+  // steps the wall clock has run since the last sample, with the brush held there, a few at most
+  // (the caller asks again once the simulation has caught up). Time between strokes is then the
+  // gap and as long as the paint ran.
   const int n = std::min(4, int((now - last_arrival_) / kStepDt));
   if (down_ || !any_ || n < 1) return out;
   last_arrival_ = now;
