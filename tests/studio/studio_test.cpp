@@ -963,10 +963,14 @@ class StudioTest : public QObject {
         return m > 0.0 ? my / m : 0.0;
       });
     };
-    const auto away = [&](int ms, bool until_at_rest) {
+    // Waits with the pen away for `ms`, or until `steps` more steps are done or the paint runs no
+    // more (a loaded machine paces the steps slower than the wall clock).
+    const auto away = [&](int ms, int64_t steps, bool until_still) {
+      const int64_t s0 = w_->sim()->status().steps;
       QElapsedTimer t;
       t.start();
-      while (t.elapsed() < ms && !(until_at_rest && !w_->sim()->paint_running() && w_->sim()->is_idle())) {
+      while (t.elapsed() < ms && !(steps > 0 && w_->sim()->status().steps - s0 >= steps) &&
+             !(until_still && !w_->sim()->paint_running() && w_->sim()->is_idle())) {
         QCoreApplication::processEvents(QEventLoop::AllEvents, 5);
         QThread::usleep(500);
       }
@@ -982,25 +986,29 @@ class StudioTest : public QObject {
       w_->dip(oily);
       stroke(40.f, 1.f, 70.f, 90.f);  // slow and pressed: a thick bead of oily paint
     };
-    // Upright: the bead runs on down the canvas while the pen is away.
+    // Upright: the bead runs on down the canvas while the pen is away, a second and a half of
+    // steps (at most the wall clock's pace).
     oily_stroke(90.f);
     const double y0 = centre_y();
     const int64_t s0 = w_->sim()->status().steps;
-    away(1500, false);
+    QElapsedTimer wall;
+    wall.start();
+    away(30000, 96, false);
     const double y1 = centre_y();
     const int64_t s1 = w_->sim()->status().steps;
-    qInfo("upright: the paint's centre at y %.2f after the stroke, %.2f after 1.5 s away (%lld steps)", y0, y1,
-          (long long)(s1 - s0));
-    QVERIFY2(s1 - s0 >= 20, "the running paint is simulated while the pen is away");
+    qInfo("upright: the paint's centre at y %.2f after the stroke, %.2f after %lld steps away (%.1f s)", y0, y1,
+          (long long)(s1 - s0), wall.elapsed() / 1000.0);
+    QVERIFY2(s1 - s0 >= 96, "the running paint is simulated while the pen is away");
+    QVERIFY2(wall.elapsed() >= 1400, "no faster than the wall clock");
     QVERIFY2(y1 - y0 > 0.5, "and runs down the easel");
     // Flat: the oily bead spreads for a while, then runs no more, and nothing more is simulated.
     oily_stroke(0.f);
     const int64_t s_flat = w_->sim()->status().steps;
-    away(20000, true);
+    away(30000, 0, true);
     QVERIFY2(!w_->sim()->paint_running(), "the spreading bead stops running");
     const double y2 = centre_y();
     const int64_t s2 = w_->sim()->status().steps;
-    away(500, false);
+    away(500, 0, false);
     qInfo("flat: running no more after %lld steps away; %lld steps in the next 0.5 s", (long long)(s2 - s_flat),
           (long long)(w_->sim()->status().steps - s2));
     QCOMPARE(w_->sim()->status().steps, s2);
