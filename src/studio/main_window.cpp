@@ -149,12 +149,8 @@ MainWindow::MainWindow(const StudioOptions& options, QWidget* parent)
     pending_events_.clear();
   });
   hold_timer_.setInterval(8);
-  connect(&hold_timer_, &QTimer::timeout, this, [this] {
-    if (clock_.down())
-      push_clock(clock_.hold(wall_now()));
-    else if (sim_->paint_running() && sim_->is_idle())
-      push_clock(clock_.air(wall_now()));  // the paint runs on while the pen is away (an easel)
-  });
+  // A held pen's repeats, and the running paint's steps while the pen is away (an easel).
+  connect(&hold_timer_, &QTimer::timeout, this, [this] { push_clock(clock_.tick(wall_now(), sim_->paint_runs_on())); });
   hold_timer_.start();
 
   // Panels.

@@ -44,12 +44,7 @@ PalettePanel::PalettePanel(const SimConfig& config, const RenderParams& render, 
   connect(view_, &CanvasView::placePaint, this, &PalettePanel::placePaint);
   connect(view_, &CanvasView::pickColor, this, &PalettePanel::pickColor);
   hold_timer_.setInterval(8);
-  connect(&hold_timer_, &QTimer::timeout, this, [this] {
-    if (clock_.down())
-      push(clock_.hold(wall_now()));
-    else if (sim_->paint_running() && sim_->is_idle())
-      push(clock_.air(wall_now()));
-  });
+  connect(&hold_timer_, &QTimer::timeout, this, [this] { push(clock_.tick(wall_now(), sim_->paint_runs_on())); });
   hold_timer_.start();
 }
 

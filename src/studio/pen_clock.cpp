@@ -99,9 +99,10 @@ ClockOutput PenClock::release(const PenInput& p, double t) {
 ClockOutput PenClock::air(double now) {
   ClockOutput out;
   // The time line ends on a lifted sample on a step boundary (release, event): it goes on by the
-  // steps the wall clock has run since the last sample, with the brush held there, a few at most
-  // (the caller asks again once the simulation has caught up). Time between strokes is then the
-  // gap and as long as the paint ran.
+  // steps the wall clock has run since the last sample, with the brush held there. A few at most:
+  // the first call after a release comes once the simulation has run the gap, whose steps already
+  // stand for the wall time since the last sample's arrival, and the caller asks again once the
+  // simulation has caught up. Time between strokes is then the gap and as long as the paint ran.
   const int n = std::min(4, int((now - last_arrival_) / kStepDt));
   if (down_ || !any_ || n < 1) return out;
   last_arrival_ = now;

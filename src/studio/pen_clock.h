@@ -60,6 +60,12 @@ class PenClock {
   /// it is for the steps of session time the wall clock has run since the last sample, at most 4
   /// (call from a timer while the simulation has caught up).
   ClockOutput air(double now);
+  /// The hold timer's tick: hold() while the pen is down, else air() where `paint_runs_on` (the
+  /// simulation has caught up and its paint still runs: SimThread::paint_runs_on).
+  ClockOutput tick(double now, bool paint_runs_on) {
+    if (down_) return hold(now);
+    return paint_runs_on ? air(now) : ClockOutput{};
+  }
   /// A palette event (dip, wipe, clean, dry) while the pen is up: fires in the next step.
   ClockOutput event(StrokeEvent e);
 

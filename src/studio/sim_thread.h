@@ -103,6 +103,9 @@ class SimThread : public QObject {
   /// Wet paint still ran at the end of the last step simulated (Simulator::paint_running): the
   /// time line goes on while the pen is away (PenClock::air).
   bool paint_running() const { return paint_running_.load(std::memory_order_relaxed); }
+  /// The paint still runs and every input so far has been simulated: the pen clock may extend the
+  /// time line (PenClock::tick).
+  bool paint_runs_on() const { return paint_running() && is_idle(); }
 
   // --- on the simulation thread (inside post()) -----------------------------------------
   Session& session() { return *doc_; }
